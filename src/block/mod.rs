@@ -1,0 +1,366 @@
+//! Blocks: the [`Block`] trait, typed ids, per-degree-of-freedom fixity and the rigid polyhedral block.
+
+use serde::{Deserialize, Serialize};
+
+use crate::constitutive::MaterialId;
+use crate::error::{positive, Error, Result};
+use crate::geometry::{MassProperties, Polyhedron};
+use crate::math::{is_finite_vector, Pose, Real, Vector};
+
+/// Typed index of a block in a [`crate::Model`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub struct BlockId(pub u32);
+
+impl std::fmt::Display for BlockId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "#{}", self.0)
+    }
+}
+
+impl BlockId {
+    /// The index into the model's block list.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// What a single degree of freedom does.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum Dof {
+    /// Moves under the forces.
+    #[default]
+    Free,
+    /// Held at zero velocity.
+    Fixed,
+    /// Moves at a prescribed velocity (m/s or rad/s).
+    Velocity(Real),
+}
+
+impl Dof {
+    /// The prescribed velocity, if the degree of freedom is constrained.
+    #[inline]
+    pub fn prescribed(self) -> Option<Real> {
+        match self {
+            Dof::Free => None,
+            Dof::Fixed => Some(0.0),
+            Dof::Velocity(v) => Some(v),
+        }
+    }
+}
+
+/// Fixity of the six degrees of freedom of a block, along the world axes.
+///
+/// ```
+/// use voussoir::block::{Dof, Fixity};
+/// // A loading plate: pushed down at 10 mm/s, free horizontally, no rotation.
+/// let plate = Fixity {
+///     translation: [Dof::Free, Dof::Velocity(-0.01), Dof::Free],
+///     rotation: [Dof::Fixed; 3],
+/// };
+/// assert!(!plate.is_free());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Fixity {
+    /// Translations along world x, y, z.
+    pub translation: [Dof; 3],
+    /// Rotations about world x, y, z.
+    pub rotation: [Dof; 3],
+}
+
+impl Fixity {
+    /// All six degrees of freedom free.
+    pub const FREE: Fixity = Fixity {
+        translation: [Dof::Free; 3],
+        rotation: [Dof::Free; 3],
+    };
+    /// All six degrees of freedom fixed (a support).
+    pub const FIXED: Fixity = Fixity {
+        translation: [Dof::Fixed; 3],
+        rotation: [Dof::Fixed; 3],
+    };
+
+    /// Translation at a prescribed velocity, rotations fixed.
+    pub fn velocity(v: Vector) -> Fixity {
+        Fixity {
+            translation: [Dof::Velocity(v.x), Dof::Velocity(v.y), Dof::Velocity(v.z)],
+            rotation: [Dof::Fixed; 3],
+        }
+    }
+
+    /// `true` when no degree of freedom is constrained.
+    pub fn is_free(&self) -> bool {
+        self.translation.iter().chain(&self.rotation).all(|d| *d == Dof::Free)
+    }
+
+    /// `true` when every degree of freedom is held at zero velocity.
+    pub fn is_fixed(&self) -> bool {
+        self.translation.iter().chain(&self.rotation).all(|d| *d == Dof::Fixed)
+    }
+
+    fn validate(&self, block: &str) -> Result<()> {
+        for d in self.translation.iter().chain(&self.rotation) {
+            if let Dof::Velocity(v) = d {
+                if !v.is_finite() {
+                    return Err(Error::NonFinite {
+                        what: format!("prescribed velocity of block {block:?}"),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Kinematic state of a block. Velocities are at the last half step of central difference.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BlockState {
+    /// Pose of the principal frame (translation = centroid).
+    pub pose: Pose,
+    /// Velocity of the centroid (m/s).
+    pub velocity: Vector,
+    /// Angular velocity, world frame (rad/s).
+    pub angular_velocity: Vector,
+    /// Angular momentum about the centroid, world frame (kg·m²/s).
+    pub angular_momentum: Vector,
+}
+
+/// A force and a moment about the block centroid, world frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Wrench {
+    /// Force (N).
+    pub force: Vector,
+    /// Moment about the centroid (N·m).
+    pub moment: Vector,
+}
+
+impl std::ops::AddAssign for Wrench {
+    fn add_assign(&mut self, o: Wrench) {
+        self.force += o.force;
+        self.moment += o.moment;
+    }
+}
+
+/// What the integrator and the contact code need from a body.
+///
+/// [`RigidBlock`] is the implementation voussoir ships; the trait leaves room for other kinds.
+pub trait Block {
+    /// A name for messages and outputs.
+    fn name(&self) -> &str;
+    /// The shape in its principal frame.
+    fn shape(&self) -> &Polyhedron;
+    /// Mass and principal inertia.
+    fn mass_properties(&self) -> MassProperties;
+    /// Current kinematic state.
+    fn state(&self) -> &BlockState;
+    /// Fixity of its degrees of freedom.
+    fn fixity(&self) -> &Fixity;
+    /// Material, which selects the joint law with each neighbour.
+    fn material(&self) -> MaterialId;
+
+    /// Current world position of a material point given in the body frame.
+    fn world_point(&self, local: Vector) -> Vector {
+        self.state().pose.transform_point(local)
+    }
+    /// Body-frame coordinates of a world point in the current pose.
+    fn local_point(&self, world: Vector) -> Vector {
+        self.state().pose.inverse_transform_point(world)
+    }
+}
+
+/// A rigid convex polyhedral block of uniform density.
+///
+/// ```
+/// use voussoir::block::{Block, Fixity, RigidBlock};
+/// use voussoir::math::Vector;
+/// let base = RigidBlock::cuboid("base", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), 2500.0)?
+///     .with_fixity(Fixity::FIXED);
+/// assert!((base.mass_properties().mass - 2500.0 * 0.8).abs() < 1e-9);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RigidBlock {
+    name: String,
+    shape: Polyhedron,
+    density: Real,
+    mass: MassProperties,
+    material: MaterialId,
+    fixity: Fixity,
+    pub(crate) state: BlockState,
+    pub(crate) initial_pose: Pose,
+    pub(crate) load: Wrench,
+}
+
+impl RigidBlock {
+    /// The convex hull of `vertices` (world coordinates) with uniform `density` (kg/m³).
+    ///
+    /// # Errors
+    /// Bad geometry as in [`Polyhedron::from_hull`]; [`Error::InvalidParameter`] for a density
+    /// that is not positive and finite.
+    pub fn from_vertices(name: &str, vertices: &[Vector], density: Real) -> Result<Self> {
+        positive(&format!("density of block {name:?}"), density)?;
+        let placed = Polyhedron::from_hull(name, vertices)?;
+        Ok(Self::from_shape(name, placed.shape, placed.pose, density))
+    }
+
+    /// A polyhedron with explicit faces (vertex loops, counter-clockwise seen from outside).
+    ///
+    /// # Errors
+    /// As [`Polyhedron::from_faces`], and for a bad density.
+    pub fn from_faces(name: &str, vertices: &[Vector], faces: &[Vec<usize>], density: Real) -> Result<Self> {
+        positive(&format!("density of block {name:?}"), density)?;
+        let placed = Polyhedron::from_faces(name, vertices, faces)?;
+        Ok(Self::from_shape(name, placed.shape, placed.pose, density))
+    }
+
+    /// An axis-aligned box between the corners `min` and `max`.
+    ///
+    /// # Errors
+    /// As [`RigidBlock::from_vertices`].
+    pub fn cuboid(name: &str, min: Vector, max: Vector, density: Real) -> Result<Self> {
+        Self::from_vertices(name, &cuboid_corners(min, max), density)
+    }
+
+    fn from_shape(name: &str, shape: Polyhedron, pose: Pose, density: Real) -> Self {
+        let mass = shape.mass_properties(density);
+        Self {
+            name: name.to_owned(),
+            shape,
+            density,
+            mass,
+            material: MaterialId::default(),
+            fixity: Fixity::FREE,
+            state: BlockState {
+                pose,
+                velocity: Vector::ZERO,
+                angular_velocity: Vector::ZERO,
+                angular_momentum: Vector::ZERO,
+            },
+            initial_pose: pose,
+            load: Wrench::default(),
+        }
+    }
+
+    /// Sets the material.
+    pub fn with_material(mut self, material: MaterialId) -> Self {
+        self.material = material;
+        self
+    }
+
+    /// Sets the fixity.
+    pub fn with_fixity(mut self, fixity: Fixity) -> Self {
+        self.fixity = fixity;
+        self
+    }
+
+    /// Sets the initial velocity (m/s) and angular velocity (rad/s, world frame).
+    pub fn with_velocity(mut self, velocity: Vector, angular_velocity: Vector) -> Self {
+        self.state.velocity = velocity;
+        self.state.angular_velocity = angular_velocity;
+        self.state.angular_momentum = self.world_inertia_times(angular_velocity);
+        self
+    }
+
+    /// Moves the block rigidly: `pose` is applied on top of its current placement.
+    pub fn transformed(mut self, pose: Pose) -> Self {
+        self.state.pose = pose * self.state.pose;
+        self.initial_pose = self.state.pose;
+        self.state.angular_momentum = self.world_inertia_times(self.state.angular_velocity);
+        self
+    }
+
+    /// Density (kg/m³).
+    pub fn density(&self) -> Real {
+        self.density
+    }
+
+    /// Pose at construction (reference for displacements).
+    pub fn initial_pose(&self) -> &Pose {
+        &self.initial_pose
+    }
+
+    /// Applied external load (force and moment about the centroid), constant in time.
+    pub fn load(&self) -> Wrench {
+        self.load
+    }
+
+    /// Displacement of the material point that was at `initial_world` at construction (m).
+    pub fn displacement_of(&self, initial_world: Vector) -> Vector {
+        let local = self.initial_pose.inverse_transform_point(initial_world);
+        self.state.pose.transform_point(local) - initial_world
+    }
+
+    /// Velocity of a material point given in world coordinates (current position).
+    pub fn point_velocity(&self, world: Vector) -> Vector {
+        self.state.velocity + self.state.angular_velocity.cross(world - self.state.pose.translation)
+    }
+
+    /// Kinetic energy at the stored (half-step) velocities (J).
+    pub fn kinetic_energy(&self) -> Real {
+        0.5 * self.mass.mass * self.state.velocity.length_squared()
+            + 0.5 * self.state.angular_velocity.dot(self.state.angular_momentum)
+    }
+
+    /// `I_world · w` with the current rotation.
+    pub(crate) fn world_inertia_times(&self, w: Vector) -> Vector {
+        let r = self.state.pose.rotation;
+        r * (self.mass.principal_inertia * (r.inverse() * w))
+    }
+
+    /// `I_world⁻¹ · l` with the current rotation.
+    pub(crate) fn world_inverse_inertia_times(&self, l: Vector) -> Vector {
+        let r = self.state.pose.rotation;
+        r * ((r.inverse() * l) / self.mass.principal_inertia)
+    }
+
+    pub(crate) fn validate(&self) -> Result<()> {
+        self.fixity.validate(&self.name)?;
+        let s = &self.state;
+        for (what, v) in [
+            ("velocity", s.velocity),
+            ("angular velocity", s.angular_velocity),
+            ("position", s.pose.translation),
+            ("load force", self.load.force),
+            ("load moment", self.load.moment),
+        ] {
+            if !is_finite_vector(v) {
+                return Err(Error::NonFinite {
+                    what: format!("{what} of block {:?}", self.name),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Block for RigidBlock {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn shape(&self) -> &Polyhedron {
+        &self.shape
+    }
+    fn mass_properties(&self) -> MassProperties {
+        self.mass
+    }
+    fn state(&self) -> &BlockState {
+        &self.state
+    }
+    fn fixity(&self) -> &Fixity {
+        &self.fixity
+    }
+    fn material(&self) -> MaterialId {
+        self.material
+    }
+}
+
+/// The eight corners of the axis-aligned box `[min, max]`.
+pub fn cuboid_corners(min: Vector, max: Vector) -> [Vector; 8] {
+    std::array::from_fn(|i| {
+        Vector::new(
+            if i & 1 == 0 { min.x } else { max.x },
+            if i & 2 == 0 { min.y } else { max.y },
+            if i & 4 == 0 { min.z } else { max.z },
+        )
+    })
+}

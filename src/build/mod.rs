@@ -1,0 +1,5 @@
+//! Generators of block assemblies used by examples, tests and users.
+
+mod wall;
+
+pub use wall::{running_bond_wall, WallSpec};

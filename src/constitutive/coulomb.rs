@@ -1,0 +1,209 @@
+//! Coulomb slip with tension cut-off, cohesion and residual friction (3DEC's joint model).
+
+use serde::{Deserialize, Serialize};
+
+use super::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
+use crate::error::{in_range, non_negative, positive, Result};
+use crate::math::{Real, Vector};
+
+/// Coulomb slip joint.
+///
+/// Per sub-contact of area `A`, with `u_n` the normal displacement (positive = opening):
+///
+/// * normal: `F_n = -kn·A·u_n`; if `F_n < -f_t·A` the joint fails in tension and `F_n = F_s = 0`;
+/// * shear (incremental): `F_s ← F_s - ks·A·Δu_s`, capped at `c·A + F_n·tan φ`;
+/// * failure in tension or shear sets cohesion and tensile strength to zero and `φ` to `φ_r`.
+///
+/// Angles are stored in radians; the constructors take degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CoulombSlip {
+    /// Normal stiffness `kn` (Pa/m).
+    pub normal_stiffness: Real,
+    /// Shear stiffness `ks` (Pa/m).
+    pub shear_stiffness: Real,
+    /// Initial friction angle `φ` (rad).
+    pub friction_angle: Real,
+    /// Residual friction angle `φ_r` (rad), after failure.
+    pub residual_friction_angle: Real,
+    /// Cohesion `c` (Pa).
+    pub cohesion: Real,
+    /// Tensile strength `f_t` (Pa).
+    pub tensile_strength: Real,
+}
+
+/// Per-sub-contact history of [`CoulombSlip`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct CoulombState {
+    /// Cohesion and tensile strength lost, residual friction active.
+    pub failed: bool,
+}
+
+impl CoulombSlip {
+    /// A dry joint (no cohesion, no tension), residual friction equal to the initial one.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] for non-positive stiffness or a friction angle outside
+    /// `[0°, 90°)`.
+    pub fn dry(kn: Real, ks: Real, friction_deg: Real) -> Result<Self> {
+        Self::new(kn, ks, friction_deg, friction_deg, 0.0, 0.0)
+    }
+
+    /// The full law: stiffness (Pa/m), initial and residual friction (degrees), cohesion and
+    /// tensile strength (Pa).
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] naming the first bad value.
+    pub fn new(
+        kn: Real,
+        ks: Real,
+        friction_deg: Real,
+        residual_friction_deg: Real,
+        cohesion: Real,
+        tensile_strength: Real,
+    ) -> Result<Self> {
+        let law = Self {
+            normal_stiffness: kn,
+            shear_stiffness: ks,
+            friction_angle: friction_deg.to_radians(),
+            residual_friction_angle: residual_friction_deg.to_radians(),
+            cohesion,
+            tensile_strength,
+        };
+        law.validate()?;
+        Ok(law)
+    }
+}
+
+impl ConstitutiveLaw for CoulombSlip {
+    type State = CoulombState;
+
+    fn stiffness(&self) -> JointStiffness {
+        JointStiffness {
+            normal: self.normal_stiffness,
+            shear: self.shear_stiffness,
+        }
+    }
+
+    fn update(&self, s: &JointStep, f: &mut JointForce, state: &mut CoulombState) -> JointStatus {
+        let a = s.area;
+        f.normal = -self.normal_stiffness * s.normal_displacement * a;
+        let (tensile, cohesion, phi) = if state.failed {
+            (0.0, 0.0, self.residual_friction_angle)
+        } else {
+            (self.tensile_strength, self.cohesion, self.friction_angle)
+        };
+        if f.normal < -tensile * a || (f.normal < 0.0 && tensile == 0.0) || (f.normal <= 0.0 && state.failed) {
+            if f.normal < 0.0 && tensile > 0.0 {
+                state.failed = true;
+            }
+            f.normal = 0.0;
+            f.shear = Vector::ZERO;
+            return JointStatus::Open;
+        }
+        f.shear -= s.shear_increment * (self.shear_stiffness * a);
+        let limit = cohesion * a + f.normal * phi.tan();
+        let trial = f.shear.length();
+        if trial > limit {
+            f.shear *= if trial > 0.0 { limit.max(0.0) / trial } else { 0.0 };
+            if cohesion > 0.0 || tensile > 0.0 || self.residual_friction_angle != self.friction_angle {
+                state.failed = true;
+            }
+            return JointStatus::Sliding;
+        }
+        JointStatus::Elastic
+    }
+
+    fn is_failed(&self, state: &CoulombState) -> bool {
+        state.failed
+    }
+
+    fn validate(&self) -> Result<()> {
+        positive("normal_stiffness", self.normal_stiffness)?;
+        positive("shear_stiffness", self.shear_stiffness)?;
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        in_range(
+            "friction_angle",
+            self.friction_angle,
+            0.0,
+            half_pi,
+            "must lie in [0, 90) degrees (given in rad)",
+        )?;
+        in_range(
+            "residual_friction_angle",
+            self.residual_friction_angle,
+            0.0,
+            half_pi,
+            "must lie in [0, 90) degrees (given in rad)",
+        )?;
+        non_negative("cohesion", self.cohesion)?;
+        non_negative("tensile_strength", self.tensile_strength)?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn step(un: Real, dus: Vector) -> JointStep {
+        JointStep {
+            area: 1.0,
+            normal_displacement: un,
+            normal_increment: 0.0,
+            shear_increment: dus,
+            normal: Vector::Z,
+            dt: 1.0,
+        }
+    }
+
+    #[test]
+    fn slip_caps_shear_at_friction_and_cohesion_is_lost_at_failure() {
+        let law = CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap();
+        let mut f = JointForce::default();
+        let mut s = CoulombState::default();
+        // Compressed by 1e-4 m: N = 1e5 N.
+        assert_eq!(
+            law.update(&step(-1e-4, Vector::ZERO), &mut f, &mut s),
+            JointStatus::Elastic
+        );
+        // Push 1 mm in x: trial 1e6 N > c + N tan 30 = 1e5 + 5.77e4.
+        assert_eq!(
+            law.update(&step(-1e-4, Vector::new(1e-3, 0.0, 0.0)), &mut f, &mut s),
+            JointStatus::Sliding
+        );
+        let cap = 1e5 + 1e5 * 30f64.to_radians().tan();
+        assert!((f.shear.x + cap).abs() < 1e-6, "{f:?}");
+        assert!(s.failed);
+        // Now residual: cap = N tan 20.
+        law.update(&step(-1e-4, Vector::new(1e-3, 0.0, 0.0)), &mut f, &mut s);
+        assert!((f.shear.x + 1e5 * 20f64.to_radians().tan()).abs() < 1e-6);
+    }
+
+    #[test]
+    fn tension_cut_off_and_failure() {
+        // With cohesion, so that tension does not exhaust the shear strength (c·A + F_n·tan φ > 0).
+        let law = CoulombSlip::new(1e9, 1e9, 30.0, 30.0, 1e5, 5e4).unwrap();
+        let mut f = JointForce::default();
+        let mut s = CoulombState::default();
+        // 4e-5 m opening: tension 4e4 < 5e4, carried.
+        assert_eq!(
+            law.update(&step(4e-5, Vector::ZERO), &mut f, &mut s),
+            JointStatus::Elastic
+        );
+        assert!((f.normal + 4e4).abs() < 1e-6);
+        assert_eq!(law.update(&step(6e-5, Vector::ZERO), &mut f, &mut s), JointStatus::Open);
+        assert!(s.failed && f.normal == 0.0);
+        // Once failed, no tension at all.
+        assert_eq!(law.update(&step(1e-6, Vector::ZERO), &mut f, &mut s), JointStatus::Open);
+    }
+
+    #[test]
+    fn bad_parameters_are_named() {
+        let e = CoulombSlip::dry(4e9, 1.6e9, 95.0).unwrap_err();
+        assert!(e.to_string().contains("friction_angle"), "{e}");
+        let e = CoulombSlip::dry(-1.0, 1.6e9, 30.0).unwrap_err();
+        assert!(e.to_string().contains("normal_stiffness"), "{e}");
+        let e = CoulombSlip::new(1e9, 1e9, 30.0, 30.0, Real::NAN, 0.0).unwrap_err();
+        assert!(e.to_string().contains("cohesion"), "{e}");
+    }
+}

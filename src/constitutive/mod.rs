@@ -1,0 +1,215 @@
+//! Joint constitutive laws: the [`ConstitutiveLaw`] trait, the laws voussoir ships, and the table
+//! that assigns a law to each pair of block materials.
+//!
+//! Sign conventions: the normal force is positive in compression; the shear force is the force on
+//! block `b` of the pair, in the joint plane; the normal displacement `u_n` is positive when the
+//! joint opens. Forces are stresses times the sub-contact area. See `docs/theory.md`.
+
+mod coulomb;
+mod elastic;
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+pub use coulomb::{CoulombSlip, CoulombState};
+pub use elastic::LinearElastic;
+
+use crate::error::Result;
+use crate::math::{Real, Vector};
+
+/// Material of a block; joint laws are chosen per pair of materials.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default, Serialize, Deserialize)]
+pub struct MaterialId(pub u16);
+
+impl std::fmt::Display for MaterialId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "material {}", self.0)
+    }
+}
+
+/// Elastic stiffness of a joint per unit area.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct JointStiffness {
+    /// Normal stiffness `kn` (Pa/m).
+    pub normal: Real,
+    /// Shear stiffness `ks` (Pa/m).
+    pub shear: Real,
+}
+
+/// What the kinematics of one step give a law at one sub-contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointStep {
+    /// Tributary area of the sub-contact (m²).
+    pub area: Real,
+    /// Total normal displacement `u_n` (m): positive = open, negative = interpenetration.
+    pub normal_displacement: Real,
+    /// Normal displacement increment of this step (m).
+    pub normal_increment: Real,
+    /// Shear displacement increment of block `b` relative to block `a` in the joint plane (m).
+    pub shear_increment: Vector,
+    /// Unit normal of the joint (from `a` to `b`).
+    pub normal: Vector,
+    /// Time step (s).
+    pub dt: Real,
+}
+
+/// The forces a law maintains at a sub-contact.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct JointForce {
+    /// Normal force (N), positive in compression.
+    pub normal: Real,
+    /// Shear force on block `b` (N), in the joint plane. On entry it holds the previous value
+    /// already rotated into the current plane.
+    pub shear: Vector,
+}
+
+/// State of a sub-contact after an update, for monitors and output.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum JointStatus {
+    /// In contact, below the strength.
+    #[default]
+    Elastic,
+    /// In contact, at the shear strength (slipping).
+    Sliding,
+    /// Open: no compression, no force (or tension below the tensile strength of a bonded joint,
+    /// which a law reports as [`JointStatus::Elastic`]).
+    Open,
+}
+
+/// A joint constitutive law: updates the forces at one sub-contact for one step.
+///
+/// Laws are plain values (their parameters); per-sub-contact history that the law needs besides
+/// the forces (damage, plastic slip, a bonded flag) lives in [`ConstitutiveLaw::State`], which
+/// voussoir stores contiguously next to each sub-contact and carries through re-detection and
+/// checkpoints. The model is generic over the law type, so calls are statically dispatched; to mix
+/// several laws in one model, implement the trait for an `enum` of them.
+///
+/// See `docs/custom-law.md` for a walk-through. A minimal law, frictionless and no-tension:
+///
+/// ```
+/// use voussoir::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
+/// use voussoir::math::Vector;
+///
+/// #[derive(Debug, Clone)]
+/// struct Frictionless { kn: f64 }
+///
+/// impl ConstitutiveLaw for Frictionless {
+///     type State = ();
+///     fn stiffness(&self) -> JointStiffness { JointStiffness { normal: self.kn, shear: 0.0 } }
+///     fn update(&self, s: &JointStep, f: &mut JointForce, _: &mut ()) -> JointStatus {
+///         f.shear = Vector::ZERO;
+///         f.normal = (-self.kn * s.normal_displacement * s.area).max(0.0);
+///         if f.normal > 0.0 { JointStatus::Sliding } else { JointStatus::Open }
+///     }
+/// }
+/// let law = Frictionless { kn: 1e9 };
+/// let step = JointStep { area: 0.01, normal_displacement: -1e-6, normal_increment: -1e-6,
+///     shear_increment: Vector::ZERO, normal: Vector::Z, dt: 1e-5 };
+/// let mut f = JointForce::default();
+/// assert_eq!(law.update(&step, &mut f, &mut ()), JointStatus::Sliding);
+/// assert!((f.normal - 10.0).abs() < 1e-9);
+/// ```
+pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
+    /// Law-specific history of one sub-contact. `Default` is the virgin state.
+    type State: Clone + Default + Send + Sync + std::fmt::Debug + PartialEq;
+
+    /// Initial (largest) stiffness, used for the critical time step and the Rayleigh dashpots.
+    fn stiffness(&self) -> JointStiffness;
+
+    /// Updates `force` (holding last step's forces, the shear already rotated into the current
+    /// plane) and `state` for this step's kinematics; returns the resulting status.
+    fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut Self::State) -> JointStatus;
+
+    /// Elastic energy stored in the joint springs (J). The default assumes linear springs with the
+    /// stiffness of [`ConstitutiveLaw::stiffness`].
+    fn elastic_energy(&self, area: Real, force: &JointForce, _state: &Self::State) -> Real {
+        let k = self.stiffness();
+        let mut e = 0.0;
+        if k.normal > 0.0 {
+            e += 0.5 * force.normal * force.normal / (k.normal * area);
+        }
+        if k.shear > 0.0 {
+            e += 0.5 * force.shear.length_squared() / (k.shear * area);
+        }
+        e
+    }
+
+    /// Whether the sub-contact has failed (lost cohesion or tensile strength), for output.
+    fn is_failed(&self, _state: &Self::State) -> bool {
+        false
+    }
+
+    /// Checks the law's parameters.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] naming the bad parameter.
+    fn validate(&self) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// The joint law of each pair of block materials (the pair is unordered).
+///
+/// ```
+/// use voussoir::constitutive::{CoulombSlip, JointTable, MaterialId};
+/// let stone = MaterialId(0);
+/// let steel = MaterialId(1);
+/// let mut joints = JointTable::new();
+/// joints.insert(stone, stone, CoulombSlip::dry(4e9, 1.6e9, 30.5)?)?;
+/// joints.insert(stone, steel, CoulombSlip::dry(4e9, 1.6e9, 0.0)?)?;
+/// assert!(joints.get(steel, stone).is_some());
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct JointTable<L> {
+    laws: Vec<L>,
+    index: BTreeMap<(MaterialId, MaterialId), u32>,
+}
+
+impl<L> Default for JointTable<L> {
+    fn default() -> Self {
+        Self {
+            laws: Vec::new(),
+            index: BTreeMap::new(),
+        }
+    }
+}
+
+impl<L: ConstitutiveLaw> JointTable<L> {
+    /// An empty table.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sets the law between materials `a` and `b` (either order), replacing any previous one.
+    ///
+    /// # Errors
+    /// The law's own [`ConstitutiveLaw::validate`] error.
+    pub fn insert(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
+        law.validate()?;
+        let key = (a.min(b), a.max(b));
+        match self.index.get(&key) {
+            Some(&i) => self.laws[i as usize] = law,
+            None => {
+                self.index.insert(key, self.laws.len() as u32);
+                self.laws.push(law);
+            }
+        }
+        Ok(())
+    }
+
+    /// The law between `a` and `b`.
+    pub fn get(&self, a: MaterialId, b: MaterialId) -> Option<&L> {
+        self.index_of(a, b).map(|i| &self.laws[i as usize])
+    }
+
+    pub(crate) fn index_of(&self, a: MaterialId, b: MaterialId) -> Option<u32> {
+        self.index.get(&(a.min(b), a.max(b))).copied()
+    }
+
+    /// All laws, indexed as contacts refer to them.
+    pub fn laws(&self) -> &[L] {
+        &self.laws
+    }
+}

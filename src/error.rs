@@ -1,0 +1,148 @@
+//! Typed errors: every bad input names what is wrong, where, and the offending value.
+
+use crate::block::BlockId;
+use crate::constitutive::MaterialId;
+use crate::math::Real;
+
+/// Result type of fallible voussoir operations.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Everything that can go wrong in voussoir.
+///
+/// Input errors name the parameter, block or material concerned and the value that was rejected;
+/// run-time errors name the step and the block.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A scalar parameter is out of its admissible range.
+    #[error("invalid parameter `{name}` = {value}: {expected}")]
+    InvalidParameter {
+        /// Parameter name, e.g. `"normal_stiffness"`.
+        name: String,
+        /// The rejected value.
+        value: Real,
+        /// What was expected, e.g. `"must be positive and finite"`.
+        expected: &'static str,
+    },
+    /// An input vector or point holds a NaN or an infinite component.
+    #[error("non-finite input in {what}")]
+    NonFinite {
+        /// Which input, e.g. `"vertex 3 of block \"voussoir 5\""`.
+        what: String,
+    },
+    /// A vertex set cannot make a solid (too few points, coplanar, collinear, duplicated).
+    #[error("block {block:?}: degenerate geometry: {reason}")]
+    DegenerateGeometry {
+        /// Name of the block being built.
+        block: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// Explicit faces do not describe a convex polyhedron.
+    #[error("block {block:?}: not convex: {reason}")]
+    NonConvex {
+        /// Name of the block being built.
+        block: String,
+        /// Which face or vertex violates convexity.
+        reason: String,
+    },
+    /// A block's volume is zero or negative (for example inward-facing faces).
+    #[error("block {block:?}: volume {volume} m^3 is not positive")]
+    NonPositiveVolume {
+        /// Name of the block being built.
+        block: String,
+        /// The computed volume.
+        volume: Real,
+    },
+    /// A block id that the model does not hold.
+    #[error("block {id} does not exist (the model has {count} blocks)")]
+    UnknownBlock {
+        /// The id that was asked for.
+        id: BlockId,
+        /// Number of blocks in the model.
+        count: usize,
+    },
+    /// Two blocks touch but no joint law was given for their pair of materials.
+    #[error("no joint law for materials {a} and {b} (blocks {block_a} and {block_b} touch)")]
+    MissingJointLaw {
+        /// First material.
+        a: MaterialId,
+        /// Second material.
+        b: MaterialId,
+        /// A block of material `a`.
+        block_a: BlockId,
+        /// A block of material `b`.
+        block_b: BlockId,
+    },
+    /// A user-given time step above the stability limit of central difference.
+    #[error("time step {dt} s exceeds the stable limit {limit} s set by block {block}")]
+    TimeStepTooLarge {
+        /// The requested step.
+        dt: Real,
+        /// The critical step (with the damping correction).
+        limit: Real,
+        /// The block with the highest frequency.
+        block: BlockId,
+    },
+    /// The run produced a non-finite or runaway state.
+    #[error("run diverged at step {step} (t = {time} s) in block {block}: {reason}")]
+    Diverged {
+        /// Step number at which the problem was found.
+        step: u64,
+        /// Simulated time at that step.
+        time: Real,
+        /// The offending block.
+        block: BlockId,
+        /// What was found, e.g. `"velocity is NaN"`.
+        reason: String,
+    },
+    /// A run reached its step budget before its stopping condition.
+    #[error("{what} not reached after {steps} steps (last value {last})")]
+    NotConverged {
+        /// What was being waited for.
+        what: &'static str,
+        /// Number of steps taken.
+        steps: u64,
+        /// The last value of the monitored quantity.
+        last: Real,
+    },
+}
+
+/// Checks that `value` is finite and strictly positive.
+pub(crate) fn positive(name: &str, value: Real) -> Result<Real> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.to_owned(),
+            value,
+            expected: "must be positive and finite",
+        })
+    }
+}
+
+/// Checks that `value` is finite and not negative.
+pub(crate) fn non_negative(name: &str, value: Real) -> Result<Real> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.to_owned(),
+            value,
+            expected: "must be finite and not negative",
+        })
+    }
+}
+
+/// Checks that `value` lies in `[lo, hi)`.
+pub(crate) fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'static str) -> Result<Real> {
+    if value.is_finite() && value >= lo && value < hi {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.to_owned(),
+            value,
+            expected,
+        })
+    }
+}

@@ -1,0 +1,124 @@
+//! Planar convex-polygon kernels in 2-D: half-plane clipping (Sutherland–Hodgman), area, centroid.
+
+use glam::DVec2;
+
+use crate::math::Real;
+
+/// Clips the convex polygon `poly` by the half-plane `{p : (p - origin) · outward <= 0}` into `out`.
+pub fn clip_halfplane(poly: &[DVec2], origin: DVec2, outward: DVec2, out: &mut Vec<DVec2>) {
+    out.clear();
+    let n = poly.len();
+    if n == 0 {
+        return;
+    }
+    for i in 0..n {
+        let a = poly[i];
+        let b = poly[(i + 1) % n];
+        let da = (a - origin).dot(outward);
+        let db = (b - origin).dot(outward);
+        if da <= 0.0 {
+            out.push(a);
+        }
+        if (da < 0.0 && db > 0.0) || (da > 0.0 && db < 0.0) {
+            let t = da / (da - db);
+            out.push(a + (b - a) * t);
+        }
+    }
+}
+
+/// Intersection of the convex polygon `subject` with the convex, counter-clockwise polygon `clip`.
+/// `scratch` is reused to avoid allocation; the result is left in `subject`.
+pub fn clip_convex(subject: &mut Vec<DVec2>, clip: &[DVec2], scratch: &mut Vec<DVec2>) {
+    let n = clip.len();
+    for i in 0..n {
+        if subject.is_empty() {
+            return;
+        }
+        let a = clip[i];
+        let b = clip[(i + 1) % n];
+        let edge = b - a;
+        let outward = DVec2::new(edge.y, -edge.x);
+        clip_halfplane(subject, a, outward, scratch);
+        std::mem::swap(subject, scratch);
+    }
+}
+
+/// Clips `subject` to the axis-aligned rectangle `[lo, hi]`.
+pub fn clip_rect(subject: &mut Vec<DVec2>, lo: DVec2, hi: DVec2, scratch: &mut Vec<DVec2>) {
+    for (origin, outward) in [
+        (lo, DVec2::new(-1.0, 0.0)),
+        (lo, DVec2::new(0.0, -1.0)),
+        (hi, DVec2::new(1.0, 0.0)),
+        (hi, DVec2::new(0.0, 1.0)),
+    ] {
+        if subject.is_empty() {
+            return;
+        }
+        clip_halfplane(subject, origin, outward, scratch);
+        std::mem::swap(subject, scratch);
+    }
+}
+
+/// Signed area (positive for counter-clockwise) and centroid of a simple polygon.
+pub fn area_centroid(poly: &[DVec2]) -> (Real, DVec2) {
+    let n = poly.len();
+    if n < 3 {
+        return (0.0, poly.first().copied().unwrap_or(DVec2::ZERO));
+    }
+    // Shift to the first vertex to keep digits.
+    let o = poly[0];
+    let mut a2 = 0.0;
+    let mut c = DVec2::ZERO;
+    for i in 1..n - 1 {
+        let p = poly[i] - o;
+        let q = poly[i + 1] - o;
+        let cr = p.perp_dot(q);
+        a2 += cr;
+        c += (p + q) * cr;
+    }
+    if a2.abs() < Real::MIN_POSITIVE {
+        return (0.0, o);
+    }
+    (0.5 * a2, o + c / (3.0 * a2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coincident_squares_give_the_square() {
+        let sq = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(0.0, 1.0),
+        ];
+        let mut s = sq.clone();
+        let mut scratch = Vec::new();
+        clip_convex(&mut s, &sq, &mut scratch);
+        let (a, c) = area_centroid(&s);
+        assert!((a - 1.0).abs() < 1e-15);
+        assert!((c - DVec2::splat(0.5)).length() < 1e-15);
+    }
+
+    #[test]
+    fn rotated_square_overlap_is_an_octagon() {
+        let sq: Vec<DVec2> = (0..4)
+            .map(|k| DVec2::from_angle(std::f64::consts::FRAC_PI_2 * k as f64).rotate(DVec2::new(1.0, 1.0)))
+            .collect();
+        let rot: Vec<DVec2> = sq
+            .iter()
+            .map(|p| DVec2::from_angle(std::f64::consts::FRAC_PI_4).rotate(*p))
+            .collect();
+        let mut s = rot.clone();
+        let mut scratch = Vec::new();
+        clip_convex(&mut s, &sq, &mut scratch);
+        let (a, _) = area_centroid(&s);
+        // Regular octagon with inradius 1: area 8 tan(pi/8).
+        assert!((a - 8.0 * (std::f64::consts::PI / 8.0).tan()).abs() < 1e-12);
+        let mut r = sq.clone();
+        clip_rect(&mut r, DVec2::new(0.0, 0.0), DVec2::new(2.0, 0.5), &mut scratch);
+        assert!((area_centroid(&r).0 - 0.5).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,14 @@
+//! Shapes and contact geometry, with no dynamics: convex polyhedra and their mass properties,
+//! the broad phase, the common plane, the contact polygon and its sub-contacts.
+
+mod broad_phase;
+pub mod clip;
+mod narrow_phase;
+mod polyhedron;
+
+pub use broad_phase::BroadPhase;
+pub use narrow_phase::{
+    detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, SubKey,
+    SubcontactDensity, SubcontactSeed,
+};
+pub use polyhedron::{Face, MassProperties, PlacedPolyhedron, Polyhedron};

@@ -1,0 +1,599 @@
+//! Narrow phase: the common plane, the contact polygon and its sub-contacts for one block pair.
+//!
+//! parry gives the contact normal and the gap (GJK/EPA); the face-to-face polygon and the
+//! sub-contact grid are built here. See `docs/theory.md`, "Contact geometry".
+
+use glam::DVec2;
+use parry3d_f64::query;
+use serde::{Deserialize, Serialize};
+
+use super::clip::{area_centroid, clip_convex, clip_rect};
+use super::polyhedron::Polyhedron;
+use crate::error::{in_range, positive, Result};
+use crate::math::{plane_basis, Pose, Real, Vector};
+
+/// How densely joint faces are covered with sub-contacts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum SubcontactDensity {
+    /// `n` sub-contacts along each edge of the host face's bounding rectangle (`n × n` cells);
+    /// the reference paper uses 15.
+    PerEdge(u16),
+    /// Square cells of this side (m).
+    Spacing(Real),
+}
+
+/// Parameters of contact detection and discretisation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ContactParameters {
+    /// Blocks closer than this (m) are in contact; contacts whose gap grows beyond it are dropped.
+    /// Default `1e-3` m.
+    pub tolerance: Real,
+    /// Contacts are re-detected once some block has moved more than this fraction of
+    /// `tolerance` since its last detection. Default `0.25`.
+    pub redetect_fraction: Real,
+    /// Two faces are treated as a face-to-face joint when their normals are opposite within this
+    /// angle (rad). Default 15°, so that an opening hinge keeps its sub-contacts and their history.
+    pub face_angle_tolerance: Real,
+    /// Sub-contact density on joint faces. Default `PerEdge(15)` (the paper's value).
+    pub density: SubcontactDensity,
+}
+
+impl Default for ContactParameters {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-3,
+            redetect_fraction: 0.25,
+            face_angle_tolerance: 15f64.to_radians(),
+            density: SubcontactDensity::PerEdge(15),
+        }
+    }
+}
+
+impl ContactParameters {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] naming the bad field.
+    pub fn validate(&self) -> Result<()> {
+        positive("contact.tolerance", self.tolerance)?;
+        in_range(
+            "contact.redetect_fraction",
+            self.redetect_fraction,
+            1e-6,
+            1.0 + 1e-12,
+            "must lie in (0, 1]",
+        )?;
+        in_range(
+            "contact.face_angle_tolerance",
+            self.face_angle_tolerance,
+            0.0,
+            std::f64::consts::FRAC_PI_4,
+            "must lie in [0, pi/4) rad",
+        )?;
+        match self.density {
+            SubcontactDensity::PerEdge(n) => {
+                positive("contact.density.per_edge", n as Real)?;
+            }
+            SubcontactDensity::Spacing(h) => {
+                positive("contact.density.spacing", h)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Stable identity of a sub-contact within its block pair: used to carry history across
+/// re-detection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub struct SubKey(pub u64);
+
+impl SubKey {
+    fn cell(face_host: u32, face_other: u32, i: u32, j: u32) -> Self {
+        Self(((face_host as u64) << 48) | ((face_other as u64 & 0xffff) << 32) | ((i as u64) << 16) | j as u64)
+    }
+    fn point(feature: u32, i: u32) -> Self {
+        Self((0xffffu64 << 48) | ((feature as u64 & 0xffff) << 32) | i as u64)
+    }
+}
+
+/// The kind of a detected contact.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum ContactKind {
+    /// Two nearly parallel faces: a polygon covered with a grid of sub-contacts anchored to the
+    /// host face. Faces are indices into each block's [`Polyhedron::faces`].
+    FaceFace {
+        /// Face of block `a`.
+        face_a: u32,
+        /// Face of block `b`.
+        face_b: u32,
+    },
+    /// Edge–face, edge–edge or vertex–face: sub-contacts on a segment or at a point, anchored to
+    /// block `a`; the normal turns with block `a`.
+    Point {
+        /// Contact normal in block `a`'s body frame.
+        normal_local: Vector,
+    },
+}
+
+/// A sub-contact as created by detection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubcontactSeed {
+    /// Identity within the pair.
+    pub key: SubKey,
+    /// Material point in the host block's body frame (m).
+    pub anchor: Vector,
+    /// Tributary area (m²).
+    pub area: Real,
+    /// Normal gap at detection (m, positive = open).
+    pub gap: Real,
+}
+
+/// A detected contact between blocks `a` and `b`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetectedContact {
+    /// The geometric case.
+    pub kind: ContactKind,
+    /// `true` if sub-contacts are anchored to block `a`, `false` for block `b`.
+    pub host_is_a: bool,
+    /// World normal from `a` to `b`.
+    pub normal: Vector,
+}
+
+/// Scratch buffers reused between detections.
+#[derive(Debug, Default, Clone)]
+pub struct NarrowPhaseScratch {
+    host: Vec<DVec2>,
+    other: Vec<DVec2>,
+    cell: Vec<DVec2>,
+    tmp: Vec<DVec2>,
+}
+
+/// Everything the narrow phase needs to know about one block.
+#[derive(Debug, Clone, Copy)]
+pub struct BlockGeometry<'a> {
+    /// The shape in its body frame.
+    pub shape: &'a Polyhedron,
+    /// Its pose.
+    pub pose: &'a Pose,
+}
+
+/// Detects the contact between `a` and `b`, pushing its sub-contacts into `seeds`.
+/// Returns `None` (and pushes nothing) when the gap exceeds the tolerance.
+pub fn detect(
+    a: BlockGeometry<'_>,
+    b: BlockGeometry<'_>,
+    params: &ContactParameters,
+    scratch: &mut NarrowPhaseScratch,
+    seeds: &mut Vec<SubcontactSeed>,
+) -> Option<DetectedContact> {
+    let c = query::contact(a.pose, a.shape.parry(), b.pose, b.shape.parry(), params.tolerance).ok()??;
+    let n = c.normal1;
+    if !(n.length_squared() > 0.5) {
+        return None;
+    }
+    let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
+    let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
+    let na = a.pose.rotation * a.shape.faces()[fa].normal;
+    let nb = b.pose.rotation * b.shape.faces()[fb].normal;
+    if -na.dot(nb) >= params.face_angle_tolerance.cos() {
+        let start = seeds.len();
+        if let Some(found) = face_face(a, fa, b, fb, params, scratch, seeds) {
+            return Some(found);
+        }
+        seeds.truncate(start);
+    }
+    point_contact(a, b, n, c.dist, params, seeds)
+}
+
+/// Characteristic sub-contact spacing for a pair (m), used for point contacts.
+fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubcontactDensity) -> Real {
+    match density {
+        SubcontactDensity::Spacing(h) => h,
+        SubcontactDensity::PerEdge(n) => a.volume().cbrt().min(b.volume().cbrt()) / n as Real,
+    }
+}
+
+fn face_face(
+    a: BlockGeometry<'_>,
+    fa: usize,
+    b: BlockGeometry<'_>,
+    fb: usize,
+    params: &ContactParameters,
+    scratch: &mut NarrowPhaseScratch,
+    seeds: &mut Vec<SubcontactSeed>,
+) -> Option<DetectedContact> {
+    let area_a = a.shape.faces()[fa].area;
+    let area_b = b.shape.faces()[fb].area;
+    let host_is_a = area_a <= area_b;
+    let (host, fh, other, fo) = if host_is_a { (a, fa, b, fb) } else { (b, fb, a, fa) };
+    let face = &host.shape.faces()[fh];
+    let (origin, u, v) = face_frame(host.shape, fh);
+    let to2d = |p: Vector| DVec2::new(u.dot(p - origin), v.dot(p - origin));
+
+    scratch.host.clear();
+    scratch.host.extend(
+        host.shape
+            .face_loop(fh)
+            .iter()
+            .map(|&i| to2d(host.shape.vertices()[i as usize])),
+    );
+    // The other face, in the host body frame, projected on the host plane; reversed so that it
+    // is counter-clockwise seen from the host's outside.
+    let rel = host.pose.inv_mul(other.pose);
+    scratch.other.clear();
+    scratch.other.extend(
+        other
+            .shape
+            .face_loop(fo)
+            .iter()
+            .rev()
+            .map(|&i| to2d(rel.transform_point(other.shape.vertices()[i as usize]))),
+    );
+    // Reject faces that are far apart along the host normal (the polygon must lie within the
+    // tolerance band of the host plane).
+    let n_other = rel.rotation * other.shape.faces()[fo].normal;
+    let denom = n_other.dot(face.normal);
+    if denom > -0.5 {
+        return None;
+    }
+    clip_convex(&mut scratch.other, &scratch.host, &mut scratch.tmp);
+    let (overlap_area, _) = area_centroid(&scratch.other);
+    if overlap_area <= 1e-9 * face.area {
+        return None;
+    }
+    // Gap at the overlap's vertices: the other face's plane seen along the host normal.
+    let other_offset = n_other.dot(rel.transform_point(other.shape.vertices()[other.shape.face_loop(fo)[0] as usize]));
+    let gap_at = |q: DVec2| {
+        let p = origin + u * q.x + v * q.y;
+        (other_offset - n_other.dot(p)) / denom
+    };
+    let min_gap = scratch.other.iter().map(|&q| gap_at(q)).fold(Real::INFINITY, Real::min);
+    if min_gap > params.tolerance {
+        return None;
+    }
+
+    let (lo, hi) = bounds(&scratch.host);
+    let size = hi - lo;
+    let (nu, nv) = match params.density {
+        SubcontactDensity::PerEdge(k) => (k as u32, k as u32),
+        SubcontactDensity::Spacing(h) => (((size.x / h).ceil() as u32).max(1), ((size.y / h).ceil() as u32).max(1)),
+    };
+    let cell = DVec2::new(size.x / nu as Real, size.y / nv as Real);
+    let (olo, ohi) = bounds(&scratch.other);
+    let i0 = (((olo.x - lo.x) / cell.x).floor().max(0.0) as u32).min(nu - 1);
+    let i1 = (((ohi.x - lo.x) / cell.x).ceil().max(1.0) as u32).min(nu);
+    let j0 = (((olo.y - lo.y) / cell.y).floor().max(0.0) as u32).min(nv - 1);
+    let j1 = (((ohi.y - lo.y) / cell.y).ceil().max(1.0) as u32).min(nv);
+    let min_area = 1e-9 * cell.x * cell.y;
+    for i in i0..i1 {
+        for j in j0..j1 {
+            let clo = lo + cell * DVec2::new(i as Real, j as Real);
+            let chi = clo + cell;
+            scratch.cell.clear();
+            scratch.cell.extend_from_slice(&scratch.other);
+            clip_rect(&mut scratch.cell, clo, chi, &mut scratch.tmp);
+            let (area, centroid) = area_centroid(&scratch.cell);
+            if area > min_area {
+                let (fh32, fo32) = (fh as u32, fo as u32);
+                let key = if host_is_a {
+                    SubKey::cell(fh32, fo32, i, j)
+                } else {
+                    SubKey::cell(fo32, fh32, i, j)
+                };
+                seeds.push(SubcontactSeed {
+                    key,
+                    anchor: origin + u * centroid.x + v * centroid.y,
+                    area,
+                    gap: gap_at(centroid),
+                });
+            }
+        }
+    }
+    let na = a.pose.rotation * a.shape.faces()[fa].normal;
+    let nb = b.pose.rotation * b.shape.faces()[fb].normal;
+    Some(DetectedContact {
+        kind: ContactKind::FaceFace {
+            face_a: fa as u32,
+            face_b: fb as u32,
+        },
+        host_is_a,
+        normal: (na - nb).normalize(),
+    })
+}
+
+/// A material frame on face `f`: origin at its first vertex, `u` along its longest edge.
+pub(crate) fn face_frame(shape: &Polyhedron, f: usize) -> (Vector, Vector, Vector) {
+    let ids = shape.face_loop(f);
+    let vs = shape.vertices();
+    let mut best = (0.0, Vector::X);
+    for k in 0..ids.len() {
+        let e = vs[ids[(k + 1) % ids.len()] as usize] - vs[ids[k] as usize];
+        let l = e.length_squared();
+        if l > best.0 {
+            best = (l, e);
+        }
+    }
+    let n = shape.faces()[f].normal;
+    let u = (best.1 - n * n.dot(best.1)).normalize();
+    (vs[ids[0] as usize], u, n.cross(u))
+}
+
+fn bounds(poly: &[DVec2]) -> (DVec2, DVec2) {
+    poly.iter().fold(
+        (DVec2::splat(Real::INFINITY), DVec2::splat(Real::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
+
+/// Edge–face, edge–edge and vertex–face contacts: points on the intersection of the two support
+/// features, anchored to block `a`.
+fn point_contact(
+    a: BlockGeometry<'_>,
+    b: BlockGeometry<'_>,
+    n: Vector,
+    dist: Real,
+    params: &ContactParameters,
+    seeds: &mut Vec<SubcontactSeed>,
+) -> Option<DetectedContact> {
+    let band = params.tolerance;
+    let support = |g: BlockGeometry<'_>, dir: Vector| -> Vec<Vector> {
+        let world: Vec<Vector> = g.shape.vertices().iter().map(|v| g.pose.transform_point(*v)).collect();
+        let top = world.iter().map(|p| dir.dot(*p)).fold(Real::NEG_INFINITY, Real::max);
+        world.into_iter().filter(|p| dir.dot(*p) >= top - band).collect()
+    };
+    let sa = support(a, n);
+    let sb = support(b, -n);
+    let (e1, e2) = plane_basis(n);
+    let to2d = |p: Vector| DVec2::new(e1.dot(p), e2.dot(p));
+    let fa = Feature::new(&sa, to2d);
+    let fb = Feature::new(&sb, to2d);
+    let h = spacing(a.shape, b.shape, params.density);
+
+    // Points of the intersection of the two projected features.
+    let (p0, p1) = match (&fa.shape, &fb.shape) {
+        (FeatureShape::Point(p), _) => (*p, *p),
+        (_, FeatureShape::Point(p)) => (*p, *p),
+        (FeatureShape::Polygon(poly), FeatureShape::Segment(s, t))
+        | (FeatureShape::Segment(s, t), FeatureShape::Polygon(poly)) => clip_segment(*s, *t, poly)?,
+        (FeatureShape::Segment(s0, s1), FeatureShape::Segment(t0, t1)) => segment_segment(*s0, *s1, *t0, *t1),
+        (FeatureShape::Polygon(pa), FeatureShape::Polygon(pb)) => {
+            // Two faces within the band but not aligned within the angle tolerance: the longest
+            // chord of their overlap carries the contact.
+            let mut sub = pb.clone();
+            let mut tmp = Vec::new();
+            clip_convex(&mut sub, pa, &mut tmp);
+            if sub.is_empty() {
+                return None;
+            }
+            farthest_pair(&sub)
+        }
+    };
+    let length = (p1 - p0).length();
+    let count = ((length / h).ceil() as u32).max(1);
+    let seg_area = if length > 1e-12 {
+        length / count as Real * h
+    } else {
+        h * h
+    };
+    let inv = a.pose.inverse();
+    for k in 0..count {
+        let q = p0 + (p1 - p0) * ((k as Real + 0.5) / count as Real);
+        let ha = fa.height(q, n);
+        let hb = fb.height(q, n);
+        let on_a = e1 * q.x + e2 * q.y + n * ha;
+        let gap = if hb.is_finite() && ha.is_finite() {
+            hb - ha
+        } else {
+            dist
+        };
+        seeds.push(SubcontactSeed {
+            key: SubKey::point(fa.dim * 4 + fb.dim, k),
+            anchor: inv.transform_point(on_a),
+            area: seg_area,
+            gap,
+        });
+    }
+    Some(DetectedContact {
+        kind: ContactKind::Point {
+            normal_local: a.pose.rotation.inverse() * n,
+        },
+        host_is_a: true,
+        normal: n,
+    })
+}
+
+enum FeatureShape {
+    Point(DVec2),
+    Segment(DVec2, DVec2),
+    Polygon(Vec<DVec2>),
+}
+
+/// A support feature (vertex, edge or face) projected on the common plane.
+struct Feature {
+    shape: FeatureShape,
+    /// Points in 3-D, for heights along the normal.
+    pts3: Vec<Vector>,
+    dim: u32,
+}
+
+impl Feature {
+    fn new(pts: &[Vector], to2d: impl Fn(Vector) -> DVec2) -> Self {
+        let p2: Vec<DVec2> = pts.iter().map(|p| to2d(*p)).collect();
+        let hull = hull2d(&p2);
+        let (shape, dim) = match hull.len() {
+            1 => (FeatureShape::Point(hull[0]), 0),
+            2 => (FeatureShape::Segment(hull[0], hull[1]), 1),
+            _ => (FeatureShape::Polygon(hull), 2),
+        };
+        Self {
+            shape,
+            pts3: pts.to_vec(),
+            dim,
+        }
+    }
+
+    /// Height along `n` of the feature above the plane point `q` (interpolated).
+    fn height(&self, q: DVec2, n: Vector) -> Real {
+        let (e1, e2) = plane_basis(n);
+        let heights: Vec<(DVec2, Real)> = self
+            .pts3
+            .iter()
+            .map(|p| (DVec2::new(e1.dot(*p), e2.dot(*p)), n.dot(*p)))
+            .collect();
+        match &self.shape {
+            FeatureShape::Point(_) => heights.iter().map(|h| h.1).sum::<Real>() / heights.len() as Real,
+            FeatureShape::Segment(s, t) => {
+                let d = *t - *s;
+                let tt = if d.length_squared() > 0.0 {
+                    ((q - *s).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let hs = nearest_height(&heights, *s);
+                let ht = nearest_height(&heights, *t);
+                hs + (ht - hs) * tt
+            }
+            FeatureShape::Polygon(_) => {
+                // Least-squares plane h = c0 + c1 x + c2 y through the feature points.
+                let m = heights.len() as Real;
+                let cx = heights.iter().map(|h| h.0).sum::<DVec2>() / m;
+                let ch = heights.iter().map(|h| h.1).sum::<Real>() / m;
+                let (mut sxx, mut sxy, mut syy, mut sxh, mut syh) = (0.0, 0.0, 0.0, 0.0, 0.0);
+                for (p, hh) in &heights {
+                    let d = *p - cx;
+                    sxx += d.x * d.x;
+                    sxy += d.x * d.y;
+                    syy += d.y * d.y;
+                    sxh += d.x * (hh - ch);
+                    syh += d.y * (hh - ch);
+                }
+                let det = sxx * syy - sxy * sxy;
+                if det.abs() < 1e-30 {
+                    return ch;
+                }
+                let gx = (sxh * syy - syh * sxy) / det;
+                let gy = (syh * sxx - sxh * sxy) / det;
+                ch + gx * (q.x - cx.x) + gy * (q.y - cx.y)
+            }
+        }
+    }
+}
+
+fn nearest_height(heights: &[(DVec2, Real)], p: DVec2) -> Real {
+    heights
+        .iter()
+        .min_by(|a, b| (a.0 - p).length_squared().total_cmp(&(b.0 - p).length_squared()))
+        .map(|h| h.1)
+        .unwrap_or(0.0)
+}
+
+/// 2-D convex hull (monotone chain), counter-clockwise; merges points closer than 1e-9 of the
+/// extent. Returns 1 point for a vertex, 2 for a segment.
+fn hull2d(pts: &[DVec2]) -> Vec<DVec2> {
+    let mut p: Vec<DVec2> = pts.to_vec();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    let (lo, hi) = bounds(&p);
+    let eps = 1e-9 * (hi - lo).length().max(1e-12);
+    p.dedup_by(|a, b| (*a - *b).length() <= eps);
+    if p.len() <= 2 {
+        if p.len() == 2 && (p[0] - p[1]).length() <= eps {
+            p.pop();
+        }
+        return p;
+    }
+    let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let mut h: Vec<DVec2> = Vec::with_capacity(2 * p.len());
+    for &q in p.iter().chain(p.iter().rev().skip(1)) {
+        while h.len() >= 2 && cross(h[h.len() - 2], h[h.len() - 1], q) <= eps * (hi - lo).length() {
+            h.pop();
+        }
+        h.push(q);
+    }
+    h.pop();
+    if h.len() < 3 {
+        // Collinear: the two extreme points.
+        return vec![p[0], p[p.len() - 1]];
+    }
+    h
+}
+
+fn clip_segment(s: DVec2, t: DVec2, poly: &[DVec2]) -> Option<(DVec2, DVec2)> {
+    let (mut t0, mut t1) = (0.0, 1.0);
+    let d = t - s;
+    for i in 0..poly.len() {
+        let a = poly[i];
+        let e = poly[(i + 1) % poly.len()] - a;
+        let outward = DVec2::new(e.y, -e.x);
+        let num = (s - a).dot(outward);
+        let den = d.dot(outward);
+        if den.abs() < 1e-300 {
+            if num > 0.0 {
+                return nearest_on_polygon(s, t, poly);
+            }
+        } else {
+            let r = -num / den;
+            if den > 0.0 {
+                t1 = Real::min(t1, r);
+            } else {
+                t0 = Real::max(t0, r);
+            }
+        }
+    }
+    if t0 > t1 {
+        return nearest_on_polygon(s, t, poly);
+    }
+    Some((s + d * t0, s + d * t1))
+}
+
+/// When a segment misses the polygon in projection (touching within the tolerance band only),
+/// the contact point is the segment point nearest to the polygon's centroid.
+fn nearest_on_polygon(s: DVec2, t: DVec2, poly: &[DVec2]) -> Option<(DVec2, DVec2)> {
+    let c = poly.iter().copied().sum::<DVec2>() / poly.len() as Real;
+    let d = t - s;
+    let tt = if d.length_squared() > 0.0 {
+        ((c - s).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let p = s + d * tt;
+    Some((p, p))
+}
+
+fn segment_segment(s0: DVec2, s1: DVec2, t0: DVec2, t1: DVec2) -> (DVec2, DVec2) {
+    let d = s1 - s0;
+    let e = t1 - t0;
+    let cr = d.perp_dot(e);
+    if cr.abs() <= 0.02 * d.length() * e.length() {
+        // Parallel within about 1°: overlap of the two intervals along d.
+        let dir = d.normalize_or_zero();
+        let (a0, a1): (Real, Real) = (0.0, d.length());
+        let (b0, b1) = {
+            let x = (t0 - s0).dot(dir);
+            let y = (t1 - s0).dot(dir);
+            (x.min(y), x.max(y))
+        };
+        let lo = a0.max(b0);
+        let hi = a1.min(b1);
+        if lo <= hi {
+            return (s0 + dir * lo, s0 + dir * hi);
+        }
+        let m = s0 + dir * (0.5 * (lo + hi));
+        return (m, m);
+    }
+    let r = (t0 - s0).perp_dot(e) / cr;
+    let p = s0 + d * r.clamp(0.0, 1.0);
+    (p, p)
+}
+
+fn farthest_pair(poly: &[DVec2]) -> (DVec2, DVec2) {
+    let mut best = (0.0, poly[0], poly[0]);
+    for i in 0..poly.len() {
+        for j in i + 1..poly.len() {
+            let l = (poly[i] - poly[j]).length_squared();
+            if l > best.0 {
+                best = (l, poly[i], poly[j]);
+            }
+        }
+    }
+    (best.1, best.2)
+}

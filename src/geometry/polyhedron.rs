@@ -1,0 +1,399 @@
+//! Convex polyhedra in their principal frame, with exact mass properties.
+
+use parry3d_f64::shape::{ConvexPolyhedron, Shape};
+use parry3d_f64::transformation::try_convex_hull;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector};
+
+/// One planar face of a [`Polyhedron`], in the body frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Face {
+    /// Outward unit normal (Newell's method over the whole vertex loop).
+    pub normal: Vector,
+    /// Plane offset: `normal · x = offset` on the face.
+    pub offset: Real,
+    /// Face area (m²).
+    pub area: Real,
+    first: u32,
+    len: u32,
+}
+
+/// Mass properties of a block: mass and principal moments about the centroid.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MassProperties {
+    /// Mass (kg).
+    pub mass: Real,
+    /// Volume (m³).
+    pub volume: Real,
+    /// Principal moments of inertia about the centroid (kg·m²), along the body axes.
+    pub principal_inertia: Vector,
+}
+
+/// A rigid convex polyhedron stored in its principal frame: the origin is the centroid and the
+/// axes are the principal axes of inertia, so the inertia tensor is diagonal.
+///
+/// Build one with [`Polyhedron::from_hull`] or [`Polyhedron::from_faces`]; both return the pose
+/// that places the body frame in the world.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Polyhedron {
+    vertices: Vec<Vector>,
+    faces: Vec<Face>,
+    face_vertices: Vec<u32>,
+    /// Largest distance from the centroid to a vertex (m).
+    radius: Real,
+    volume: Real,
+    /// Inertia about the centroid per unit density (m⁵), principal axes.
+    unit_inertia: Vector,
+    #[serde(skip, default = "empty_parry")]
+    parry: Option<ConvexPolyhedron>,
+}
+
+fn empty_parry() -> Option<ConvexPolyhedron> {
+    None
+}
+
+/// A block shape placed in the world: the body-frame polyhedron and its pose.
+#[derive(Debug, Clone)]
+pub struct PlacedPolyhedron {
+    /// The shape in its principal frame.
+    pub shape: Polyhedron,
+    /// Pose of the principal frame in the world (translation = centroid).
+    pub pose: Pose,
+}
+
+impl Polyhedron {
+    /// Builds the convex hull of `points` (world coordinates). Interior points are ignored.
+    ///
+    /// `name` is used in error messages only.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] for NaN or infinite coordinates, [`Error::DegenerateGeometry`] for fewer
+    /// than four points or a flat or collinear set, [`Error::NonPositiveVolume`] for a volume below
+    /// `1e-12` of the bounding box volume.
+    ///
+    /// # Example
+    /// ```
+    /// use voussoir::geometry::Polyhedron;
+    /// use voussoir::math::Vector;
+    /// let corners: Vec<Vector> = (0..8)
+    ///     .map(|i| Vector::new((i & 1) as f64 * 2.0, (i >> 1 & 1) as f64, (i >> 2) as f64 * 0.5))
+    ///     .collect();
+    /// let placed = Polyhedron::from_hull("brick", &corners)?;
+    /// assert!((placed.shape.volume() - 1.0).abs() < 1e-12);
+    /// assert_eq!(placed.shape.faces().len(), 6);
+    /// assert!((placed.pose.translation - Vector::new(1.0, 0.5, 0.25)).length() < 1e-12);
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    pub fn from_hull(name: &str, points: &[Vector]) -> Result<PlacedPolyhedron> {
+        check_points(name, points)?;
+        let (verts, tris) = try_convex_hull(points).map_err(|e| Error::DegenerateGeometry {
+            block: name.to_owned(),
+            reason: format!("convex hull failed: {e:?}"),
+        })?;
+        Self::from_triangles(name, verts, &tris)
+    }
+
+    /// Builds a polyhedron from vertices and explicit faces (vertex index loops, counter-clockwise
+    /// seen from outside). The faces are checked for planarity and the solid for convexity.
+    ///
+    /// # Errors
+    /// As [`Polyhedron::from_hull`], plus [`Error::NonConvex`] when a face is not planar, a vertex
+    /// lies outside a face plane or a face index is out of range.
+    pub fn from_faces(name: &str, points: &[Vector], faces: &[Vec<usize>]) -> Result<PlacedPolyhedron> {
+        check_points(name, points)?;
+        if faces.len() < 4 {
+            return Err(Error::DegenerateGeometry {
+                block: name.to_owned(),
+                reason: format!("{} faces given, a solid needs at least 4", faces.len()),
+            });
+        }
+        let scale = bbox_diagonal(points);
+        let tol = 1e-9 * scale;
+        let mut tris = Vec::new();
+        for (fi, face) in faces.iter().enumerate() {
+            if face.len() < 3 {
+                return Err(Error::DegenerateGeometry {
+                    block: name.to_owned(),
+                    reason: format!("face {fi} has {} vertices", face.len()),
+                });
+            }
+            if let Some(&bad) = face.iter().find(|&&v| v >= points.len()) {
+                return Err(Error::NonConvex {
+                    block: name.to_owned(),
+                    reason: format!(
+                        "face {fi} refers to vertex {bad}, but there are {} vertices",
+                        points.len()
+                    ),
+                });
+            }
+            let loop_pts: Vec<Vector> = face.iter().map(|&i| points[i]).collect();
+            let normal = newell_normal(&loop_pts);
+            let len = normal.length();
+            if len < 1e-14 * scale * scale {
+                return Err(Error::DegenerateGeometry {
+                    block: name.to_owned(),
+                    reason: format!("face {fi} has zero area"),
+                });
+            }
+            let n = normal / len;
+            let offset = n.dot(loop_pts[0]);
+            for (k, p) in loop_pts.iter().enumerate() {
+                if (n.dot(*p) - offset).abs() > tol {
+                    return Err(Error::NonConvex {
+                        block: name.to_owned(),
+                        reason: format!("face {fi} is not planar at its vertex {}", face[k]),
+                    });
+                }
+            }
+            for (vi, p) in points.iter().enumerate() {
+                if n.dot(*p) - offset > tol {
+                    return Err(Error::NonConvex {
+                        block: name.to_owned(),
+                        reason: format!("vertex {vi} lies outside face {fi} (or the face is inward-facing)"),
+                    });
+                }
+            }
+            for k in 1..face.len() - 1 {
+                tris.push([face[0] as u32, face[k] as u32, face[k + 1] as u32]);
+            }
+        }
+        Self::from_triangles(name, points.to_vec(), &tris)
+    }
+
+    fn from_triangles(name: &str, verts: Vec<Vector>, tris: &[[u32; 3]]) -> Result<PlacedPolyhedron> {
+        let scale = bbox_diagonal(&verts);
+        let world =
+            ConvexPolyhedron::from_convex_mesh(verts.clone(), tris).ok_or_else(|| Error::DegenerateGeometry {
+                block: name.to_owned(),
+                reason: "the faces do not form a closed convex manifold".into(),
+            })?;
+        // Subtract a reference point first so that mass properties keep their digits far from the origin.
+        let reference = verts.iter().copied().sum::<Vector>() / verts.len() as Real;
+        let shifted: Vec<Vector> = world.points().iter().map(|p| *p - reference).collect();
+        let shifted_poly =
+            ConvexPolyhedron::from_convex_mesh(shifted, tris).ok_or_else(|| Error::DegenerateGeometry {
+                block: name.to_owned(),
+                reason: "the faces do not form a closed convex manifold".into(),
+            })?;
+        let mp = shifted_poly.mass_properties(1.0);
+        let volume = mp.mass();
+        if !(volume > 1e-12 * scale * scale * scale) {
+            return Err(Error::NonPositiveVolume {
+                block: name.to_owned(),
+                volume,
+            });
+        }
+        let frame: Rotation = mp.principal_inertia_local_frame.normalize();
+        let com = mp.local_com;
+        let inv = frame.inverse();
+        let body: Vec<Vector> = shifted_poly.points().iter().map(|p| inv * (*p - com)).collect();
+        let pose = Pose::from_parts(reference + com, frame);
+        let shape = Self::from_body_mesh(name, body, tris, volume, mp.principal_inertia())?;
+        Ok(PlacedPolyhedron { shape, pose })
+    }
+
+    fn from_body_mesh(
+        name: &str,
+        body: Vec<Vector>,
+        tris: &[[u32; 3]],
+        volume: Real,
+        unit_inertia: Vector,
+    ) -> Result<Self> {
+        let parry = ConvexPolyhedron::from_convex_mesh(body, tris).ok_or_else(|| Error::DegenerateGeometry {
+            block: name.to_owned(),
+            reason: "the faces do not form a closed convex manifold".into(),
+        })?;
+        let vertices = parry.points().to_vec();
+        let mut faces = Vec::with_capacity(parry.faces().len());
+        let mut face_vertices = Vec::new();
+        for f in parry.faces() {
+            let i1 = f.first_vertex_or_edge as usize;
+            let i2 = i1 + f.num_vertices_or_edges as usize;
+            let ids = &parry.vertices_adj_to_face()[i1..i2];
+            let loop_pts: Vec<Vector> = ids.iter().map(|&v| vertices[v as usize]).collect();
+            let nw = newell_normal(&loop_pts);
+            let area = 0.5 * nw.length();
+            let normal = nw.normalize();
+            let offset = loop_pts.iter().map(|p| normal.dot(*p)).sum::<Real>() / loop_pts.len() as Real;
+            faces.push(Face {
+                normal,
+                offset,
+                area,
+                first: face_vertices.len() as u32,
+                len: ids.len() as u32,
+            });
+            face_vertices.extend_from_slice(ids);
+        }
+        let radius = vertices.iter().map(|v| v.length()).fold(0.0, Real::max);
+        Ok(Self {
+            vertices,
+            faces,
+            face_vertices,
+            radius,
+            volume,
+            unit_inertia,
+            parry: Some(parry),
+        })
+    }
+
+    /// Vertices in the body frame (m).
+    pub fn vertices(&self) -> &[Vector] {
+        &self.vertices
+    }
+
+    /// Faces in the body frame.
+    pub fn faces(&self) -> &[Face] {
+        &self.faces
+    }
+
+    /// Vertex indices of face `face`, counter-clockwise seen from outside.
+    pub fn face_loop(&self, face: usize) -> &[u32] {
+        let f = &self.faces[face];
+        &self.face_vertices[f.first as usize..(f.first + f.len) as usize]
+    }
+
+    /// Volume (m³).
+    pub fn volume(&self) -> Real {
+        self.volume
+    }
+
+    /// Largest distance from the centroid to a vertex (m).
+    pub fn radius(&self) -> Real {
+        self.radius
+    }
+
+    /// Mass properties for a uniform `density` (kg/m³).
+    pub fn mass_properties(&self, density: Real) -> MassProperties {
+        MassProperties {
+            mass: density * self.volume,
+            volume: self.volume,
+            principal_inertia: self.unit_inertia * density,
+        }
+    }
+
+    /// parry's view of the shape, for GJK/EPA and AABBs.
+    pub(crate) fn parry(&self) -> &ConvexPolyhedron {
+        self.parry.as_ref().expect("polyhedron restored after deserialisation")
+    }
+
+    /// The face whose outward normal is most aligned with `dir` (body frame).
+    pub fn most_aligned_face(&self, dir: Vector) -> usize {
+        let mut best = 0;
+        let mut best_dot = Real::NEG_INFINITY;
+        for (i, f) in self.faces.iter().enumerate() {
+            let d = f.normal.dot(dir);
+            if d > best_dot {
+                best_dot = d;
+                best = i;
+            }
+        }
+        best
+    }
+}
+
+fn check_points(name: &str, points: &[Vector]) -> Result<()> {
+    if let Some(i) = points.iter().position(|p| !is_finite_vector(*p)) {
+        return Err(Error::NonFinite {
+            what: format!("vertex {i} of block {name:?}"),
+        });
+    }
+    if points.len() < 4 {
+        return Err(Error::DegenerateGeometry {
+            block: name.to_owned(),
+            reason: format!("{} vertices given, a solid needs at least 4", points.len()),
+        });
+    }
+    Ok(())
+}
+
+fn bbox_diagonal(points: &[Vector]) -> Real {
+    let (mut lo, mut hi) = (Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY));
+    for p in points {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    (hi - lo).length().max(Real::MIN_POSITIVE)
+}
+
+/// Newell's normal of a polygon loop: twice the vector area (not normalised).
+pub(crate) fn newell_normal(pts: &[Vector]) -> Vector {
+    let mut n = Vector::ZERO;
+    for i in 0..pts.len() {
+        let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+        n += a.cross(b);
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn brick(a: Real, b: Real, c: Real, origin: Vector) -> Vec<Vector> {
+        (0..8)
+            .map(|i| {
+                origin
+                    + Vector::new(
+                        (i & 1) as Real * a,
+                        ((i >> 1) & 1) as Real * b,
+                        ((i >> 2) & 1) as Real * c,
+                    )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn brick_mass_properties_match_closed_form() {
+        let (a, b, c) = (0.2, 0.1, 0.05);
+        let p = Polyhedron::from_hull("b", &brick(a, b, c, Vector::new(1000.0, -3.0, 7.0))).unwrap();
+        let mp = p.shape.mass_properties(2500.0);
+        let m = 2500.0 * a * b * c;
+        assert!((mp.mass - m).abs() < 1e-12 * m);
+        let mut expect = [
+            m * (b * b + c * c) / 12.0,
+            m * (a * a + c * c) / 12.0,
+            m * (a * a + b * b) / 12.0,
+        ];
+        let mut got = mp.principal_inertia.to_array();
+        expect.sort_by(Real::total_cmp);
+        got.sort_by(Real::total_cmp);
+        for k in 0..3 {
+            assert!((expect[k] - got[k]).abs() < 1e-9 * expect[k], "{expect:?} {got:?}");
+        }
+        let c0 = Vector::new(1000.0 + a / 2.0, -3.0 + b / 2.0, 7.0 + c / 2.0);
+        assert!((p.pose.translation - c0).length() < 1e-12);
+        let total_area: Real = p.shape.faces().iter().map(|f| f.area).sum();
+        assert!((total_area - 2.0 * (a * b + b * c + a * c)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn explicit_faces_agree_with_hull_and_reject_bad_input() {
+        let pts = vec![Vector::ZERO, Vector::X, Vector::Y, Vector::Z];
+        let faces = vec![vec![0, 2, 1], vec![0, 1, 3], vec![1, 2, 3], vec![2, 0, 3]];
+        let p = Polyhedron::from_faces("tet", &pts, &faces).unwrap();
+        assert!((p.shape.volume() - 1.0 / 6.0).abs() < 1e-14);
+        assert!((p.pose.translation - Vector::splat(0.25)).length() < 1e-14);
+        let inward: Vec<Vec<usize>> = faces.iter().map(|f| f.iter().rev().copied().collect()).collect();
+        assert!(matches!(
+            Polyhedron::from_faces("tet", &pts, &inward),
+            Err(Error::NonConvex { .. })
+        ));
+        let flat = vec![Vector::ZERO, Vector::X, Vector::Y, Vector::new(1.0, 1.0, 0.0)];
+        assert!(matches!(
+            Polyhedron::from_hull("flat", &flat),
+            Err(Error::DegenerateGeometry { .. } | Error::NonPositiveVolume { .. })
+        ));
+        let nan = vec![Vector::ZERO, Vector::X, Vector::Y, Vector::new(Real::NAN, 0.0, 1.0)];
+        assert!(matches!(
+            Polyhedron::from_hull("nan", &nan),
+            Err(Error::NonFinite { .. })
+        ));
+        let bad_index = vec![vec![0, 2, 1], vec![0, 1, 3], vec![1, 2, 3], vec![2, 0, 9]];
+        assert!(matches!(
+            Polyhedron::from_faces("tet", &pts, &bad_index),
+            Err(Error::NonConvex { .. })
+        ));
+    }
+}

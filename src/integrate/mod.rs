@@ -1,0 +1,49 @@
+//! Time integration: the [`Integrator`] trait, central difference with local (Cundall), Rayleigh
+//! or no damping, and the critical time step.
+#![doc = include_str!("README.md")]
+
+mod central_difference;
+mod damping;
+mod time_step;
+
+pub use central_difference::CentralDifference;
+pub use damping::Damping;
+pub use time_step::{critical_time_step, CriticalStep, StiffnessBound, TimeStep};
+
+use crate::block::{RigidBlock, Wrench};
+use crate::math::{Real, Vector};
+
+/// What an integrator reports for one block and one step.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct StepRecord {
+    /// Force and moment the constraints applied to the constrained degrees of freedom.
+    pub reaction: Wrench,
+    /// Damping force and moment applied this step (local or mass-proportional).
+    pub damping: Wrench,
+    /// Mean of the old and new velocity (m/s): the velocity at the integer time level.
+    pub mean_velocity: Vector,
+    /// Mean of the old and new angular velocity (rad/s).
+    pub mean_angular_velocity: Vector,
+}
+
+/// One step of the equations of motion for all blocks.
+///
+/// `forces[i]` is the total force and moment on block `i` (gravity, applied loads and contacts;
+/// damping is the integrator's business). Implementations must give the same result whatever the
+/// number of threads.
+pub trait Integrator: Send + Sync + std::fmt::Debug {
+    /// Advances velocities to `t + dt/2` and poses to `t + dt`, filling `records`.
+    fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]);
+
+    /// The damping model (the contact code adds the stiffness-proportional dashpots).
+    fn damping(&self) -> Damping;
+
+    /// A boxed copy (for cloning models).
+    fn boxed_clone(&self) -> Box<dyn Integrator>;
+}
+
+impl Clone for Box<dyn Integrator> {
+    fn clone(&self) -> Self {
+        self.boxed_clone()
+    }
+}

@@ -1,0 +1,87 @@
+//! # voussoir
+//!
+//! Discrete element modelling of masonry built from rigid convex polyhedral blocks: arches,
+//! walls, vaults and bridges under static and impact loads.
+//!
+//! Blocks interact through **soft contacts**: each joint carries sub-contacts (points with a
+//! tributary area) where normal and shear springs, capped by a [`ConstitutiveLaw`] such as
+//! Coulomb slip with tension cut-off, give the joint forces. Blocks move by explicit central
+//! difference with local (Cundall) or Rayleigh damping. f64 and SI units throughout.
+//!
+//! ## Getting started
+//!
+//! A block on an incline steeper than its friction angle slides with
+//! `a = g (sin ψ − tan φ cos ψ)`:
+//!
+//! ```
+//! use voussoir::prelude::*;
+//!
+//! let slope = 35f64.to_radians();
+//! let params = ModelParameters {
+//!     gravity: 9.81 * Vector::new(slope.sin(), 0.0, -slope.cos()), // incline as a tilted gravity
+//!     ..ModelParameters::default()
+//! };
+//! let mut model: Model = Model::new(params)?;
+//! model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 1e9, 30.0)?)?;
+//! model.set_damping(Damping::None)?;
+//! model.add_block(
+//!     RigidBlock::cuboid("ramp", Vector::new(-1.0, -0.5, -0.1), Vector::new(2.0, 0.5, 0.0), 2500.0)?
+//!         .with_fixity(Fixity::FIXED),
+//! )?;
+//! let brick = model.add_block(RigidBlock::cuboid("brick", Vector::ZERO, Vector::new(0.2, 0.2, 0.1), 2500.0)?)?;
+//! model.run_until_time(0.3)?;
+//! let v = model.block(brick)?.state().velocity.x;
+//! let a = 9.81 * (slope.sin() - 30f64.to_radians().tan() * slope.cos());
+//! assert!((v / 0.3 - a).abs() < 0.03 * a, "{} vs {}", v / 0.3, a);
+//! # Ok::<(), voussoir::Error>(())
+//! ```
+//!
+//! ## Map of the crate
+//!
+//! | module | stage |
+//! |---|---|
+//! | [`geometry`] | polyhedra, mass properties, broad phase, contact polygon and sub-contacts |
+//! | [`block`] | the [`Block`] trait, ids, fixity, rigid blocks |
+//! | [`contact`] | the [`Contact`] trait, sub-contact state and kinematics |
+//! | [`constitutive`] | the [`ConstitutiveLaw`] trait and the shipped laws |
+//! | [`integrate`] | the [`Integrator`] trait, central difference, damping, critical step |
+//! | [`model`] | the [`Model`]: stepping, runs, energies |
+//! | [`monitor`] | monitors and histories |
+//! | [`build`] | generators (walls, stacks) |
+#![warn(missing_docs)]
+
+pub mod block;
+pub mod build;
+pub mod constitutive;
+pub mod contact;
+pub mod error;
+pub mod geometry;
+pub mod integrate;
+pub mod math;
+pub mod model;
+pub mod monitor;
+
+pub use block::{Block, BlockId, RigidBlock};
+pub use constitutive::ConstitutiveLaw;
+pub use contact::Contact;
+pub use error::{Error, Result};
+pub use integrate::Integrator;
+pub use model::{Model, ModelParameters};
+
+// Fails to compile if our glam and parry's glam ever diverge.
+const _: fn(glam::DVec3) -> parry3d_f64::math::Vector = |v| v;
+const _: fn(glam::DQuat) -> parry3d_f64::math::Rotation = |q| q;
+const _: fn(parry3d_f64::glamx::DPose3) -> parry3d_f64::math::Pose = |p| p;
+
+/// The names most programs need.
+pub mod prelude {
+    pub use crate::block::{Block, BlockId, Dof, Fixity, RigidBlock, Wrench};
+    pub use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, LinearElastic, MaterialId};
+    pub use crate::contact::{Contact, DisplacementMode};
+    pub use crate::error::{Error, Result};
+    pub use crate::geometry::{ContactParameters, SubcontactDensity};
+    pub use crate::integrate::{CentralDifference, Damping, Integrator, TimeStep};
+    pub use crate::math::{Pose, Real, Rotation, Vector};
+    pub use crate::model::{Energies, Model, ModelParameters};
+    pub use crate::monitor::{Component, EnergyTerm, Monitor, MonitorId};
+}

@@ -1,0 +1,52 @@
+//! Energy bookkeeping: every term is accumulated independently so that their balance tests the
+//! whole engine.
+
+use serde::{Deserialize, Serialize};
+
+use crate::math::Real;
+
+/// Energies and works since the start of the run (J).
+///
+/// Balance: `kinetic + elastic + friction + damping = initial_kinetic + gravity_work + load_work +
+/// boundary_work`. `kinetic` is evaluated at integer time levels (mean of the half-step
+/// velocities); works are the power of each force times the step; `elastic` is the energy stored
+/// in the joint springs; `friction` is the work done on the joints (trapezoidal rule, per
+/// sub-contact) less the elastic energy, i.e. what slip and failure dissipated.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Energies {
+    /// Kinetic energy (J).
+    pub kinetic: Real,
+    /// Kinetic energy before the first step (J).
+    pub initial_kinetic: Real,
+    /// Elastic energy in the joint springs (J).
+    pub elastic: Real,
+    /// Work of gravity (J).
+    pub gravity_work: Real,
+    /// Work of applied loads (J).
+    pub load_work: Real,
+    /// Work of the supports and prescribed velocities (J).
+    pub boundary_work: Real,
+    /// Energy dissipated by slip and joint failure (J).
+    pub friction: Real,
+    /// Energy dissipated by damping: local, Rayleigh mass part and contact dashpots (J).
+    pub damping: Real,
+    /// Total work done on the joint springs (J).
+    pub joint_work: Real,
+}
+
+impl Energies {
+    /// Energy put in: initial kinetic energy plus the work of gravity, loads and supports (J).
+    pub fn input(&self) -> Real {
+        self.initial_kinetic + self.gravity_work + self.load_work + self.boundary_work
+    }
+
+    /// Energy accounted for: kinetic, elastic, friction and damping (J).
+    pub fn accounted(&self) -> Real {
+        self.kinetic + self.elastic + self.friction + self.damping
+    }
+
+    /// `accounted − input` (J); zero for a perfect integrator.
+    pub fn balance_error(&self) -> Real {
+        self.accounted() - self.input()
+    }
+}

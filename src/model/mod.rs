@@ -1,0 +1,660 @@
+//! The model: blocks, joint laws, gravity and loads; stepping and runs.
+
+mod detection;
+mod energy;
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+pub use energy::Energies;
+
+use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
+use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
+use crate::contact::{
+    sum_contact, update_pair_geometry, update_subcontact, ContactPair, ContactView, DisplacementMode, KernelContext,
+    SubContact,
+};
+use crate::error::{positive, Error, Result};
+use crate::geometry::ContactParameters;
+use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
+use crate::math::{is_finite_vector, Pose, Real, Vector};
+use crate::monitor::{History, Monitor, MonitorId};
+
+use detection::DetectionScratch;
+
+/// Global parameters of a model, with documented defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ModelParameters {
+    /// Gravitational acceleration (m/s²). Default `(0, 0, −9.81)`.
+    pub gravity: Vector,
+    /// Contact detection and discretisation.
+    pub contact: ContactParameters,
+    /// Time step choice. Default automatic at 0.9 of the critical step.
+    pub time_step: TimeStep,
+    /// Large (default) or small displacements.
+    pub mode: DisplacementMode,
+    /// A block faster than this (m/s) means the run has diverged. Default 1000 m/s.
+    pub max_speed: Real,
+}
+
+impl Default for ModelParameters {
+    fn default() -> Self {
+        Self {
+            gravity: Vector::new(0.0, 0.0, -9.81),
+            contact: ContactParameters::default(),
+            time_step: TimeStep::default(),
+            mode: DisplacementMode::Large,
+            max_speed: 1e3,
+        }
+    }
+}
+
+impl ModelParameters {
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] or [`Error::NonFinite`] naming the field.
+    pub fn validate(&self) -> Result<()> {
+        if !is_finite_vector(self.gravity) {
+            return Err(Error::NonFinite { what: "gravity".into() });
+        }
+        self.contact.validate()?;
+        match self.time_step {
+            TimeStep::Auto { safety } => {
+                crate::error::in_range("time_step.safety", safety, 1e-6, 1.0 + 1e-12, "must lie in (0, 1]")?;
+            }
+            TimeStep::Fixed(dt) => {
+                positive("time_step", dt)?;
+            }
+        }
+        positive("max_speed", self.max_speed)?;
+        Ok(())
+    }
+}
+
+/// A discrete element model of rigid blocks with joint law type `L`.
+///
+/// ```
+/// use voussoir::prelude::*;
+///
+/// let mut model: Model = Model::new(ModelParameters::default())?;
+/// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+/// model.add_block(
+///     RigidBlock::cuboid("base", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), 2500.0)?
+///         .with_fixity(Fixity::FIXED),
+/// )?;
+/// let cube = model.add_block(RigidBlock::cuboid("cube", Vector::ZERO, Vector::splat(0.2), 2500.0)?)?;
+/// model.run_to_equilibrium(1e-4, 20_000)?;
+/// let weight = 2500.0 * 0.008 * 9.81;
+/// let support: f64 = model.contacts().map(|c| c.pair.normal_force()).sum();
+/// assert!((support - weight).abs() < 1e-3 * weight);
+/// assert!(model.block(cube)?.displacement_of(Vector::splat(0.1)).length() < 1e-4);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
+    params: ModelParameters,
+    blocks: Vec<RigidBlock>,
+    joints: JointTable<L>,
+    integrator: Box<dyn Integrator>,
+    pairs: Vec<ContactPair>,
+    subs: Vec<SubContact<L::State>>,
+    sub_pair: Vec<u32>,
+    block_contacts: Vec<u32>,
+    block_offsets: Vec<u32>,
+    forces: Vec<Wrench>,
+    records: Vec<StepRecord>,
+    ref_poses: Vec<Pose>,
+    bounds: Vec<StiffnessBound>,
+    dt: Real,
+    critical: Option<CriticalStep>,
+    step: u64,
+    time: Real,
+    energy: Energies,
+    started: bool,
+    unbalanced_ratio: Real,
+    detections: u64,
+    scratch: DetectionScratch<L::State>,
+    monitors: Vec<(String, Monitor)>,
+    history: History,
+    monitor_interval: u64,
+}
+
+impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Model")
+            .field("blocks", &self.blocks.len())
+            .field("contacts", &self.pairs.len())
+            .field("subcontacts", &self.subs.len())
+            .field("step", &self.step)
+            .field("time", &self.time)
+            .field("dt", &self.dt)
+            .finish()
+    }
+}
+
+/// Smallest number of items per rayon task in the contact loops.
+const ITEMS_PER_TASK: usize = 512;
+
+impl<L: ConstitutiveLaw> Model<L> {
+    /// An empty model.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] or [`Error::NonFinite`] for bad parameters.
+    pub fn new(params: ModelParameters) -> Result<Self> {
+        params.validate()?;
+        Ok(Self {
+            params,
+            blocks: Vec::new(),
+            joints: JointTable::new(),
+            integrator: Box::new(CentralDifference::default()),
+            pairs: Vec::new(),
+            subs: Vec::new(),
+            sub_pair: Vec::new(),
+            block_contacts: Vec::new(),
+            block_offsets: vec![0],
+            forces: Vec::new(),
+            records: Vec::new(),
+            ref_poses: Vec::new(),
+            bounds: Vec::new(),
+            dt: 0.0,
+            critical: None,
+            step: 0,
+            time: 0.0,
+            energy: Energies::default(),
+            started: false,
+            unbalanced_ratio: Real::INFINITY,
+            detections: 0,
+            scratch: DetectionScratch::default(),
+            monitors: Vec::new(),
+            history: History::default(),
+            monitor_interval: 1,
+        })
+    }
+
+    /// Adds a block and returns its id.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] for a NaN or infinite velocity, position, load or prescribed velocity.
+    pub fn add_block(&mut self, block: RigidBlock) -> Result<BlockId> {
+        block.validate()?;
+        let id = BlockId(self.blocks.len() as u32);
+        self.ref_poses.push(block.state.pose);
+        self.blocks.push(block);
+        self.forces.push(Wrench::default());
+        self.records.push(StepRecord::default());
+        self.bounds.push(StiffnessBound::default());
+        self.scratch.force_full_detection = true;
+        Ok(id)
+    }
+
+    /// Sets the joint law between two materials (either order).
+    ///
+    /// # Errors
+    /// The law's validation error.
+    pub fn set_joint_law(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
+        self.joints.insert(a, b, law)?;
+        self.scratch.force_full_detection = true;
+        Ok(())
+    }
+
+    /// Replaces the integrator.
+    pub fn set_integrator(&mut self, integrator: impl Integrator + 'static) -> Result<()> {
+        integrator.damping().validate()?;
+        self.integrator = Box::new(integrator);
+        self.refresh_time_step()
+    }
+
+    /// Central difference with the given damping (shortcut for [`Model::set_integrator`]).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for bad coefficients; [`Error::TimeStepTooLarge`] if a fixed
+    /// step is no longer stable with the new damping.
+    pub fn set_damping(&mut self, damping: Damping) -> Result<()> {
+        self.set_integrator(CentralDifference::new(damping))
+    }
+
+    /// Replaces the global parameters (gravity, contact parameters, time step, mode).
+    ///
+    /// # Errors
+    /// As [`ModelParameters::validate`].
+    pub fn set_parameters(&mut self, params: ModelParameters) -> Result<()> {
+        params.validate()?;
+        self.params = params;
+        self.scratch.force_full_detection = true;
+        Ok(())
+    }
+
+    /// The global parameters.
+    pub fn parameters(&self) -> &ModelParameters {
+        &self.params
+    }
+
+    /// Sets the constant external load (force, and moment about the centroid) on a block.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`], [`Error::NonFinite`].
+    pub fn set_load(&mut self, id: BlockId, load: Wrench) -> Result<()> {
+        if !is_finite_vector(load.force) || !is_finite_vector(load.moment) {
+            return Err(Error::NonFinite {
+                what: format!("load on block {id}"),
+            });
+        }
+        self.block_mut(id)?.load = load;
+        Ok(())
+    }
+
+    /// Sets the fixity of a block.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`], [`Error::NonFinite`] for a NaN prescribed velocity.
+    pub fn set_fixity(&mut self, id: BlockId, fixity: Fixity) -> Result<()> {
+        let b = self.block_mut(id)?;
+        let old = b.fixity().to_owned();
+        *b = b.clone().with_fixity(fixity);
+        if let Err(e) = b.validate() {
+            *b = b.clone().with_fixity(old);
+            return Err(e);
+        }
+        self.refresh_time_step()
+    }
+
+    /// Sets a block's velocity (m/s) and angular velocity (rad/s).
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`], [`Error::NonFinite`].
+    pub fn set_velocity(&mut self, id: BlockId, velocity: Vector, angular_velocity: Vector) -> Result<()> {
+        if !is_finite_vector(velocity) || !is_finite_vector(angular_velocity) {
+            return Err(Error::NonFinite {
+                what: format!("velocity of block {id}"),
+            });
+        }
+        let b = self.block_mut(id)?;
+        *b = b.clone().with_velocity(velocity, angular_velocity);
+        Ok(())
+    }
+
+    fn block_mut(&mut self, id: BlockId) -> Result<&mut RigidBlock> {
+        let count = self.blocks.len();
+        self.blocks.get_mut(id.index()).ok_or(Error::UnknownBlock { id, count })
+    }
+
+    /// A block by id.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn block(&self, id: BlockId) -> Result<&RigidBlock> {
+        self.blocks.get(id.index()).ok_or(Error::UnknownBlock {
+            id,
+            count: self.blocks.len(),
+        })
+    }
+
+    /// All blocks, indexed by [`BlockId::index`].
+    pub fn blocks(&self) -> &[RigidBlock] {
+        &self.blocks
+    }
+
+    /// The joint laws.
+    pub fn joints(&self) -> &JointTable<L> {
+        &self.joints
+    }
+
+    /// The current contacts, each with its sub-contacts.
+    pub fn contacts(&self) -> impl ExactSizeIterator<Item = ContactView<'_, L::State>> + '_ {
+        self.pairs.iter().map(move |p| ContactView {
+            pair: p,
+            subs: &self.subs[p.range()],
+        })
+    }
+
+    /// The contact between two blocks, if any.
+    pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<ContactView<'_, L::State>> {
+        let key = (a.0.min(b.0), a.0.max(b.0));
+        self.pairs
+            .binary_search_by_key(&key, |p| (p.a, p.b))
+            .ok()
+            .map(|i| ContactView {
+                pair: &self.pairs[i],
+                subs: &self.subs[self.pairs[i].range()],
+            })
+    }
+
+    /// Total number of sub-contacts.
+    pub fn subcontact_count(&self) -> usize {
+        self.subs.len()
+    }
+
+    /// Steps taken.
+    pub fn step_count(&self) -> u64 {
+        self.step
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> Real {
+        self.time
+    }
+
+    /// The time step in use (s); zero before the first step.
+    pub fn dt(&self) -> Real {
+        self.dt
+    }
+
+    /// The critical time step and the block that limits it (after the first step).
+    pub fn critical_step(&self) -> Option<CriticalStep> {
+        self.critical
+    }
+
+    /// Energies since the start.
+    pub fn energies(&self) -> &Energies {
+        &self.energy
+    }
+
+    /// Number of contact detections run so far.
+    pub fn detection_count(&self) -> u64 {
+        self.detections
+    }
+
+    /// Unbalanced-force ratio of the last step: the largest out-of-balance force on a free block
+    /// divided by the mean contact force (infinite before the first step or without contacts).
+    pub fn unbalanced_force_ratio(&self) -> Real {
+        self.unbalanced_ratio
+    }
+
+    /// Force and moment the supports or prescribed velocities applied to a block in the last step.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn reaction(&self, id: BlockId) -> Result<Wrench> {
+        self.block(id)?;
+        Ok(self.records[id.index()].reaction)
+    }
+
+    /// Total contact force and moment (about its centroid) on a block in the last step.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn contact_wrench(&self, id: BlockId) -> Result<Wrench> {
+        self.block(id)?;
+        Ok(self.contact_wrench_of(id.index()))
+    }
+
+    fn contact_wrench_of(&self, i: usize) -> Wrench {
+        let mut w = Wrench::default();
+        for &c in &self.block_contacts[self.block_offsets[i] as usize..self.block_offsets[i + 1] as usize] {
+            let p = &self.pairs[c as usize];
+            if p.b as usize == i {
+                w.force += p.force;
+                w.moment += p.moment_b;
+            } else {
+                w.force -= p.force;
+                w.moment += p.moment_a;
+            }
+        }
+        w
+    }
+
+    /// Adds a monitor sampled every [`Model::set_monitor_interval`] steps.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`] if the monitor refers to a missing block.
+    pub fn add_monitor(&mut self, name: &str, monitor: Monitor) -> Result<MonitorId> {
+        for id in monitor.blocks() {
+            self.block(id)?;
+        }
+        let id = MonitorId(self.monitors.len() as u32);
+        self.history.add_column(name, monitor.unit());
+        self.monitors.push((name.to_owned(), monitor));
+        Ok(id)
+    }
+
+    /// Samples monitors every `n` steps (default 1).
+    pub fn set_monitor_interval(&mut self, n: u64) {
+        self.monitor_interval = n.max(1);
+    }
+
+    /// The sampled histories.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Evaluates a monitor now.
+    pub fn evaluate(&self, monitor: &Monitor) -> Real {
+        monitor.evaluate(self)
+    }
+
+    /// One step.
+    ///
+    /// # Errors
+    /// [`Error::MissingJointLaw`] when blocks of materials with no law touch;
+    /// [`Error::TimeStepTooLarge`] for a fixed step above the critical one;
+    /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway.
+    pub fn step(&mut self) -> Result<()> {
+        if !self.started {
+            self.start()?;
+        } else if self.params.mode == DisplacementMode::Large && self.needs_detection() {
+            self.detect()?;
+        }
+        self.compute_forces();
+        self.integrator
+            .advance(&mut self.blocks, &self.forces, self.dt, &mut self.records);
+        self.account_energy();
+        self.step += 1;
+        self.time += self.dt;
+        self.check_divergence()?;
+        if self.step % self.monitor_interval == 0 && !self.monitors.is_empty() {
+            self.sample();
+        }
+        Ok(())
+    }
+
+    fn start(&mut self) -> Result<()> {
+        self.params.validate()?;
+        self.integrator.damping().validate()?;
+        self.scratch.force_full_detection = true;
+        self.detect()?;
+        self.energy.initial_kinetic = self.blocks.iter().map(|b| b.kinetic_energy()).sum();
+        self.energy.kinetic = self.energy.initial_kinetic;
+        self.started = true;
+        Ok(())
+    }
+
+    fn compute_forces(&mut self) {
+        let ctx = KernelContext {
+            dt: self.dt,
+            stiffness_damping: self.integrator.damping().stiffness_coefficient(),
+            mode: self.params.mode,
+        };
+        let blocks = &self.blocks;
+        if ctx.mode == DisplacementMode::Large {
+            self.pairs.par_iter_mut().with_min_len(ITEMS_PER_TASK).for_each(|p| {
+                let (a, b) = (&blocks[p.a as usize], &blocks[p.b as usize]);
+                update_pair_geometry(p, &a.state, &b.state, a.shape(), b.shape());
+            });
+        }
+        let pairs = &self.pairs;
+        let laws = self.joints.laws();
+        self.subs
+            .par_iter_mut()
+            .with_min_len(ITEMS_PER_TASK)
+            .zip(self.sub_pair.par_iter())
+            .for_each(|(s, &pi)| {
+                let p = &pairs[pi as usize];
+                update_subcontact(
+                    s,
+                    p,
+                    &blocks[p.a as usize].state,
+                    &blocks[p.b as usize].state,
+                    &laws[p.law as usize],
+                    ctx,
+                );
+            });
+        let subs = &self.subs;
+        self.pairs.par_iter_mut().with_min_len(ITEMS_PER_TASK).for_each(|p| {
+            let r = p.range();
+            let (a, b) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
+            sum_contact(p, &subs[r], a, b, ctx.mode);
+        });
+        let gravity = self.params.gravity;
+        let pairs = &self.pairs;
+        let (contacts, offsets) = (&self.block_contacts, &self.block_offsets);
+        self.forces
+            .par_iter_mut()
+            .with_min_len(ITEMS_PER_TASK)
+            .enumerate()
+            .for_each(|(i, w)| {
+                let b = &blocks[i];
+                let mut total = b.load;
+                total.force += gravity * b.mass_properties().mass;
+                for &c in &contacts[offsets[i] as usize..offsets[i + 1] as usize] {
+                    let p = &pairs[c as usize];
+                    if p.b as usize == i {
+                        total.force += p.force;
+                        total.moment += p.moment_b;
+                    } else {
+                        total.force -= p.force;
+                        total.moment += p.moment_a;
+                    }
+                }
+                *w = total;
+            });
+        // Unbalanced-force ratio.
+        let mut max_unbalanced: Real = 0.0;
+        for (b, w) in self.blocks.iter().zip(&self.forces) {
+            if b.fixity().is_free() {
+                max_unbalanced = max_unbalanced.max(w.force.length());
+            }
+        }
+        let mean_contact = if self.pairs.is_empty() {
+            0.0
+        } else {
+            self.pairs.iter().map(|p| p.force.length()).sum::<Real>() / self.pairs.len() as Real
+        };
+        self.unbalanced_ratio = if mean_contact > 0.0 {
+            max_unbalanced / mean_contact
+        } else {
+            Real::INFINITY
+        };
+    }
+
+    fn account_energy(&mut self) {
+        let dt = self.dt;
+        let g = self.params.gravity;
+        let e = &mut self.energy;
+        let mut kinetic = 0.0;
+        for (b, r) in self.blocks.iter().zip(&self.records) {
+            let m = b.mass_properties().mass;
+            let v = r.mean_velocity;
+            let w = r.mean_angular_velocity;
+            kinetic += 0.5 * m * v.length_squared() + 0.5 * w.dot(b.world_inertia_times(w));
+            e.gravity_work += m * g.dot(v) * dt;
+            e.load_work += (b.load.force.dot(v) + b.load.moment.dot(w)) * dt;
+            e.boundary_work += (r.reaction.force.dot(v) + r.reaction.moment.dot(w)) * dt;
+            e.damping -= (r.damping.force.dot(v) + r.damping.moment.dot(w)) * dt;
+        }
+        e.kinetic = kinetic;
+        let (mut work, mut dashpot, mut elastic) = (0.0, 0.0, 0.0);
+        for p in &self.pairs {
+            work += p.work;
+            dashpot += p.dashpot_work;
+            elastic += p.elastic;
+        }
+        e.joint_work += work;
+        e.damping += dashpot;
+        e.elastic = elastic;
+        e.friction = e.joint_work - elastic;
+    }
+
+    fn check_divergence(&self) -> Result<()> {
+        let max2 = self.params.max_speed * self.params.max_speed;
+        for (i, b) in self.blocks.iter().enumerate() {
+            let s = &b.state;
+            let finite = is_finite_vector(s.velocity)
+                && is_finite_vector(s.angular_velocity)
+                && is_finite_vector(s.pose.translation)
+                && s.pose.rotation.is_finite();
+            let r = b.shape().radius();
+            let speed2 = s
+                .velocity
+                .length_squared()
+                .max(s.angular_velocity.length_squared() * r * r);
+            if !finite || speed2 > max2 {
+                return Err(Error::Diverged {
+                    step: self.step,
+                    time: self.time,
+                    block: BlockId(i as u32),
+                    reason: if finite {
+                        format!(
+                            "speed {:.3e} m/s exceeds max_speed {} m/s",
+                            speed2.sqrt(),
+                            self.params.max_speed
+                        )
+                    } else {
+                        "position or velocity is not finite".into()
+                    },
+                });
+            }
+        }
+        Ok(())
+    }
+
+    fn sample(&mut self) {
+        let values: Vec<Real> = self.monitors.iter().map(|(_, m)| m.evaluate(self)).collect();
+        self.history.push(self.step, self.time, &values);
+    }
+
+    /// Runs `n` steps.
+    ///
+    /// # Errors
+    /// As [`Model::step`].
+    pub fn run_steps(&mut self, n: u64) -> Result<()> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Runs until the simulated time reaches `t` (s).
+    ///
+    /// # Errors
+    /// As [`Model::step`].
+    pub fn run_until_time(&mut self, t: Real) -> Result<()> {
+        while self.time < t {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    /// Runs until `done(model)` returns true (checked after each step) or `max_steps` steps;
+    /// returns whether the condition was met.
+    ///
+    /// # Errors
+    /// As [`Model::step`].
+    pub fn run_until(&mut self, max_steps: u64, mut done: impl FnMut(&Self) -> bool) -> Result<bool> {
+        for _ in 0..max_steps {
+            self.step()?;
+            if done(self) {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
+
+    /// Runs until the unbalanced-force ratio falls below `target`; returns the steps taken.
+    ///
+    /// # Errors
+    /// [`Error::NotConverged`] after `max_steps`; otherwise as [`Model::step`].
+    pub fn run_to_equilibrium(&mut self, target: Real, max_steps: u64) -> Result<u64> {
+        positive("equilibrium target ratio", target)?;
+        for k in 1..=max_steps {
+            self.step()?;
+            if self.unbalanced_ratio < target {
+                return Ok(k);
+            }
+        }
+        Err(Error::NotConverged {
+            what: "unbalanced-force ratio target",
+            steps: max_steps,
+            last: self.unbalanced_ratio,
+        })
+    }
+}
