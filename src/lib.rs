@@ -85,3 +85,8 @@ pub mod prelude {
     pub use crate::model::{Energies, Model, ModelParameters};
     pub use crate::monitor::{Component, EnergyTerm, Monitor, MonitorId};
 }
+
+/// The README's usage example, compiled and run as a doc-test.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
