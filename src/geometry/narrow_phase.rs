@@ -1,10 +1,10 @@
 //! Narrow phase: the common plane, the contact polygon and its sub-contacts for one block pair.
 //!
-//! parry gives the contact normal and the gap (GJK/EPA); the face-to-face polygon and the
-//! sub-contact grid are built here. See `docs/theory.md`, "Contact geometry".
+//! The common plane comes from a separating-axis test over face normals and edge pairs (exact for
+//! convex polyhedra, also for faces that just touch, where GJK/EPA normals are arbitrary); the
+//! face-to-face polygon and the sub-contact grid are built here. See `docs/theory.md`, "Contact geometry".
 
 use glam::DVec2;
-use parry3d_f64::query;
 use serde::{Deserialize, Serialize};
 
 use super::clip::{area_centroid, clip_convex, clip_rect};
@@ -142,6 +142,8 @@ pub struct DetectedContact {
 /// Scratch buffers reused between detections.
 #[derive(Debug, Default, Clone)]
 pub struct NarrowPhaseScratch {
+    world_a: Vec<Vector>,
+    world_b: Vec<Vector>,
     host: Vec<DVec2>,
     other: Vec<DVec2>,
     cell: Vec<DVec2>,
@@ -166,11 +168,11 @@ pub fn detect(
     scratch: &mut NarrowPhaseScratch,
     seeds: &mut Vec<SubcontactSeed>,
 ) -> Option<DetectedContact> {
-    let c = query::contact(a.pose, a.shape.parry(), b.pose, b.shape.parry(), params.tolerance).ok()??;
-    let n = c.normal1;
-    if !(n.length_squared() > 0.5) {
+    let axis = separating_axis(a, b, scratch);
+    if axis.separation > params.tolerance {
         return None;
     }
+    let n = axis.normal;
     let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
     let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
     let na = a.pose.rotation * a.shape.faces()[fa].normal;
@@ -182,7 +184,74 @@ pub fn detect(
         }
         seeds.truncate(start);
     }
-    point_contact(a, b, n, c.dist, params, seeds)
+    point_contact(a, b, n, axis.separation, params, seeds)
+}
+
+/// The common-plane normal from the separating axis theorem.
+#[derive(Debug, Clone, Copy)]
+struct Axis {
+    /// Unit normal from `a` to `b`.
+    normal: Vector,
+    /// Signed separation along it (m): positive = gap, negative = overlap depth.
+    separation: Real,
+}
+
+/// Separating axis test over the face normals of both blocks and the cross products of their
+/// edges: the axis of largest separation is the contact normal (the least-penetration axis when
+/// they overlap). Exact for convex polyhedra, including faces that touch with zero overlap, where
+/// GJK/EPA normals are arbitrary. Face axes win ties against edge axes.
+fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut NarrowPhaseScratch) -> Axis {
+    scratch.world_a.clear();
+    scratch.world_a.extend(a.shape.vertices().iter().map(|v| a.pose.transform_point(*v)));
+    scratch.world_b.clear();
+    scratch.world_b.extend(b.shape.vertices().iter().map(|v| b.pose.transform_point(*v)));
+    let (wa, wb) = (&scratch.world_a, &scratch.world_b);
+    let separation = |d: Vector| {
+        let max_a = wa.iter().map(|p| d.dot(*p)).fold(Real::NEG_INFINITY, Real::max);
+        let min_b = wb.iter().map(|p| d.dot(*p)).fold(Real::INFINITY, Real::min);
+        min_b - max_a
+    };
+    let mut best = Axis {
+        normal: Vector::Z,
+        separation: Real::NEG_INFINITY,
+    };
+    for f in a.shape.faces() {
+        let d = a.pose.rotation * f.normal;
+        let s = separation(d);
+        if s > best.separation {
+            best = Axis { normal: d, separation: s };
+        }
+    }
+    for f in b.shape.faces() {
+        let d = -(b.pose.rotation * f.normal);
+        let s = separation(d);
+        if s > best.separation {
+            best = Axis { normal: d, separation: s };
+        }
+    }
+    // Edge–edge axes must beat the face axes clearly, so that touching faces stay face contacts.
+    let bias = 1e-9 * (a.shape.radius() + b.shape.radius());
+    let centre = b.pose.translation - a.pose.translation;
+    for ea in a.shape.edges() {
+        let da = wa[ea[1] as usize] - wa[ea[0] as usize];
+        for eb in b.shape.edges() {
+            let db = wb[eb[1] as usize] - wb[eb[0] as usize];
+            let c = da.cross(db);
+            let len = c.length();
+            if len <= 1e-9 * da.length() * db.length() {
+                continue;
+            }
+            let mut d = c / len;
+            if d.dot(centre) < 0.0 {
+                d = -d;
+            }
+            let s = separation(d);
+            if s > best.separation + bias {
+                best = Axis { normal: d, separation: s };
+            }
+        }
+    }
+    best
 }
 
 /// Characteristic sub-contact spacing for a pair (m), used for point contacts.

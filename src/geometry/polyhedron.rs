@@ -41,6 +41,8 @@ pub struct Polyhedron {
     vertices: Vec<Vector>,
     faces: Vec<Face>,
     face_vertices: Vec<u32>,
+    /// Unique edges as vertex index pairs.
+    edges: Vec<[u32; 2]>,
     /// Largest distance from the centroid to a vertex (m).
     radius: Real,
     volume: Real,
@@ -227,10 +229,21 @@ impl Polyhedron {
             face_vertices.extend_from_slice(ids);
         }
         let radius = vertices.iter().map(|v| v.length()).fold(0.0, Real::max);
+        let mut edges: Vec<[u32; 2]> = Vec::new();
+        for f in &faces {
+            let ids = &face_vertices[f.first as usize..(f.first + f.len) as usize];
+            for k in 0..ids.len() {
+                let (i, j) = (ids[k], ids[(k + 1) % ids.len()]);
+                edges.push([i.min(j), i.max(j)]);
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
         Ok(Self {
             vertices,
             faces,
             face_vertices,
+            edges,
             radius,
             volume,
             unit_inertia,
@@ -252,6 +265,11 @@ impl Polyhedron {
     pub fn face_loop(&self, face: usize) -> &[u32] {
         let f = &self.faces[face];
         &self.face_vertices[f.first as usize..(f.first + f.len) as usize]
+    }
+
+    /// Unique edges as pairs of vertex indices.
+    pub fn edges(&self) -> &[[u32; 2]] {
+        &self.edges
     }
 
     /// Volume (m³).
