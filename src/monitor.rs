@@ -92,6 +92,16 @@ pub enum Monitor {
         /// Component.
         component: Component,
     },
+    /// Resultant force (N) of the joint between two blocks, on the second one (zero when they
+    /// are not in contact).
+    JointForce {
+        /// First block.
+        a: BlockId,
+        /// Second block: the force is the one acting on it.
+        b: BlockId,
+        /// Component.
+        component: Component,
+    },
     /// An energy term (J).
     Energy(EnergyTerm),
     /// The unbalanced-force ratio (-).
@@ -105,6 +115,7 @@ impl Monitor {
             | Monitor::Velocity { block, .. }
             | Monitor::Reaction { block, .. }
             | Monitor::ContactForce { block, .. } => vec![block],
+            Monitor::JointForce { a, b, .. } => vec![a, b],
             _ => Vec::new(),
         }
     }
@@ -114,7 +125,7 @@ impl Monitor {
         match self {
             Monitor::Displacement { .. } => "m",
             Monitor::Velocity { .. } => "m/s",
-            Monitor::Reaction { .. } | Monitor::ContactForce { .. } => "N",
+            Monitor::Reaction { .. } | Monitor::ContactForce { .. } | Monitor::JointForce { .. } => "N",
             Monitor::Energy(_) => "J",
             Monitor::UnbalancedRatio => "-",
         }
@@ -143,6 +154,14 @@ impl Monitor {
             }
             Monitor::ContactForce { block: id, component } => {
                 component.of(model.contact_wrench(id).map(|w| w.force).unwrap_or_default())
+            }
+            Monitor::JointForce { a, b, component } => {
+                let f = model
+                    .contact_between(a, b)
+                    .map(|c| c.pair.resultant())
+                    .unwrap_or_default();
+                // The stored resultant acts on the higher-numbered block.
+                component.of(if b.0 > a.0 { f } else { -f })
             }
             Monitor::Energy(term) => {
                 let e = model.energies();
@@ -180,11 +199,11 @@ impl History {
         self.columns.push(vec![Real::NAN; self.steps.len()]);
     }
 
-    pub(crate) fn push(&mut self, step: u64, time: Real, values: &[Real]) {
+    pub(crate) fn push(&mut self, step: u64, time: Real, values: impl Iterator<Item = Real>) {
         self.steps.push(step);
         self.times.push(time);
         for (c, v) in self.columns.iter_mut().zip(values) {
-            c.push(*v);
+            c.push(v);
         }
     }
 

@@ -14,21 +14,19 @@ use crate::math::{Real, Vector};
 /// * shear (incremental): `F_s ← F_s - ks·A·Δu_s`, capped at `c·A + F_n·tan φ`;
 /// * failure in tension or shear sets cohesion and tensile strength to zero and `φ` to `φ_r`.
 ///
-/// Angles are stored in radians; the constructors take degrees.
+/// The constructors take angles in degrees and validate every parameter; the accessors return
+/// radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct CoulombSlip {
-    /// Normal stiffness `kn` (Pa/m).
-    pub normal_stiffness: Real,
-    /// Shear stiffness `ks` (Pa/m).
-    pub shear_stiffness: Real,
-    /// Initial friction angle `φ` (rad).
-    pub friction_angle: Real,
-    /// Residual friction angle `φ_r` (rad), after failure.
-    pub residual_friction_angle: Real,
-    /// Cohesion `c` (Pa).
-    pub cohesion: Real,
-    /// Tensile strength `f_t` (Pa).
-    pub tensile_strength: Real,
+    normal_stiffness: Real,
+    shear_stiffness: Real,
+    friction_angle: Real,
+    residual_friction_angle: Real,
+    cohesion: Real,
+    tensile_strength: Real,
+    /// `tan φ`, `tan φ_r`, cached out of the hot loop.
+    tan_friction: Real,
+    tan_residual: Real,
 }
 
 /// Per-sub-contact history of [`CoulombSlip`].
@@ -68,9 +66,36 @@ impl CoulombSlip {
             residual_friction_angle: residual_friction_deg.to_radians(),
             cohesion,
             tensile_strength,
+            tan_friction: friction_deg.to_radians().tan(),
+            tan_residual: residual_friction_deg.to_radians().tan(),
         };
         law.validate()?;
         Ok(law)
+    }
+
+    /// Normal stiffness `kn` (Pa/m).
+    pub fn normal_stiffness(&self) -> Real {
+        self.normal_stiffness
+    }
+    /// Shear stiffness `ks` (Pa/m).
+    pub fn shear_stiffness(&self) -> Real {
+        self.shear_stiffness
+    }
+    /// Initial friction angle `φ` (rad).
+    pub fn friction_angle(&self) -> Real {
+        self.friction_angle
+    }
+    /// Residual friction angle `φ_r` (rad).
+    pub fn residual_friction_angle(&self) -> Real {
+        self.residual_friction_angle
+    }
+    /// Cohesion `c` (Pa).
+    pub fn cohesion(&self) -> Real {
+        self.cohesion
+    }
+    /// Tensile strength `f_t` (Pa).
+    pub fn tensile_strength(&self) -> Real {
+        self.tensile_strength
     }
 }
 
@@ -87,10 +112,10 @@ impl ConstitutiveLaw for CoulombSlip {
     fn update(&self, s: &JointStep, f: &mut JointForce, state: &mut CoulombState) -> JointStatus {
         let a = s.area;
         f.normal = -self.normal_stiffness * s.normal_displacement * a;
-        let (tensile, cohesion, phi) = if state.failed {
-            (0.0, 0.0, self.residual_friction_angle)
+        let (tensile, cohesion, tan_phi) = if state.failed {
+            (0.0, 0.0, self.tan_residual)
         } else {
-            (self.tensile_strength, self.cohesion, self.friction_angle)
+            (self.tensile_strength, self.cohesion, self.tan_friction)
         };
         if f.normal < -tensile * a || (f.normal < 0.0 && tensile == 0.0) || (f.normal <= 0.0 && state.failed) {
             if f.normal < 0.0 && tensile > 0.0 {
@@ -101,7 +126,7 @@ impl ConstitutiveLaw for CoulombSlip {
             return JointStatus::Open;
         }
         f.shear -= s.shear_increment * (self.shear_stiffness * a);
-        let limit = cohesion * a + f.normal * phi.tan();
+        let limit = cohesion * a + f.normal * tan_phi;
         let trial = f.shear.length();
         if trial > limit {
             f.shear *= if trial > 0.0 { limit.max(0.0) / trial } else { 0.0 };

@@ -202,9 +202,13 @@ struct Axis {
 /// GJK/EPA normals are arbitrary. Face axes win ties against edge axes.
 fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut NarrowPhaseScratch) -> Axis {
     scratch.world_a.clear();
-    scratch.world_a.extend(a.shape.vertices().iter().map(|v| a.pose.transform_point(*v)));
+    scratch
+        .world_a
+        .extend(a.shape.vertices().iter().map(|v| a.pose.transform_point(*v)));
     scratch.world_b.clear();
-    scratch.world_b.extend(b.shape.vertices().iter().map(|v| b.pose.transform_point(*v)));
+    scratch
+        .world_b
+        .extend(b.shape.vertices().iter().map(|v| b.pose.transform_point(*v)));
     let (wa, wb) = (&scratch.world_a, &scratch.world_b);
     let separation = |d: Vector| {
         let max_a = wa.iter().map(|p| d.dot(*p)).fold(Real::NEG_INFINITY, Real::max);
@@ -219,14 +223,20 @@ fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut Nar
         let d = a.pose.rotation * f.normal;
         let s = separation(d);
         if s > best.separation {
-            best = Axis { normal: d, separation: s };
+            best = Axis {
+                normal: d,
+                separation: s,
+            };
         }
     }
     for f in b.shape.faces() {
         let d = -(b.pose.rotation * f.normal);
         let s = separation(d);
         if s > best.separation {
-            best = Axis { normal: d, separation: s };
+            best = Axis {
+                normal: d,
+                separation: s,
+            };
         }
     }
     // Edge–edge axes must beat the face axes clearly, so that touching faces stay face contacts.
@@ -247,7 +257,10 @@ fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut Nar
             }
             let s = separation(d);
             if s > best.separation + bias {
-                best = Axis { normal: d, separation: s };
+                best = Axis {
+                    normal: d,
+                    separation: s,
+                };
             }
         }
     }

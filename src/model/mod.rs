@@ -598,8 +598,13 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     fn sample(&mut self) {
-        let values: Vec<Real> = self.monitors.iter().map(|(_, m)| m.evaluate(self)).collect();
-        self.history.push(self.step, self.time, &values);
+        let mut history = std::mem::take(&mut self.history);
+        history.push(
+            self.step,
+            self.time,
+            self.monitors.iter().map(|(_, m)| m.evaluate(self)),
+        );
+        self.history = history;
     }
 
     /// Runs `n` steps.
