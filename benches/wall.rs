@@ -30,7 +30,11 @@ fn wall(blocks: usize) -> Model {
     };
     let mut model = Model::new(params).expect("parameters");
     model
-        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"))
+        .set_joint_law(
+            MaterialId(0),
+            MaterialId(0),
+            CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"),
+        )
         .expect("law");
     for b in running_bond_wall(&spec).expect("wall") {
         model.add_block(b).expect("block");
@@ -43,5 +47,7 @@ fn wall(blocks: usize) -> Model {
 fn settle_step(bencher: divan::Bencher, blocks: usize) {
     let mut model = wall(blocks);
     let updates = model.subcontact_count();
-    bencher.counter(ItemsCount::new(updates)).bench_local(|| model.step().expect("step"));
+    bencher
+        .counter(ItemsCount::new(updates))
+        .bench_local(|| model.step().expect("step"));
 }

@@ -20,9 +20,19 @@ fn main() -> Result<()> {
     model.set_damping(Damping::None)?;
     // Build a ramp and a brick lying on it in the ramp's frame, then tilt both by ψ about y.
     let tilt = Pose::from_parts(Vector::ZERO, Rotation::from_rotation_y(-psi));
-    let ramp = RigidBlock::cuboid("ramp", Vector::new(-1.5, -0.5, -0.2), Vector::new(1.5, 0.5, 0.0), 2500.0)?;
+    let ramp = RigidBlock::cuboid(
+        "ramp",
+        Vector::new(-1.5, -0.5, -0.2),
+        Vector::new(1.5, 0.5, 0.0),
+        2500.0,
+    )?;
     model.add_block(ramp.transformed(tilt).with_fixity(Fixity::FIXED))?;
-    let brick = RigidBlock::cuboid("brick", Vector::new(-0.1, -0.1, 0.0), Vector::new(0.1, 0.1, 0.1), 2500.0)?;
+    let brick = RigidBlock::cuboid(
+        "brick",
+        Vector::new(-0.1, -0.1, 0.0),
+        Vector::new(0.1, 0.1, 0.1),
+        2500.0,
+    )?;
     let brick = model.add_block(brick.transformed(tilt))?;
 
     // Down the slope is -x of the ramp frame.
