@@ -181,7 +181,7 @@ impl Polyhedron {
             })?;
         let mp = shifted_poly.mass_properties(1.0);
         let volume = mp.mass();
-        if !(volume > 1e-12 * scale * scale * scale) {
+        if volume.is_nan() || volume <= 1e-12 * scale * scale * scale {
             return Err(Error::NonPositiveVolume {
                 block: name.to_owned(),
                 volume,
