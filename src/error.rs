@@ -96,6 +96,14 @@ pub enum Error {
         /// What was found, e.g. `"velocity is NaN"`.
         reason: String,
     },
+    /// Reading or writing a file failed.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file or folder.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
     /// A run reached its step budget before its stopping condition.
     #[error("{what} not reached after {steps} steps (last value {last})")]
     NotConverged {

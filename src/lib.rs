@@ -48,6 +48,7 @@
 //! | [`model`] | the [`Model`]: stepping, runs, energies |
 //! | [`monitor`] | monitors and histories |
 //! | [`build`] | generators (walls, stacks) |
+//! | [`io`] | ParaView series, CSV histories |
 #![warn(missing_docs)]
 
 pub mod block;
@@ -57,6 +58,7 @@ pub mod contact;
 pub mod error;
 pub mod geometry;
 pub mod integrate;
+pub mod io;
 pub mod math;
 pub mod model;
 pub mod monitor;

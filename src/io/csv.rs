@@ -1,0 +1,50 @@
+//! CSV histories: `step,time [s],<monitor> [unit],...`, one row per sample.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::error::Result;
+use crate::io::io_error;
+use crate::monitor::History;
+
+/// Renders a history as CSV text: a header `step,time [s],name [unit],...` then one row per
+/// sample, numbers in shortest round-trip form.
+///
+/// ```
+/// use voussoir::prelude::*;
+/// let mut model: Model = Model::new(ModelParameters::default())?;
+/// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+/// model.add_block(RigidBlock::cuboid("b", Vector::ZERO, Vector::splat(0.1), 2000.0)?)?;
+/// model.add_monitor("kinetic", Monitor::Energy(EnergyTerm::Kinetic))?;
+/// model.run_steps(3)?;
+/// let csv = voussoir::io::csv::history_to_csv(model.history());
+/// assert!(csv.starts_with("step,time [s],kinetic [J]\n1,"));
+/// assert_eq!(csv.lines().count(), 4);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+pub fn history_to_csv(history: &History) -> String {
+    let mut out = String::from("step,time [s]");
+    for (name, unit) in history.names().iter().zip(history.units()) {
+        let _ = write!(out, ",{} [{}]", name.replace(',', ";"), unit);
+    }
+    out.push('\n');
+    for row in 0..history.len() {
+        let _ = write!(out, "{},{:e}", history.steps()[row], history.times()[row]);
+        for c in 0..history.names().len() {
+            let _ = write!(out, ",{:e}", history.column(crate::monitor::MonitorId(c as u32))[row]);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// Writes [`history_to_csv`] to a file, creating its folder.
+///
+/// # Errors
+/// [`crate::Error::Io`] naming the file.
+pub fn write_history(path: &Path, history: &History) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
+    }
+    std::fs::write(path, history_to_csv(history)).map_err(|e| io_error(path, &e))
+}
