@@ -1,6 +1,9 @@
-//! Outputs users expect: ParaView series ([`vtk`]), CSV histories and JSON summaries ([`csv`]).
+//! Outputs users expect: ParaView series ([`vtk`]), CSV histories ([`csv`]), SVG plots ([`plot`])
+//! and progress bars ([`progress`]).
 
 pub mod csv;
+pub mod plot;
+pub mod progress;
 pub mod vtk;
 
 use std::path::Path;
