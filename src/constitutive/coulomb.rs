@@ -17,16 +17,63 @@ use crate::math::{Real, Vector};
 /// The constructors take angles in degrees and validate every parameter; the accessors return
 /// radians.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "CoulombSpec", into = "CoulombSpec")]
 pub struct CoulombSlip {
     normal_stiffness: Real,
     shear_stiffness: Real,
-    friction_angle: Real,
-    residual_friction_angle: Real,
+    /// Degrees, as given (so that serialisation round-trips exactly).
+    friction_deg: Real,
+    residual_friction_deg: Real,
     cohesion: Real,
     tensile_strength: Real,
     /// `tan φ`, `tan φ_r`, cached out of the hot loop.
     tan_friction: Real,
     tan_residual: Real,
+}
+
+/// The serialised form of [`CoulombSlip`]: angles in degrees, validated on load.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CoulombSpec {
+    /// Pa/m.
+    normal_stiffness: Real,
+    /// Pa/m.
+    shear_stiffness: Real,
+    friction_deg: Real,
+    residual_friction_deg: Real,
+    /// Pa.
+    #[serde(default)]
+    cohesion: Real,
+    /// Pa.
+    #[serde(default)]
+    tensile_strength: Real,
+}
+
+impl TryFrom<CoulombSpec> for CoulombSlip {
+    type Error = crate::Error;
+    fn try_from(s: CoulombSpec) -> Result<Self> {
+        CoulombSlip::new(
+            s.normal_stiffness,
+            s.shear_stiffness,
+            s.friction_deg,
+            s.residual_friction_deg,
+            s.cohesion,
+            s.tensile_strength,
+        )
+    }
+}
+
+impl From<CoulombSlip> for CoulombSpec {
+    fn from(l: CoulombSlip) -> Self {
+        Self {
+            normal_stiffness: l.normal_stiffness,
+            shear_stiffness: l.shear_stiffness,
+            friction_deg: l.friction_deg,
+            residual_friction_deg: l.residual_friction_deg,
+            cohesion: l.cohesion,
+            tensile_strength: l.tensile_strength,
+        }
+    }
 }
 
 /// Per-sub-contact history of [`CoulombSlip`].
@@ -62,8 +109,8 @@ impl CoulombSlip {
         let law = Self {
             normal_stiffness: kn,
             shear_stiffness: ks,
-            friction_angle: friction_deg.to_radians(),
-            residual_friction_angle: residual_friction_deg.to_radians(),
+            friction_deg,
+            residual_friction_deg,
             cohesion,
             tensile_strength,
             tan_friction: friction_deg.to_radians().tan(),
@@ -83,11 +130,11 @@ impl CoulombSlip {
     }
     /// Initial friction angle `φ` (rad).
     pub fn friction_angle(&self) -> Real {
-        self.friction_angle
+        self.friction_deg.to_radians()
     }
     /// Residual friction angle `φ_r` (rad).
     pub fn residual_friction_angle(&self) -> Real {
-        self.residual_friction_angle
+        self.residual_friction_deg.to_radians()
     }
     /// Cohesion `c` (Pa).
     pub fn cohesion(&self) -> Real {
@@ -130,7 +177,7 @@ impl ConstitutiveLaw for CoulombSlip {
         let trial = f.shear.length();
         if trial > limit {
             f.shear *= if trial > 0.0 { limit.max(0.0) / trial } else { 0.0 };
-            if cohesion > 0.0 || tensile > 0.0 || self.residual_friction_angle != self.friction_angle {
+            if cohesion > 0.0 || tensile > 0.0 || self.tan_residual != self.tan_friction {
                 state.failed = true;
             }
             return JointStatus::Sliding;
@@ -145,20 +192,13 @@ impl ConstitutiveLaw for CoulombSlip {
     fn validate(&self) -> Result<()> {
         positive("normal_stiffness", self.normal_stiffness)?;
         positive("shear_stiffness", self.shear_stiffness)?;
-        let half_pi = std::f64::consts::FRAC_PI_2;
-        in_range(
-            "friction_angle",
-            self.friction_angle,
-            0.0,
-            half_pi,
-            "must lie in [0, 90) degrees (given in rad)",
-        )?;
+        in_range("friction_angle", self.friction_deg, 0.0, 90.0, "must lie in [0, 90) degrees")?;
         in_range(
             "residual_friction_angle",
-            self.residual_friction_angle,
+            self.residual_friction_deg,
             0.0,
-            half_pi,
-            "must lie in [0, 90) degrees (given in rad)",
+            90.0,
+            "must lie in [0, 90) degrees",
         )?;
         non_negative("cohesion", self.cohesion)?;
         non_negative("tensile_strength", self.tensile_strength)?;
