@@ -104,6 +104,14 @@ pub enum Error {
         /// What went wrong.
         message: String,
     },
+    /// A checkpoint or scene file is truncated, corrupt or inconsistent.
+    #[error("bad checkpoint or scene at `{path}`: {message}")]
+    Checkpoint {
+        /// Where in the document (for example `blocks[3].density`).
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A run reached its step budget before its stopping condition.
     #[error("{what} not reached after {steps} steps (last value {last})")]
     NotConverged {

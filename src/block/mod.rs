@@ -333,6 +333,13 @@ impl RigidBlock {
     }
 }
 
+impl RigidBlock {
+    pub(crate) fn restore(&mut self) -> Result<()> {
+        self.shape.restore()?;
+        self.validate()
+    }
+}
+
 impl Block for RigidBlock {
     fn name(&self) -> &str {
         &self.name

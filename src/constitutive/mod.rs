@@ -8,8 +8,6 @@
 mod coulomb;
 mod elastic;
 
-use std::collections::BTreeMap;
-
 use serde::{Deserialize, Serialize};
 
 pub use coulomb::{CoulombSlip, CoulombState};
@@ -164,14 +162,15 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct JointTable<L> {
     laws: Vec<L>,
-    index: BTreeMap<(MaterialId, MaterialId), u32>,
+    /// `((min material, max material), law index)`, sorted.
+    index: Vec<((MaterialId, MaterialId), u32)>,
 }
 
 impl<L> Default for JointTable<L> {
     fn default() -> Self {
         Self {
             laws: Vec::new(),
-            index: BTreeMap::new(),
+            index: Vec::new(),
         }
     }
 }
@@ -189,10 +188,10 @@ impl<L: ConstitutiveLaw> JointTable<L> {
     pub fn insert(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
         law.validate()?;
         let key = (a.min(b), a.max(b));
-        match self.index.get(&key) {
-            Some(&i) => self.laws[i as usize] = law,
-            None => {
-                self.index.insert(key, self.laws.len() as u32);
+        match self.index.binary_search_by_key(&key, |e| e.0) {
+            Ok(k) => self.laws[self.index[k].1 as usize] = law,
+            Err(k) => {
+                self.index.insert(k, (key, self.laws.len() as u32));
                 self.laws.push(law);
             }
         }
@@ -205,7 +204,18 @@ impl<L: ConstitutiveLaw> JointTable<L> {
     }
 
     pub(crate) fn index_of(&self, a: MaterialId, b: MaterialId) -> Option<u32> {
-        self.index.get(&(a.min(b), a.max(b))).copied()
+        let key = (a.min(b), a.max(b));
+        self.index.binary_search_by_key(&key, |e| e.0).ok().map(|k| self.index[k].1)
+    }
+
+    /// The `(material, material, law)` entries, sorted by material pair.
+    pub fn entries(&self) -> impl Iterator<Item = (MaterialId, MaterialId, &L)> + '_ {
+        self.index.iter().map(|&((a, b), i)| (a, b, &self.laws[i as usize]))
+    }
+
+    /// Checks the table's internal indices (after deserialisation).
+    pub(crate) fn check(&self) -> bool {
+        self.index.iter().all(|e| (e.1 as usize) < self.laws.len()) && self.index.windows(2).all(|w| w[0].0 < w[1].0)
     }
 
     /// All laws, indexed as contacts refer to them.

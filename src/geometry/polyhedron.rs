@@ -251,6 +251,37 @@ impl Polyhedron {
         })
     }
 
+    /// Rebuilds parry's shape after deserialisation and checks the stored topology.
+    pub(crate) fn restore(&mut self) -> Result<()> {
+        let bad = |reason: &str| Error::DegenerateGeometry {
+            block: "(restored)".into(),
+            reason: reason.into(),
+        };
+        let n = self.vertices.len() as u32;
+        if self.faces.len() < 4 || self.face_vertices.iter().any(|&v| v >= n) {
+            return Err(bad("stored faces refer to missing vertices"));
+        }
+        let mut tris = Vec::new();
+        for f in &self.faces {
+            let end = f.first as usize + f.len as usize;
+            if f.len < 3 || end > self.face_vertices.len() {
+                return Err(bad("stored face loop out of range"));
+            }
+            let ids = &self.face_vertices[f.first as usize..end];
+            for k in 1..ids.len() - 1 {
+                tris.push([ids[0], ids[k], ids[k + 1]]);
+            }
+        }
+        if self.edges.iter().any(|e| e[0] >= n || e[1] >= n) {
+            return Err(bad("stored edges refer to missing vertices"));
+        }
+        self.parry = Some(
+            ConvexPolyhedron::from_convex_mesh(self.vertices.clone(), &tris)
+                .ok_or_else(|| bad("stored faces do not form a convex manifold"))?,
+        );
+        Ok(())
+    }
+
     /// Vertices in the body frame (m).
     pub fn vertices(&self) -> &[Vector] {
         &self.vertices

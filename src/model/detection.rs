@@ -196,7 +196,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.refresh_time_step()
     }
 
-    fn rebuild_block_index(&mut self) {
+    pub(super) fn rebuild_block_index(&mut self) {
         let n = self.blocks.len();
         self.block_offsets.clear();
         self.block_offsets.resize(n + 1, 0);
@@ -216,6 +216,15 @@ impl<L: ConstitutiveLaw> Model<L> {
                 fill[k] += 1;
             }
         }
+    }
+
+    /// Recomputes the per-block stiffness bounds without touching `dt` (after a restart).
+    pub(super) fn refresh_bounds_only(&mut self) {
+        let dt = self.dt;
+        let critical = self.critical;
+        let _ = self.refresh_time_step();
+        self.dt = dt;
+        self.critical = critical;
     }
 
     /// Re-evaluates the critical step from the current contacts and each block's potential

@@ -1,5 +1,6 @@
 //! The model: blocks, joint laws, gravity and loads; stepping and runs.
 
+mod checkpoint;
 mod detection;
 mod energy;
 

@@ -1,0 +1,104 @@
+//! Checkpoint and restart: a restarted run continues bit-identically; corrupt or truncated
+//! checkpoints give errors, never panics.
+
+use voussoir::build::{running_bond_wall, WallSpec};
+use voussoir::prelude::*;
+
+/// A small wall under a lateral load, so that blocks slide, rock and get re-detected.
+fn moving_wall() -> Result<Model> {
+    let params = ModelParameters {
+        gravity: Vector::new(6.0, 0.0, -9.81), // beyond tan 25° × g: the courses slide
+        contact: ContactParameters {
+            density: SubcontactDensity::PerEdge(4),
+            ..ContactParameters::default()
+        },
+        ..ModelParameters::default()
+    };
+    let mut model: Model = Model::new(params)?;
+    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::new(1e9, 4e8, 25.0, 20.0, 2e3, 1e3)?)?;
+    model.set_damping(Damping::rayleigh_stiffness(0.02, 50.0)?)?;
+    for b in running_bond_wall(&WallSpec {
+        bricks_per_course: 4,
+        courses: 5,
+        ..WallSpec::default()
+    })? {
+        model.add_block(b)?;
+    }
+    model.add_monitor("kinetic", Monitor::Energy(EnergyTerm::Kinetic))?;
+    model.add_monitor(
+        "top x",
+        Monitor::Displacement {
+            block: BlockId(20),
+            point: Vector::new(0.5, 0.05, 0.225),
+            component: Component::X,
+        },
+    )?;
+    model.set_monitor_interval(10);
+    Ok(model)
+}
+
+fn state_bits(model: &Model) -> Vec<u64> {
+    let mut bits = Vec::new();
+    for b in model.blocks() {
+        let s = b.state();
+        for v in [s.pose.translation, s.velocity, s.angular_velocity, s.angular_momentum] {
+            bits.extend(v.to_array().map(f64::to_bits));
+        }
+        bits.extend(s.pose.rotation.to_array().map(f64::to_bits));
+    }
+    for c in model.contacts() {
+        for s in c.subs {
+            bits.push(s.normal_force().to_bits());
+            bits.extend(s.shear_force().to_array().map(f64::to_bits));
+        }
+    }
+    let e = model.energies();
+    bits.extend([e.kinetic, e.elastic, e.friction, e.damping, e.gravity_work].map(f64::to_bits));
+    bits
+}
+
+#[test]
+fn restarted_run_is_bit_identical() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(2000)?;
+    let dir = std::env::temp_dir().join(format!("voussoir-checkpoint-{}", std::process::id()));
+    let path = dir.join("wall.json");
+    model.save_checkpoint(&path)?;
+    let mut restarted: Model = Model::load_checkpoint(&path)?;
+    let detections = model.detection_count();
+    model.run_steps(3000)?;
+    restarted.run_steps(3000)?;
+    assert!(model.detection_count() > detections, "the test must cross re-detections");
+    assert!(model.contacts().flat_map(|c| c.subs).any(|s| s.slip() > 0.0), "the test must include slip");
+    assert_eq!(state_bits(&model), state_bits(&restarted));
+    assert_eq!(model.history(), restarted.history());
+    std::fs::remove_dir_all(&dir).ok();
+    Ok(())
+}
+
+#[test]
+fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(50)?;
+    let text = model.to_checkpoint_string()?;
+    // Truncated anywhere: an error naming where, never a panic.
+    for cut in (0..text.len()).step_by(text.len() / 97 + 1) {
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&text[..cut]).expect_err("truncated");
+        assert!(matches!(err, Error::Checkpoint { .. }), "{err}");
+    }
+    // Inconsistent indices that parse fine.
+    let bad_pair = text.replacen("\"sub_pair\":[0", "\"sub_pair\":[7777", 1);
+    assert_ne!(bad_pair, text);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_pair).expect_err("bad sub_pair");
+    assert!(err.to_string().contains("pairs[0]"), "{err}");
+    // A bad law parameter is caught by the law's own validation, with its path.
+    let bad_law = text.replacen("\"friction_deg\":25.0", "\"friction_deg\":95.0", 1);
+    assert_ne!(bad_law, text);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_law).expect_err("bad friction");
+    assert!(err.to_string().contains("joints.laws[0]") && err.to_string().contains("friction"), "{err}");
+    // A missing file.
+    let err = Model::<CoulombSlip>::load_checkpoint(std::path::Path::new("/nonexistent/x.json")).expect_err("missing");
+    assert!(matches!(err, Error::Io { .. }), "{err}");
+    Ok(())
+}
+
