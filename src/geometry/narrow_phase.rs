@@ -24,6 +24,7 @@ pub enum SubcontactDensity {
 
 /// Parameters of contact detection and discretisation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ContactParameters {
     /// Blocks closer than this (m) are in contact; contacts whose gap grows beyond it are dropped.
     /// Default `1e-3` m.

@@ -1,9 +1,11 @@
 //! Outputs users expect: ParaView series ([`vtk`]), CSV histories ([`csv`]), SVG plots ([`plot`])
-//! and progress bars ([`progress`]).
+//! progress bars ([`progress`]) and scene files ([`scene`]). Checkpoints are methods of
+//! [`crate::Model`] (`save_checkpoint`, `load_checkpoint`).
 
 pub mod csv;
 pub mod plot;
 pub mod progress;
+pub mod scene;
 pub mod vtk;
 
 use std::path::Path;

@@ -25,6 +25,7 @@ use detection::DetectionScratch;
 
 /// Global parameters of a model, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct ModelParameters {
     /// Gravitational acceleration (m/s²). Default `(0, 0, −9.81)`.
     pub gravity: Vector,
@@ -411,6 +412,21 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Samples monitors every `n` steps (default 1).
     pub fn set_monitor_interval(&mut self, n: u64) {
         self.monitor_interval = n.max(1);
+    }
+
+    /// The monitors, with their names, in column order.
+    pub fn monitors(&self) -> &[(String, Monitor)] {
+        &self.monitors
+    }
+
+    /// Steps between monitor samples.
+    pub fn monitor_interval(&self) -> u64 {
+        self.monitor_interval
+    }
+
+    /// The integrator's damping model.
+    pub fn damping(&self) -> Damping {
+        self.integrator.damping()
     }
 
     /// The sampled histories.

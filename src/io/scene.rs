@@ -1,0 +1,220 @@
+//! Scene files: a model's definition (blocks, materials, joint laws, fixities, loads, damping,
+//! monitors, parameters) as JSON, validated on load with the path of the first bad field.
+//!
+//! The format is documented in `docs/scene-format.md`.
+
+use std::path::Path;
+
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+
+use crate::block::{Block, Fixity, RigidBlock, Wrench};
+use crate::constitutive::{ConstitutiveLaw, MaterialId};
+use crate::error::{Error, Result};
+use crate::integrate::Damping;
+use crate::io::io_error;
+use crate::math::Vector;
+use crate::model::{Model, ModelParameters};
+use crate::monitor::Monitor;
+
+/// A block as written in a scene: world vertices (convex hull) or vertices and faces.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BlockSpec {
+    /// Name used in messages and outputs.
+    pub name: String,
+    /// Vertices in world coordinates (m).
+    pub vertices: Vec<Vector>,
+    /// Optional explicit faces (vertex index loops, counter-clockwise seen from outside); the
+    /// convex hull of the vertices otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub faces: Option<Vec<Vec<usize>>>,
+    /// Density (kg/m³).
+    pub density: f64,
+    /// Material id (selects joint laws).
+    #[serde(default)]
+    pub material: MaterialId,
+    /// Fixity; free when omitted.
+    #[serde(default)]
+    pub fixity: Fixity,
+    /// Initial velocity (m/s).
+    #[serde(default)]
+    pub velocity: Vector,
+    /// Initial angular velocity (rad/s).
+    #[serde(default)]
+    pub angular_velocity: Vector,
+    /// Constant applied load (force and moment about the centroid).
+    #[serde(default)]
+    pub load: Wrench,
+}
+
+/// The joint law between two materials.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec<L> {
+    /// The two materials (either order).
+    pub materials: [MaterialId; 2],
+    /// The law and its parameters.
+    pub law: L,
+}
+
+/// A named monitor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MonitorSpec {
+    /// Column name.
+    pub name: String,
+    /// What is monitored.
+    pub monitor: Monitor,
+}
+
+/// A model's definition, without its run state (see [`Model::to_checkpoint_string`] for that).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene<L> {
+    /// Global parameters; defaults for omitted fields.
+    #[serde(default)]
+    pub parameters: ModelParameters,
+    /// Damping; local 0.8 when omitted.
+    #[serde(default)]
+    pub damping: Damping,
+    /// Joint laws per pair of materials.
+    pub joints: Vec<JointSpec<L>>,
+    /// The blocks, in id order.
+    pub blocks: Vec<BlockSpec>,
+    /// Monitors.
+    #[serde(default)]
+    pub monitors: Vec<MonitorSpec>,
+    /// Sample the monitors every this many steps (default 1).
+    #[serde(default = "one")]
+    pub monitor_interval: u64,
+}
+
+fn one() -> u64 {
+    1
+}
+
+impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
+    /// Parses a scene from JSON text. Syntax and type errors name the path of the field.
+    ///
+    /// # Errors
+    /// [`Error::Checkpoint`] with the path (for example `blocks[2].density`).
+    pub fn from_json(text: &str) -> Result<Self> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        serde_path_to_error::deserialize(de).map_err(|e| Error::Checkpoint {
+            path: e.path().to_string(),
+            message: e.inner().to_string(),
+        })
+    }
+
+    /// Reads a scene file.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file; otherwise as [`Scene::from_json`].
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| io_error(path, &e))?;
+        Self::from_json(&text)
+    }
+
+    /// Pretty JSON text.
+    ///
+    /// # Errors
+    /// [`Error::Io`] if serialisation fails.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(self).map_err(|e| Error::Io {
+            path: "(scene)".into(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Writes the scene as pretty JSON.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn save(&self, path: &Path) -> Result<()> {
+        let text = self.to_json()?;
+        if let Some(dir) = path.parent() {
+            if !dir.as_os_str().is_empty() {
+                std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
+            }
+        }
+        std::fs::write(path, text).map_err(|e| io_error(path, &e))
+    }
+
+    /// The definition of a model in its current pose (velocities and loads included).
+    pub fn from_model(model: &Model<L>) -> Self {
+        let blocks = model
+            .blocks()
+            .iter()
+            .map(|b| {
+                let s = b.state();
+                BlockSpec {
+                    name: b.name().to_owned(),
+                    vertices: b.shape().vertices().iter().map(|v| s.pose.transform_point(*v)).collect(),
+                    faces: Some(
+                        (0..b.shape().faces().len())
+                            .map(|f| b.shape().face_loop(f).iter().map(|&i| i as usize).collect())
+                            .collect(),
+                    ),
+                    density: b.density(),
+                    material: b.material(),
+                    fixity: *b.fixity(),
+                    velocity: s.velocity,
+                    angular_velocity: s.angular_velocity,
+                    load: b.load(),
+                }
+            })
+            .collect();
+        Self {
+            parameters: *model.parameters(),
+            damping: model.damping(),
+            joints: model
+                .joints()
+                .entries()
+                .map(|(a, b, law)| JointSpec {
+                    materials: [a, b],
+                    law: law.clone(),
+                })
+                .collect(),
+            blocks,
+            monitors: model
+                .monitors()
+                .iter()
+                .map(|(name, m)| MonitorSpec {
+                    name: name.clone(),
+                    monitor: *m,
+                })
+                .collect(),
+            monitor_interval: model.monitor_interval(),
+        }
+    }
+
+    /// Builds the model, validating everything; errors name the path of the bad entry.
+    ///
+    /// # Errors
+    /// [`Error::Checkpoint`] with the path (for example `blocks[3]`) and the underlying error.
+    pub fn build(&self) -> Result<Model<L>> {
+        let at = |path: String| move |e: Error| Error::Checkpoint { path, message: e.to_string() };
+        let mut model = Model::new(self.parameters).map_err(at("parameters".into()))?;
+        model.set_damping(self.damping).map_err(at("damping".into()))?;
+        for (k, j) in self.joints.iter().enumerate() {
+            model.set_joint_law(j.materials[0], j.materials[1], j.law.clone()).map_err(at(format!("joints[{k}].law")))?;
+        }
+        for (i, b) in self.blocks.iter().enumerate() {
+            let path = format!("blocks[{i}]");
+            let block = match &b.faces {
+                Some(faces) => RigidBlock::from_faces(&b.name, &b.vertices, faces, b.density),
+                None => RigidBlock::from_vertices(&b.name, &b.vertices, b.density),
+            }
+            .map_err(at(path.clone()))?;
+            let block = block.with_material(b.material).with_fixity(b.fixity).with_velocity(b.velocity, b.angular_velocity);
+            let id = model.add_block(block).map_err(at(path.clone()))?;
+            model.set_load(id, b.load).map_err(at(path))?;
+        }
+        for (k, m) in self.monitors.iter().enumerate() {
+            model.add_monitor(&m.name, m.monitor).map_err(at(format!("monitors[{k}]")))?;
+        }
+        model.set_monitor_interval(self.monitor_interval);
+        Ok(model)
+    }
+}

@@ -1,0 +1,71 @@
+//! Scene files: the documented example loads and runs; a model round-trips through a scene;
+//! bad fields are reported with their path.
+
+use std::path::Path;
+
+use voussoir::io::scene::Scene;
+use voussoir::prelude::*;
+
+fn example() -> Result<Scene<CoulombSlip>> {
+    Scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples/block-on-base.json"))
+}
+
+#[test]
+fn documented_example_builds_and_reaches_equilibrium() -> Result<()> {
+    let mut model = example()?.build()?;
+    assert_eq!(model.blocks().len(), 2);
+    model.run_to_equilibrium(1e-6, 50_000)?;
+    // The 50 N push is below μW = tan 30.5° × 2446.5 × 0.008 × 9.81 = 113 N: the stone sticks,
+    // and the support carries its weight.
+    let weight = 2446.5 * 0.008 * 9.81;
+    // (The base's own reaction also carries the base's weight: use the joint force instead.)
+    let support = -model.contact_wrench(BlockId(0))?.force.z;
+    assert!((support - weight).abs() < 1e-4 * weight, "support {support} vs weight {weight}");
+    assert_eq!(model.history().names(), ["stone x", "support z"]);
+    Ok(())
+}
+
+#[test]
+fn model_round_trips_through_a_scene() -> Result<()> {
+    let model = example()?.build()?;
+    let text = Scene::from_model(&model).to_json()?;
+    let again = Scene::<CoulombSlip>::from_json(&text)?.build()?;
+    for (a, b) in model.blocks().iter().zip(again.blocks()) {
+        assert_eq!(a.name(), b.name());
+        assert!((a.mass_properties().mass - b.mass_properties().mass).abs() < 1e-12 * a.mass_properties().mass);
+        assert!((a.state().pose.translation - b.state().pose.translation).length() < 1e-12);
+        assert_eq!(a.fixity(), b.fixity());
+        assert_eq!(a.load(), b.load());
+    }
+    assert_eq!(model.joints().laws(), again.joints().laws());
+    assert_eq!(model.monitors(), again.monitors());
+    Ok(())
+}
+
+#[test]
+fn bad_fields_are_reported_with_their_path() -> Result<()> {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples/block-on-base.json"))
+        .expect("example file");
+    let cases = [
+        // (replace, with, expected fragment of the message)
+        ("\"density\": 2446.5,\n      \"load\"", "\"density\": \"heavy\",\n      \"load\"", "blocks[1].density"),
+        ("\"density\": 2446.5,\n      \"load\"", "\"density\": -1.0,\n      \"load\"", "blocks[1]"),
+        ("\"friction_deg\": 30.5", "\"friction_deg\": 95.0", "joints[0].law"),
+        ("\"tolerance\": 0.001", "\"tolerance\": -0.001", "parameters"),
+        ("\"alpha\": 0.8", "\"alpha\": 1.5", "damping"),
+        ("\"block\": 1,", "\"block\": 7,", "monitors[0]"),
+        ("\"monitor_interval\": 10", "\"monitor_interval\": 10, \"colour\": 3", "colour"),
+        (
+            "[-0.1, -0.1, 0.2], [0.1, -0.1, 0.2], [0.1, 0.1, 0.2], [-0.1, 0.1, 0.2]",
+            "[-0.1, -0.1, 0.0], [0.1, -0.1, 0.0], [0.1, 0.1, 0.0], [-0.1, 0.1, 0.0]",
+            "blocks[1]",
+        ),
+    ];
+    for (from, to, expected) in cases {
+        let bad = text.replacen(from, to, 1);
+        assert_ne!(bad, text, "test case {from:?} does not apply");
+        let err = Scene::<CoulombSlip>::from_json(&bad).and_then(|s| s.build()).expect_err(expected);
+        assert!(err.to_string().contains(expected), "{expected:?} not in {err}");
+    }
+    Ok(())
+}
