@@ -51,3 +51,15 @@ fn settle_step(bencher: divan::Bencher, blocks: usize) {
         .counter(ItemsCount::new(updates))
         .bench_local(|| model.step().expect("step"));
 }
+
+/// Writing one ParaView frame (blocks as polyhedron cells) of a settled wall.
+#[divan::bench(args = [10_000], sample_count = 5, sample_size = 1)]
+fn write_vtu_frame(bencher: divan::Bencher, blocks: usize) {
+    let model = wall(blocks);
+    let dir = std::env::temp_dir().join(format!("voussoir-bench-vtu-{}", std::process::id()));
+    let path = dir.join("wall.vtu");
+    bencher.bench_local(|| {
+        voussoir::io::vtk::write_blocks(&path, model.blocks(), |i| *model.blocks()[i].initial_pose()).expect("write")
+    });
+    std::fs::remove_dir_all(&dir).ok();
+}
