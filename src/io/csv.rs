@@ -1,4 +1,4 @@
-//! CSV histories: `step,time [s],<monitor> [unit],...`, one row per sample.
+//! CSV histories: `time [s],step,<monitor> [unit],...`, one row per sample.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -7,7 +7,7 @@ use crate::error::Result;
 use crate::io::io_error;
 use crate::monitor::History;
 
-/// Renders a history as CSV text: a header `step,time [s],name [unit],...` then one row per
+/// Renders a history as CSV text: a header `time [s],step,name [unit],...` then one row per
 /// sample, numbers in shortest round-trip form.
 ///
 /// ```
@@ -18,18 +18,18 @@ use crate::monitor::History;
 /// model.add_monitor("kinetic", Monitor::Energy(EnergyTerm::Kinetic))?;
 /// model.run_steps(3)?;
 /// let csv = voussoir::io::csv::history_to_csv(model.history());
-/// assert!(csv.starts_with("step,time [s],kinetic [J]\n1,"));
+/// assert!(csv.starts_with("time [s],step,kinetic [J]\n"));
 /// assert_eq!(csv.lines().count(), 4);
 /// # Ok::<(), voussoir::Error>(())
 /// ```
 pub fn history_to_csv(history: &History) -> String {
-    let mut out = String::from("step,time [s]");
+    let mut out = String::from("time [s],step");
     for (name, unit) in history.names().iter().zip(history.units()) {
         let _ = write!(out, ",{} [{}]", name.replace(',', ";"), unit);
     }
     out.push('\n');
     for row in 0..history.len() {
-        let _ = write!(out, "{},{:e}", history.steps()[row], history.times()[row]);
+        let _ = write!(out, "{:e},{}", history.times()[row], history.steps()[row]);
         for c in 0..history.names().len() {
             let _ = write!(out, ",{:e}", history.column(crate::monitor::MonitorId(c as u32))[row]);
         }

@@ -18,3 +18,21 @@ pub(crate) fn io_error(path: &Path, e: &std::io::Error) -> Error {
         message: e.to_string(),
     }
 }
+
+/// Writes any serialisable value as pretty JSON (for example an example's `summary.json`),
+/// creating the folder. Non-finite numbers become `null`.
+///
+/// # Errors
+/// [`Error::Io`] naming the file.
+pub fn write_json(path: &Path, value: &impl serde::Serialize) -> crate::Result<()> {
+    let text = serde_json::to_string_pretty(value).map_err(|e| Error::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    if let Some(dir) = path.parent() {
+        if !dir.as_os_str().is_empty() {
+            std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
+        }
+    }
+    std::fs::write(path, text).map_err(|e| io_error(path, &e))
+}
