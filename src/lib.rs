@@ -48,9 +48,12 @@
 //! | [`model`] | the [`Model`]: stepping, runs, energies |
 //! | [`monitor`] | monitors and histories |
 //! | [`build`] | generators (walls, stacks) |
-//! | [`io`] | ParaView series, CSV histories |
+//! | [`io`] | ParaView series, CSV histories, plots, scenes |
+//! | [`analysis`] | joint states and collapse mechanisms |
+//! | [`scenarios`] | reproductions of published tests (the reference arch) |
 #![warn(missing_docs)]
 
+pub mod analysis;
 pub mod block;
 pub mod build;
 pub mod constitutive;
@@ -62,6 +65,7 @@ pub mod io;
 pub mod math;
 pub mod model;
 pub mod monitor;
+pub mod scenarios;
 
 pub use block::{Block, BlockId, RigidBlock};
 pub use constitutive::ConstitutiveLaw;

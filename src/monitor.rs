@@ -197,14 +197,18 @@ mod nullable_columns {
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
     pub fn serialize<S: Serializer>(cols: &[Vec<f64>], s: S) -> Result<S::Ok, S::Error> {
-        let v: Vec<Vec<Option<f64>>> =
-            cols.iter().map(|c| c.iter().map(|x| x.is_finite().then_some(*x)).collect()).collect();
+        let v: Vec<Vec<Option<f64>>> = cols
+            .iter()
+            .map(|c| c.iter().map(|x| x.is_finite().then_some(*x)).collect())
+            .collect();
         v.serialize(s)
     }
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<Vec<f64>>, D::Error> {
         let v: Vec<Vec<Option<f64>>> = Vec::deserialize(d)?;
-        Ok(v.into_iter().map(|c| c.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect()).collect())
+        Ok(v.into_iter()
+            .map(|c| c.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect())
+            .collect())
     }
 }
 

@@ -93,7 +93,11 @@ impl ArchSpec {
     /// Intrados and extrados points `(x, y)` of joint `j` (z = 0).
     pub fn joint_points(&self, j: usize) -> (Vector, Vector) {
         let phi = self.joint_angle(j);
-        let (ri, re, yc) = (self.intrados_radius(), self.intrados_radius() + self.thickness, self.centre_height());
+        let (ri, re, yc) = (
+            self.intrados_radius(),
+            self.intrados_radius() + self.thickness,
+            self.centre_height(),
+        );
         (
             Vector::new(ri * phi.sin(), yc + ri * phi.cos(), 0.0),
             Vector::new(re * phi.sin(), yc + re * phi.cos(), 0.0),
@@ -176,7 +180,10 @@ impl Arch {
         let b = spec.width;
         let pts: Vec<(Vector, Vector)> = (0..=n).map(|j| spec.joint_points(j)).collect();
         let extrude = |outline: &[Vector]| -> Vec<Vector> {
-            outline.iter().flat_map(|p| [Vector::new(p.x, p.y, 0.0), Vector::new(p.x, p.y, b)]).collect()
+            outline
+                .iter()
+                .flat_map(|p| [Vector::new(p.x, p.y, 0.0), Vector::new(p.x, p.y, b)])
+                .collect()
         };
         let mut blocks = Vec::with_capacity(n + 2);
         let abutment = |sign: Real, (i0, e0): (Vector, Vector)| -> Vec<Vector> {
@@ -240,6 +247,23 @@ impl Arch {
         0.5 * (self.joints[k - 1].extrados + self.joints[k].extrados)
     }
 
+    /// The joints as [`crate::analysis::JointRef`]s for the mechanism classifier, assuming the
+    /// blocks were added to an empty model in [`Arch::blocks`] order.
+    pub fn joint_refs(&self) -> Vec<crate::analysis::JointRef> {
+        self.joints
+            .iter()
+            .map(|j| crate::analysis::JointRef {
+                index: j.index,
+                blocks: (
+                    crate::block::BlockId(j.left as u32),
+                    crate::block::BlockId(j.right as u32),
+                ),
+                intrados: j.intrados,
+                extrados: j.extrados,
+            })
+            .collect()
+    }
+
     /// Unit outward normal of the extrados face of voussoir `k`.
     pub fn extrados_normal(&self, k: usize) -> Vector {
         let k = self.voussoir(k);
@@ -269,15 +293,23 @@ mod tests {
             assert!((spec.joint_angle(j).to_degrees() - phi).abs() < 1e-4, "joint {j}");
             let (pi, pe) = spec.joint_points(j);
             // The table has 5 decimals.
-            assert!((pi.x - i.0).abs() < 6e-6 && (pi.y - i.1).abs() < 6e-6, "intrados {j}: {pi}");
-            assert!((pe.x - e.0).abs() < 6e-6 && (pe.y - e.1).abs() < 6e-6, "extrados {j}: {pe}");
+            assert!(
+                (pi.x - i.0).abs() < 6e-6 && (pi.y - i.1).abs() < 6e-6,
+                "intrados {j}: {pi}"
+            );
+            assert!(
+                (pe.x - e.0).abs() < 6e-6 && (pe.y - e.1).abs() < 6e-6,
+                "extrados {j}: {pe}"
+            );
         }
         let arch = Arch::new(&spec).unwrap();
         let v5 = &arch.blocks[arch.voussoir(5)];
         let area = v5.shape().volume() / 0.15;
         assert!((area - 0.026991).abs() < 1e-6, "section {area}");
         assert!((v5.mass_properties().mass - 9.905).abs() < 1e-3);
-        let ring: f64 = (1..=13).map(|k| arch.blocks[arch.voussoir(k)].mass_properties().mass).sum();
+        let ring: f64 = (1..=13)
+            .map(|k| arch.blocks[arch.voussoir(k)].mass_properties().mass)
+            .sum();
         assert!((ring - 128.8).abs() < 0.05, "ring {ring}");
         let p = arch.extrados_midpoint(5);
         assert!((p.x + 0.29967).abs() < 6e-6 && (p.y - 0.54171).abs() < 6e-6, "{p}");

@@ -192,7 +192,13 @@ impl ConstitutiveLaw for CoulombSlip {
     fn validate(&self) -> Result<()> {
         positive("normal_stiffness", self.normal_stiffness)?;
         positive("shear_stiffness", self.shear_stiffness)?;
-        in_range("friction_angle", self.friction_deg, 0.0, 90.0, "must lie in [0, 90) degrees")?;
+        in_range(
+            "friction_angle",
+            self.friction_deg,
+            0.0,
+            90.0,
+            "must lie in [0, 90) degrees",
+        )?;
         in_range(
             "residual_friction_angle",
             self.residual_friction_deg,

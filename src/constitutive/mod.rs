@@ -205,7 +205,10 @@ impl<L: ConstitutiveLaw> JointTable<L> {
 
     pub(crate) fn index_of(&self, a: MaterialId, b: MaterialId) -> Option<u32> {
         let key = (a.min(b), a.max(b));
-        self.index.binary_search_by_key(&key, |e| e.0).ok().map(|k| self.index[k].1)
+        self.index
+            .binary_search_by_key(&key, |e| e.0)
+            .ok()
+            .map(|k| self.index[k].1)
     }
 
     /// The `(material, material, law)` entries, sorted by material pair.

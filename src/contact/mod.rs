@@ -73,6 +73,10 @@ pub struct ContactPair {
     pub(crate) work: Real,
     pub(crate) dashpot_work: Real,
     pub(crate) elastic: Real,
+    /// Sum of the sub-contact areas (m²).
+    pub(crate) area: Real,
+    /// `area` when the critical step was last evaluated (0 for a new contact).
+    pub(crate) bound_area: Real,
 }
 
 impl ContactPair {

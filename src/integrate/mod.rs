@@ -8,7 +8,7 @@ mod time_step;
 
 pub use central_difference::CentralDifference;
 pub use damping::Damping;
-pub use time_step::{critical_time_step, CriticalStep, StiffnessBound, TimeStep};
+pub use time_step::{critical_time_step, CriticalStep, Stiffness6, StiffnessBound, TimeStep};
 
 use crate::block::{RigidBlock, Wrench};
 use crate::math::{Real, Vector};

@@ -10,7 +10,10 @@ use crate::math::Real;
 pub enum TimeStep {
     /// `safety × critical step`, re-evaluated whenever contacts are re-detected.
     Auto {
-        /// Fraction of the critical step, in `(0, 1]`. Default 0.9.
+        /// Fraction of the critical step, in `(0, 1]`. Default 0.5: the bound is exact for a
+        /// block against a fixed support, and close to it central difference is stable but
+        /// distorts the bouncing of contacts that open and close (a sliding block on an
+        /// undamped incline errs by 24 % at 0.9, by < 0.01 % at 0.7 and 0.5).
         safety: Real,
     },
     /// A fixed step (s); an error if it exceeds the critical step.
@@ -19,7 +22,7 @@ pub enum TimeStep {
 
 impl Default for TimeStep {
     fn default() -> Self {
-        TimeStep::Auto { safety: 0.9 }
+        TimeStep::Auto { safety: 0.5 }
     }
 }
 
@@ -72,4 +75,87 @@ pub fn critical_time_step(bounds: &[StiffnessBound], stiffness_damping: Real) ->
         omega_max: w,
         block: BlockId(index as u32),
     })
+}
+
+/// A symmetric 6×6 matrix: the mass-normalised stiffness `M^{-1/2} K M^{-1/2}` of one block
+/// (three translations, three rotations), assembled from rank-one spring terms.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Stiffness6(pub [[Real; 6]; 6]);
+
+impl Stiffness6 {
+    /// Adds `k · j jᵀ`.
+    #[inline]
+    pub fn add_spring(&mut self, j: &[Real; 6], k: Real) {
+        for (r, row) in self.0.iter_mut().enumerate() {
+            let kj = k * j[r];
+            for (c, v) in row.iter_mut().enumerate() {
+                *v += kj * j[c];
+            }
+        }
+    }
+
+    /// Adds another matrix.
+    pub fn add(&mut self, other: &Stiffness6) {
+        for r in 0..6 {
+            for c in 0..6 {
+                self.0[r][c] += other.0[r][c];
+            }
+        }
+    }
+
+    /// An upper bound of the largest eigenvalue, tight to about 1e-6: a few cyclic Jacobi
+    /// rotations (a similarity transform, so the eigenvalues are unchanged) followed by the
+    /// Gershgorin bound of the nearly diagonal result.
+    ///
+    /// ```
+    /// use voussoir::integrate::Stiffness6;
+    /// let mut k = Stiffness6::default();
+    /// k.add_spring(&[1.0, 1.0, 0.0, 0.0, 0.0, 0.0], 2.0); // eigenvalue 2·|j|² = 4
+    /// k.add_spring(&[0.0, 0.0, 0.0, 1.0, 0.0, 0.0], 3.0);
+    /// let l = k.max_eigenvalue();
+    /// assert!(l > 4.0 * (1.0 - 1e-12) && l < 4.0 * (1.0 + 1e-6));
+    /// ```
+    pub fn max_eigenvalue(&self) -> Real {
+        let mut a = self.0;
+        let gershgorin = |a: &[[Real; 6]; 6]| {
+            (0..6)
+                .map(|r| a[r][r] + (0..6).filter(|&c| c != r).map(|c| a[r][c].abs()).sum::<Real>())
+                .fold(Real::NEG_INFINITY, Real::max)
+        };
+        let scale: Real = (0..6).map(|r| a[r][r].abs()).fold(0.0, Real::max);
+        for _sweep in 0..8 {
+            let off: Real = (0..6)
+                .map(|r| (0..6).filter(|&c| c != r).map(|c| a[r][c].abs()).sum::<Real>())
+                .fold(0.0, Real::max);
+            if off <= 1e-7 * scale {
+                break;
+            }
+            for p in 0..6 {
+                for q in p + 1..6 {
+                    if a[p][q].abs() <= 1e-300 {
+                        continue;
+                    }
+                    let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                    let t = if theta == 0.0 {
+                        1.0
+                    } else {
+                        theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt())
+                    };
+                    let c = 1.0 / (t * t + 1.0).sqrt();
+                    let s = t * c;
+                    for row in a.iter_mut() {
+                        let (akp, akq) = (row[p], row[q]);
+                        row[p] = c * akp - s * akq;
+                        row[q] = s * akp + c * akq;
+                    }
+                    let (rp, rq) = (a[p], a[q]);
+                    for k in 0..6 {
+                        a[p][k] = c * rp[k] - s * rq[k];
+                        a[q][k] = s * rp[k] + c * rq[k];
+                    }
+                }
+            }
+        }
+        gershgorin(&a)
+    }
 }

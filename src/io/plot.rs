@@ -124,7 +124,11 @@ impl LinePlot {
             if !lo.is_finite() {
                 return (0.0, 1.0);
             }
-            let pad = if hi > lo { 0.05 * (hi - lo) } else { 0.5 * lo.abs().max(1.0) };
+            let pad = if hi > lo {
+                0.05 * (hi - lo)
+            } else {
+                0.5 * lo.abs().max(1.0)
+            };
             (lo - pad, hi + pad)
         };
         (span(&xs), span(&ys))

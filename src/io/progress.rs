@@ -12,9 +12,9 @@ pub use indicatif::{MultiProgress, ProgressBar};
 /// ```
 pub fn bar(len: u64, message: &str) -> ProgressBar {
     let bar = ProgressBar::new(len);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        "{msg:>24} [{elapsed_precise}] {wide_bar} {percent:>3}% (eta {eta})",
-    ) {
+    if let Ok(style) =
+        indicatif::ProgressStyle::with_template("{msg:>24} [{elapsed_precise}] {wide_bar} {percent:>3}% (eta {eta})")
+    {
         bar.set_style(style);
     }
     bar.set_message(message.to_owned());

@@ -150,7 +150,12 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                 let s = b.state();
                 BlockSpec {
                     name: b.name().to_owned(),
-                    vertices: b.shape().vertices().iter().map(|v| s.pose.transform_point(*v)).collect(),
+                    vertices: b
+                        .shape()
+                        .vertices()
+                        .iter()
+                        .map(|v| s.pose.transform_point(*v))
+                        .collect(),
                     faces: Some(
                         (0..b.shape().faces().len())
                             .map(|f| b.shape().face_loop(f).iter().map(|&i| i as usize).collect())
@@ -194,11 +199,18 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
     /// # Errors
     /// [`Error::Checkpoint`] with the path (for example `blocks[3]`) and the underlying error.
     pub fn build(&self) -> Result<Model<L>> {
-        let at = |path: String| move |e: Error| Error::Checkpoint { path, message: e.to_string() };
+        let at = |path: String| {
+            move |e: Error| Error::Checkpoint {
+                path,
+                message: e.to_string(),
+            }
+        };
         let mut model = Model::new(self.parameters).map_err(at("parameters".into()))?;
         model.set_damping(self.damping).map_err(at("damping".into()))?;
         for (k, j) in self.joints.iter().enumerate() {
-            model.set_joint_law(j.materials[0], j.materials[1], j.law.clone()).map_err(at(format!("joints[{k}].law")))?;
+            model
+                .set_joint_law(j.materials[0], j.materials[1], j.law.clone())
+                .map_err(at(format!("joints[{k}].law")))?;
         }
         for (i, b) in self.blocks.iter().enumerate() {
             let path = format!("blocks[{i}]");
@@ -207,12 +219,17 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                 None => RigidBlock::from_vertices(&b.name, &b.vertices, b.density),
             }
             .map_err(at(path.clone()))?;
-            let block = block.with_material(b.material).with_fixity(b.fixity).with_velocity(b.velocity, b.angular_velocity);
+            let block = block
+                .with_material(b.material)
+                .with_fixity(b.fixity)
+                .with_velocity(b.velocity, b.angular_velocity);
             let id = model.add_block(block).map_err(at(path.clone()))?;
             model.set_load(id, b.load).map_err(at(path))?;
         }
         for (k, m) in self.monitors.iter().enumerate() {
-            model.add_monitor(&m.name, m.monitor).map_err(at(format!("monitors[{k}]")))?;
+            model
+                .add_monitor(&m.name, m.monitor)
+                .map_err(at(format!("monitors[{k}]")))?;
         }
         model.set_monitor_interval(self.monitor_interval);
         Ok(model)

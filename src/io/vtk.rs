@@ -68,7 +68,12 @@ pub fn write_blocks<B: Block>(path: &Path, blocks: &[B], initial: impl Fn(usize)
         let p0 = initial(i);
         let rot = (s.pose.rotation * p0.rotation.inverse()).to_scaled_axis();
         let d = s.pose.translation - p0.translation;
-        let fixed = b.fixity().translation.iter().chain(&b.fixity().rotation).all(|d| d.prescribed().is_some());
+        let fixed = b
+            .fixity()
+            .translation
+            .iter()
+            .chain(&b.fixity().rotation)
+            .all(|d| d.prescribed().is_some());
         let _ = write!(cell.block_id, "{i} ");
         let _ = write!(cell.material, "{} ", b.material().0);
         let _ = write!(cell.displacement, "{:e} {:e} {:e} ", d.x, d.y, d.z);
@@ -153,7 +158,14 @@ pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> R
     let ends: String = (1..=n).map(|i| format!("{i} ")).collect();
     data_array(&mut out, "Int64", "connectivity", 1, &seq, false);
     data_array(&mut out, "Int64", "offsets", 1, &ends, false);
-    data_array(&mut out, "UInt8", "types", 1, &format!("{VTK_VERTEX} ").repeat(n), false);
+    data_array(
+        &mut out,
+        "UInt8",
+        "types",
+        1,
+        &format!("{VTK_VERTEX} ").repeat(n),
+        false,
+    );
     out.push_str("</Cells>\n<PointData Scalars=\"normal_stress\" Vectors=\"shear_force\">\n");
     data_array(&mut out, "Float64", "normal_force", 1, &a.normal_force, false);
     data_array(&mut out, "Float64", "normal_stress", 1, &a.normal_stress, false);
@@ -192,7 +204,11 @@ fn footer(out: &mut String) {
 }
 
 fn data_array(out: &mut String, ty: &str, name: &str, components: usize, values: &str, points: bool) {
-    let name_attr = if points { String::new() } else { format!(" Name=\"{name}\"") };
+    let name_attr = if points {
+        String::new()
+    } else {
+        format!(" Name=\"{name}\"")
+    };
     let _ = writeln!(
         out,
         "<DataArray type=\"{ty}\"{name_attr} NumberOfComponents=\"{components}\" format=\"ascii\">\n{}\n</DataArray>",
@@ -278,7 +294,10 @@ impl Series {
             );
             for (t, b, c) in &self.frames {
                 let file = if pick == 0 { b } else { c };
-                let _ = writeln!(out, "<DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{file}\"/>");
+                let _ = writeln!(
+                    out,
+                    "<DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{file}\"/>"
+                );
             }
             out.push_str("</Collection>\n</VTKFile>\n");
             write_file(&self.dir.join(format!("{}_{suffix}.pvd", self.name)), &out)?;

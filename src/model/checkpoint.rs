@@ -145,7 +145,10 @@ where
                 && p.first as usize == next
                 && snap.sub_pair[p.range()].iter().all(|&q| q as usize == k);
             if !ok || p.range().end > snap.subs.len() {
-                return Err(corrupt(&format!("pairs[{k}]"), "inconsistent block, law or sub-contact indices"));
+                return Err(corrupt(
+                    &format!("pairs[{k}]"),
+                    "inconsistent block, law or sub-contact indices",
+                ));
             }
             next = p.range().end;
         }
@@ -159,7 +162,8 @@ where
         }
         let mut model = Model::new(snap.params)?;
         for (i, mut b) in snap.blocks.into_iter().enumerate() {
-            b.restore().map_err(|e| corrupt(&format!("blocks[{i}]"), &e.to_string()))?;
+            b.restore()
+                .map_err(|e| corrupt(&format!("blocks[{i}]"), &e.to_string()))?;
             model.add_block(b)?;
         }
         model.joints = snap.joints;

@@ -6,8 +6,8 @@ use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus};
 use crate::contact::{ContactPair, DisplacementMode, SubContact};
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, NarrowPhaseScratch, SubcontactSeed};
-use crate::integrate::{critical_time_step, StiffnessBound, TimeStep};
-use crate::math::{Real, Vector};
+use crate::integrate::{critical_time_step, Stiffness6, TimeStep};
+use crate::math::{Real, Rotation, Vector};
 
 /// Buffers reused from one detection to the next.
 #[derive(Debug, Clone)]
@@ -121,6 +121,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     block_b: BlockId(j),
                 })?;
             let host = if dc.host_is_a { bi } else { bj };
+            let bound_area = old.map_or(0.0, |k| self.pairs[k].bound_area);
             let old_subs = old.map(|k| {
                 let p = &self.pairs[k];
                 (p.kind == dc.kind && p.host_is_a == dc.host_is_a).then(|| &self.subs[p.range()])
@@ -180,8 +181,13 @@ impl<L: ConstitutiveLaw> Model<L> {
                 work: 0.0,
                 dashpot_work: 0.0,
                 elastic: 0.0,
+                area: sc.seeds.iter().map(|s| s.area).sum(),
+                bound_area,
             });
         }
+        // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
+        // since the last evaluation (lost contacts only make the step safer).
+        let stiffer = sc.pairs.iter().any(|p| p.area > 1.05 * p.bound_area);
         std::mem::swap(&mut self.pairs, &mut sc.pairs);
         std::mem::swap(&mut self.subs, &mut sc.subs);
         std::mem::swap(&mut self.sub_pair, &mut sc.sub_pair);
@@ -193,7 +199,11 @@ impl<L: ConstitutiveLaw> Model<L> {
         sc.force_full_detection = false;
         self.detections += 1;
         self.rebuild_block_index();
-        self.refresh_time_step()
+        if stiffer || self.critical.is_none() {
+            self.refresh_time_step()
+        } else {
+            Ok(())
+        }
     }
 
     pub(super) fn rebuild_block_index(&mut self) {
@@ -233,6 +243,58 @@ impl<L: ConstitutiveLaw> Model<L> {
         if self.blocks.is_empty() {
             return Ok(());
         }
+        // Mass scaling of each movable block: translations by 1/√m, rotations by R I^{-1/2} Rᵀ.
+        let scaling: Vec<Option<(Real, Rotation, Vector)>> = self
+            .blocks
+            .iter()
+            .map(|b| {
+                (!all_constrained(b)).then(|| {
+                    let mp = b.mass_properties();
+                    (
+                        1.0 / mp.mass.sqrt(),
+                        b.state.pose.rotation,
+                        Vector::ONE / mp.principal_inertia.map(Real::sqrt),
+                    )
+                })
+            })
+            .collect();
+        let n = self.blocks.len();
+        let mut own = vec![Stiffness6::default(); n];
+        let mut coupling = vec![0.0; n];
+        let mut in_contact = vec![false; n];
+        for p in self.pairs.iter_mut() {
+            let subs = &self.subs[p.range()];
+            p.bound_area = p.area;
+            let k = self.joints.laws()[p.law as usize].stiffness();
+            // Area moments of the sub-contact points about the first one (for digits).
+            let origin = subs.first().map_or(Vector::ZERO, |s| s.point);
+            let mut moments = AreaMoments::default();
+            for s in subs {
+                moments.add(s.point - origin, s.area);
+            }
+            let side = |i: usize| -> Option<Stiffness6> {
+                let (inv_sqrt_m, rot, inv_sqrt_i) = scaling[i]?;
+                let centre = self.blocks[i].state.pose.translation - origin;
+                Some(moments.stiffness(centre, p.normal, k.normal, k.shear, inv_sqrt_m, rot, inv_sqrt_i))
+            };
+            let (a, b) = (p.a as usize, p.b as usize);
+            let (ka, kb) = (side(a), side(b));
+            let la = ka.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
+            let lb = kb.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
+            if let Some(m) = ka {
+                own[a].add(&m);
+            }
+            if let Some(m) = kb {
+                own[b].add(&m);
+            }
+            coupling[a] += (la * lb).sqrt();
+            coupling[b] += (la * lb).sqrt();
+            in_contact[a] = true;
+            in_contact[b] = true;
+        }
+        // A block in free flight gets the bound of a contact over its largest face, so that its
+        // step is sensible when it lands (the landing contact is detected before it loads, and
+        // the step is then re-evaluated from the real contacts).
         let k_max = self
             .joints
             .laws()
@@ -242,41 +304,17 @@ impl<L: ConstitutiveLaw> Model<L> {
                 k.normal + 2.0 * k.shear
             })
             .fold(0.0, Real::max);
-        // Compliance of each block at its farthest vertex (0 for blocks that cannot move).
-        let compliance: Vec<Real> = self
-            .blocks
-            .iter()
-            .map(|b| {
-                if all_constrained(b) {
-                    0.0
-                } else {
-                    let mp = b.mass_properties();
-                    let i_min = mp.principal_inertia.min_element();
-                    1.0 / mp.mass + b.shape().radius().powi(2) / i_min
-                }
-            })
-            .collect();
         for (i, b) in self.blocks.iter().enumerate() {
-            let face = b.shape().faces().iter().map(|f| f.area).fold(0.0, Real::max);
-            self.bounds[i] = StiffnessBound {
-                omega_squared: 2.0 * k_max * face * compliance[i],
-            };
-        }
-        let mut from_contacts = vec![0.0; self.blocks.len()];
-        for p in &self.pairs {
-            let k = self.joints.laws()[p.law as usize].stiffness();
-            let k = k.normal + 2.0 * k.shear;
-            let area: Real = self.subs[p.range()].iter().map(|s| s.area).sum();
-            let term = k * area * (compliance[p.a as usize] + compliance[p.b as usize]);
-            from_contacts[p.a as usize] += term;
-            from_contacts[p.b as usize] += term;
-        }
-        for (i, b) in self.blocks.iter().enumerate() {
-            if all_constrained(b) {
-                self.bounds[i].omega_squared = 0.0;
+            self.bounds[i].omega_squared = if all_constrained(b) {
+                0.0
+            } else if in_contact[i] {
+                // Block Gershgorin: λ ≤ λ_max(A_bb) + Σ_c ‖A_bc‖, ‖A_bc‖ ≤ √(λ_b λ_c) per contact.
+                own[i].max_eigenvalue() + coupling[i]
             } else {
-                self.bounds[i].omega_squared = self.bounds[i].omega_squared.max(from_contacts[i]);
-            }
+                let mp = b.mass_properties();
+                let face = b.shape().faces().iter().map(|f| f.area).fold(0.0, Real::max);
+                k_max * face * (1.0 / mp.mass + b.shape().radius().powi(2) / mp.principal_inertia.min_element())
+            };
         }
         let b_damp = self.integrator.damping().stiffness_coefficient();
         self.critical = critical_time_step(&self.bounds, b_damp);
@@ -321,4 +359,139 @@ fn movement(b: &crate::block::RigidBlock, r: &crate::math::Pose) -> Real {
     let dq = s.rotation * r.rotation.inverse();
     let angle = 2.0 * dq.xyz().length().atan2(dq.w.abs());
     (s.translation - r.translation).length() + b.shape().radius() * angle
+}
+
+/// Zeroth, first and second area moments of a contact's sub-contact points: enough to assemble
+/// the contact's 6×6 stiffness on either block exactly, since all its springs share `kn`, `ks`
+/// and the normal.
+#[derive(Debug, Clone, Copy)]
+struct AreaMoments {
+    s0: Real,
+    s1: Vector,
+    s2: crate::math::Matrix,
+}
+
+impl Default for AreaMoments {
+    /// All zero (note: glam's `DMat3::default()` is the identity).
+    fn default() -> Self {
+        Self {
+            s0: 0.0,
+            s1: Vector::ZERO,
+            s2: crate::math::Matrix::ZERO,
+        }
+    }
+}
+
+impl AreaMoments {
+    fn add(&mut self, p: Vector, area: Real) {
+        self.s0 += area;
+        self.s1 += p * area;
+        self.s2 += crate::math::Matrix::from_cols(p * (p.x * area), p * (p.y * area), p * (p.z * area));
+    }
+
+    /// `M^{-1/2} K M^{-1/2}` of the contact's springs acting on a block with centroid `x`:
+    /// with `C = ks·I + (kn − ks)·n nᵀ` per unit area and `r = p − x`,
+    /// `K = Σ A [C, C[r]ᵀ; [r]C, [r] C [r]ᵀ]` (`[r]` the cross-product matrix).
+    #[allow(clippy::too_many_arguments)]
+    fn stiffness(
+        &self,
+        x: Vector,
+        n: Vector,
+        kn: Real,
+        ks: Real,
+        inv_sqrt_m: Real,
+        rot: Rotation,
+        inv_sqrt_i: Vector,
+    ) -> Stiffness6 {
+        use crate::math::Matrix;
+        let c = Matrix::from_diagonal(Vector::splat(ks)) + outer(n, n) * (kn - ks);
+        // Moments about the centroid.
+        let a0 = self.s0;
+        let a1 = self.s1 - x * a0;
+        let a2 = self.s2 - outer(self.s1, x) - outer(x, self.s1) + outer(x, x) * a0;
+        let cross = |v: Vector| {
+            Matrix::from_cols(
+                Vector::new(0.0, v.z, -v.y),
+                Vector::new(-v.z, 0.0, v.x),
+                Vector::new(v.y, -v.x, 0.0),
+            )
+        };
+        let k_tt = c * a0;
+        // Σ A [r] C = [a1] C (linear in r).
+        let k_rt = cross(a1) * c;
+        // Σ A [r] C [r]ᵀ: with [r] = Σ_i r_i E_i, it is Σ_ij (A r_i r_j) E_i C E_jᵀ.
+        let e = [cross(Vector::X), cross(Vector::Y), cross(Vector::Z)];
+        let mut k_rr = Matrix::ZERO;
+        for (i, ei) in e.iter().enumerate() {
+            for (j, ej) in e.iter().enumerate() {
+                k_rr += (*ei * c * ej.transpose()) * a2.col(j)[i];
+            }
+        }
+        // Scale: translations by 1/√m, rotations by S = R diag(I^{-1/2}) Rᵀ.
+        let r = Matrix::from_quat(rot);
+        let s = r * Matrix::from_diagonal(inv_sqrt_i) * r.transpose();
+        let m2 = inv_sqrt_m * inv_sqrt_m;
+        let tt = k_tt * m2;
+        let rt = s * k_rt * inv_sqrt_m;
+        let rr = s * k_rr * s;
+        let mut out = Stiffness6::default();
+        for i in 0..3 {
+            for j in 0..3 {
+                out.0[i][j] = tt.col(j)[i];
+                out.0[3 + i][j] = rt.col(j)[i];
+                out.0[j][3 + i] = rt.col(j)[i];
+                out.0[3 + i][3 + j] = rr.col(j)[i];
+            }
+        }
+        out
+    }
+}
+
+fn outer(a: Vector, b: Vector) -> crate::math::Matrix {
+    crate::math::Matrix::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The moment-based assembly equals the sum of rank-one spring terms.
+    #[test]
+    fn area_moments_assemble_the_spring_stiffness() {
+        let n = Vector::new(0.3, -0.2, 0.9).normalize();
+        let (kn, ks) = (4e9, 1.6e9);
+        let rot = Rotation::from_scaled_axis(Vector::new(0.2, -0.4, 0.7));
+        let (inv_sqrt_m, inv_sqrt_i) = (1.0 / 3.0, Vector::new(2.0, 3.0, 5.0));
+        let x = Vector::new(0.1, 0.5, -0.2);
+        let pts = [
+            (Vector::new(0.3, 0.1, 0.4), 0.01),
+            (Vector::new(-0.2, 0.3, 0.1), 0.02),
+            (Vector::new(0.05, -0.3, 0.2), 0.005),
+        ];
+        let mut m = AreaMoments::default();
+        let mut direct = Stiffness6::default();
+        let (t1, t2) = crate::math::plane_basis(n);
+        let s = crate::math::Matrix::from_quat(rot)
+            * crate::math::Matrix::from_diagonal(inv_sqrt_i)
+            * crate::math::Matrix::from_quat(rot).transpose();
+        for (p, a) in pts {
+            m.add(p, a);
+            for (d, k) in [(n, kn), (t1, ks), (t2, ks)] {
+                let t = d * inv_sqrt_m;
+                let w = s * (p - x).cross(d);
+                direct.add_spring(&[t.x, t.y, t.z, w.x, w.y, w.z], k * a);
+            }
+        }
+        let assembled = m.stiffness(x, n, kn, ks, inv_sqrt_m, rot, inv_sqrt_i);
+        for i in 0..6 {
+            for j in 0..6 {
+                let (u, v) = (assembled.0[i][j], direct.0[i][j]);
+                assert!(
+                    (u - v).abs() <= 1e-9 * direct.0[i][i].abs().max(1.0),
+                    "({i},{j}): {u} vs {v}"
+                );
+            }
+        }
+        assert!((assembled.max_eigenvalue() - direct.max_eigenvalue()).abs() < 1e-6 * direct.max_eigenvalue());
+    }
 }

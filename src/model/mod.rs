@@ -31,7 +31,7 @@ pub struct ModelParameters {
     pub gravity: Vector,
     /// Contact detection and discretisation.
     pub contact: ContactParameters,
-    /// Time step choice. Default automatic at 0.9 of the critical step.
+    /// Time step choice. Default automatic at 0.5 of the critical step.
     pub time_step: TimeStep,
     /// Large (default) or small displacements.
     pub mode: DisplacementMode,

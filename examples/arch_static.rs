@@ -1,0 +1,343 @@
+//! The quasi-static test of the reference arch (Pulatsu, Gonen & Lourenço 2021; `BENCHMARKS.md` §3).
+//!
+//! ```text
+//! cargo run --release --example arch_static                 # baseline + every study, in parallel
+//! cargo run --release --example arch_static -- --baseline-only
+//! cargo run --release --example arch_static -- --out results/static --friction 27,30.5,35
+//! ```
+//!
+//! Writes `summary.json`, `force_displacement.csv`, `force_displacement.svg`,
+//! `capacity_vs_friction.svg` and a ParaView series of the baseline under `out/arch_static/`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde::Serialize;
+use voussoir::contact::DisplacementMode;
+use voussoir::io::plot::{Curve, LinePlot, Reference};
+use voussoir::io::{progress, vtk, write_json};
+use voussoir::scenarios::arch_static::{run, StaticCase, StaticResult};
+
+/// Peak load of the test (kN).
+const EXPERIMENT_PEAK_KN: f64 = 2.71;
+
+struct Options {
+    out: PathBuf,
+    baseline_only: bool,
+    friction: Vec<f64>,
+    sweep: bool,
+}
+
+fn parse() -> Result<Options, String> {
+    let mut o = Options {
+        out: PathBuf::from("out/arch_static"),
+        baseline_only: false,
+        friction: vec![27.0, 30.0, 30.5, 35.0],
+        sweep: true,
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--out" => o.out = args.next().ok_or("--out needs a folder")?.into(),
+            "--baseline-only" => o.baseline_only = true,
+            "--no-sweep" => o.sweep = false,
+            "--friction" => {
+                let list = args.next().ok_or("--friction needs a list such as 27,30.5")?;
+                o.friction = list
+                    .split(',')
+                    .map(|x| x.trim().parse().map_err(|_| format!("bad angle {x:?}")))
+                    .collect::<Result<_, _>>()?;
+            }
+            "-h" | "--help" => {
+                println!("arch_static [--out DIR] [--baseline-only] [--no-sweep] [--friction 27,30,30.5,35]");
+                std::process::exit(0);
+            }
+            other => return Err(format!("unknown argument {other:?} (try --help)")),
+        }
+    }
+    Ok(o)
+}
+
+/// The study cases of the paper, plus the capacity-versus-friction sweep.
+fn cases(o: &Options) -> Vec<StaticCase> {
+    let base = StaticCase::baseline();
+    let mut cases = vec![base.clone()];
+    if o.baseline_only {
+        return cases;
+    }
+    let mut angles: Vec<f64> = o.friction.clone();
+    if o.sweep {
+        angles.extend((25..=40).map(f64::from));
+    }
+    angles.sort_by(f64::total_cmp);
+    angles.dedup();
+    for phi in angles {
+        if phi != base.friction_deg {
+            cases.push(StaticCase {
+                label: format!("friction {phi}°"),
+                friction_deg: phi,
+                ..base.clone()
+            });
+        }
+    }
+    for kn in [2e9, 8e9] {
+        cases.push(StaticCase {
+            label: format!("kn {} GPa/m", kn / 1e9),
+            kn,
+            ks: kn * base.ks / base.kn,
+            ..base.clone()
+        });
+    }
+    for rate in [5e-2, 5e-3] {
+        cases.push(StaticCase {
+            label: format!("rate {rate} m/s"),
+            rate,
+            ..base.clone()
+        });
+    }
+    cases.push(StaticCase {
+        label: "small displacements".into(),
+        mode: DisplacementMode::Small,
+        ..base.clone()
+    });
+    cases.push(StaticCase {
+        label: "width 0.20 m".into(),
+        width: 0.20,
+        ..base.clone()
+    });
+    cases
+}
+
+#[derive(Serialize)]
+struct CaseSummary {
+    label: String,
+    friction_deg: f64,
+    kn_pa_per_m: f64,
+    ks_pa_per_m: f64,
+    rate_m_per_s: f64,
+    mode: &'static str,
+    width_m: f64,
+    peak_load_kn: f64,
+    peak_load_kn_per_m: f64,
+    disp_at_peak_mm: f64,
+    end_disp_mm: f64,
+    end_load_kn: f64,
+    settle_unbalanced_ratio: f64,
+    mechanism: MechanismSummary,
+    steps: u64,
+    dt_s: f64,
+    subcontacts: usize,
+    wall_s: f64,
+}
+
+#[derive(Serialize)]
+struct MechanismSummary {
+    at_peak: voussoir::analysis::Mechanism,
+    at_end: voussoir::analysis::Mechanism,
+}
+
+#[derive(Serialize)]
+struct Summary {
+    experiment: Experiment,
+    adopted: serde_json::Value,
+    cases: Vec<CaseSummary>,
+    total_wall_s: f64,
+}
+
+#[derive(Serialize)]
+struct Experiment {
+    peak_load_kn: f64,
+    source: &'static str,
+}
+
+fn summarise(r: &StaticResult) -> CaseSummary {
+    let c = &r.case;
+    let end = r.curve.last().copied();
+    CaseSummary {
+        label: c.label.clone(),
+        friction_deg: c.friction_deg,
+        kn_pa_per_m: c.kn,
+        ks_pa_per_m: c.ks,
+        rate_m_per_s: c.rate,
+        mode: if c.mode == DisplacementMode::Large {
+            "large"
+        } else {
+            "small"
+        },
+        width_m: c.width,
+        peak_load_kn: r.peak_load / 1e3,
+        peak_load_kn_per_m: r.peak_load / 1e3 / c.width,
+        disp_at_peak_mm: r.displacement_at_peak * 1e3,
+        end_disp_mm: end.map_or(0.0, |s| s.displacement * 1e3),
+        end_load_kn: end.map_or(0.0, |s| s.load / 1e3),
+        settle_unbalanced_ratio: r.settle_ratio,
+        mechanism: MechanismSummary {
+            at_peak: r.mechanism_at_peak.clone(),
+            at_end: r.mechanism_at_end.clone(),
+        },
+        steps: r.steps,
+        dt_s: r.dt,
+        subcontacts: r.subcontacts,
+        wall_s: r.wall_s,
+    }
+}
+
+fn main() {
+    if let Err(e) = try_main() {
+        eprintln!("arch_static: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn try_main() -> Result<(), Box<dyn std::error::Error>> {
+    let o = parse()?;
+    let started = Instant::now();
+    let cases = cases(&o);
+    let base = StaticCase::baseline();
+    println!(
+        "Quasi-static test of the reference arch (Pulatsu et al. 2021), {} cases",
+        cases.len()
+    );
+    println!(
+        "Adopted values (BENCHMARKS.md): width {} m; plate {:.2} m × {} m steel, vertical velocity only",
+        base.width, base.plate_length, base.plate_thickness
+    );
+    println!(
+        "  (free to slide and turn in plane: no horizontal restraint); joints kn {:.1e} Pa/m, ks {:.1e} Pa/m, φ {}°, c = f_t = 0;",
+        base.kn, base.ks, base.friction_deg
+    );
+    println!(
+        "  {} sub-contacts per joint edge; local damping {}; settle to unbalanced ratio {:.0e}; load at {} m/s to {} mm or {}% of peak",
+        base.per_edge,
+        base.local_damping,
+        base.settle_ratio,
+        base.rate,
+        base.max_displacement * 1e3,
+        base.stop_fraction * 100.0
+    );
+    let bar = progress::bar(cases.len() as u64, "cases");
+    let frames_dir = o.out.join("paraview");
+    let results: Vec<StaticResult> = cases
+        .par_iter()
+        .enumerate()
+        .map(|(k, case)| {
+            let result = if k == 0 {
+                let mut series = vtk::Series::new(&frames_dir, "baseline");
+                run(case, Some(5e-4), |m| series.write_frame(m))
+            } else {
+                run(case, None, |_| Ok(()))
+            };
+            bar.inc(1);
+            result
+        })
+        .collect::<Result<_, _>>()?;
+    bar.finish_and_clear();
+
+    println!();
+    println!(
+        "{:<22} {:>9} {:>9} {:>9} {:>7}  {:<34} {:>6}",
+        "case", "peak kN", "kN/m", "at mm", "wall s", "mechanism at peak (i/e = intrados/extrados)", "exp."
+    );
+    for r in &results {
+        println!(
+            "{:<22} {:>9.3} {:>9.2} {:>9.2} {:>7.1}  {:<34} {:>6}",
+            r.case.label,
+            r.peak_load / 1e3,
+            r.peak_load / 1e3 / r.case.width,
+            r.displacement_at_peak * 1e3,
+            r.wall_s,
+            r.mechanism_at_peak.describe(),
+            if r.case.label == "baseline" {
+                format!("{EXPERIMENT_PEAK_KN}")
+            } else {
+                String::new()
+            }
+        );
+    }
+    let b = &results[0];
+    println!(
+        "\nbaseline: model {:.3} kN vs experiment {EXPERIMENT_PEAK_KN} kN ({:+.1} %); settled to unbalanced ratio {:.1e}",
+        b.peak_load / 1e3,
+        (b.peak_load / 1e3 / EXPERIMENT_PEAK_KN - 1.0) * 100.0,
+        b.settle_ratio
+    );
+
+    // Outputs.
+    std::fs::create_dir_all(&o.out)?;
+    let summary = Summary {
+        experiment: Experiment {
+            peak_load_kn: EXPERIMENT_PEAK_KN,
+            source: "Pulatsu, Gonen & Lourenço 2021, Infrastructures 6(12):178",
+        },
+        adopted: serde_json::to_value(&base)?,
+        cases: results.iter().map(summarise).collect(),
+        total_wall_s: started.elapsed().as_secs_f64(),
+    };
+    write_json(&o.out.join("summary.json"), &summary)?;
+    let mut csv = String::from("case,displacement [mm],load [kN],left support dx [mm],right support dx [mm]\n");
+    for r in &results {
+        for s in &r.curve {
+            csv.push_str(&format!(
+                "{},{:e},{:e},{:e},{:e}\n",
+                r.case.label,
+                s.displacement * 1e3,
+                s.load / 1e3,
+                s.left_support_dx * 1e3,
+                s.right_support_dx * 1e3
+            ));
+        }
+    }
+    std::fs::write(o.out.join("force_displacement.csv"), csv)?;
+    let by_friction: Vec<&StaticResult> = results
+        .iter()
+        .filter(|r| {
+            o.friction.contains(&r.case.friction_deg)
+                && (r.case.label == "baseline" || r.case.label.starts_with("friction"))
+        })
+        .collect();
+    LinePlot {
+        title: "Arch under a quarter-span load: load–displacement".into(),
+        x_label: "plate displacement [mm]".into(),
+        y_label: "load [kN]".into(),
+        curves: by_friction
+            .iter()
+            .map(|r| Curve {
+                label: format!("φ = {}°", r.case.friction_deg),
+                points: r.curve.iter().map(|s| (s.displacement * 1e3, s.load / 1e3)).collect(),
+            })
+            .collect(),
+        references: vec![Reference::Horizontal {
+            label: format!("experiment peak {EXPERIMENT_PEAK_KN} kN"),
+            y: EXPERIMENT_PEAK_KN,
+        }],
+    }
+    .write_svg(&o.out.join("force_displacement.svg"))?;
+    let mut sweep: Vec<(f64, f64)> = results
+        .iter()
+        .filter(|r| r.case.label == "baseline" || r.case.label.starts_with("friction"))
+        .map(|r| (r.case.friction_deg, r.peak_load / 1e3))
+        .collect();
+    sweep.sort_by(|a, b| a.0.total_cmp(&b.0));
+    LinePlot {
+        title: "Capacity versus joint friction angle".into(),
+        x_label: "friction angle [°]".into(),
+        y_label: "peak load [kN]".into(),
+        curves: vec![Curve {
+            label: "model".into(),
+            points: sweep,
+        }],
+        references: vec![Reference::Point {
+            label: "experiment (φ = 30.5°)".into(),
+            x: 30.5,
+            y: EXPERIMENT_PEAK_KN,
+        }],
+    }
+    .write_svg(&o.out.join("capacity_vs_friction.svg"))?;
+    println!(
+        "outputs in {} ({:.1} s wall)",
+        o.out.display(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}

@@ -1,0 +1,303 @@
+//! The quasi-static test of the reference arch (`BENCHMARKS.md` §3): a displacement-controlled
+//! vertical load on voussoir 5 through a plate that does not restrain it horizontally.
+//!
+//! Model: the arch of [`ArchSpec::reference`]; a steel plate seated on the extrados of voussoir 5
+//! (footprint 0.10 m along the span, full width), whose **vertical velocity only** is prescribed:
+//! it is free to translate horizontally and to rotate in the plane of the arch (the roller and
+//! bearing of the test), so the load it transmits is vertical. The plate–stone joint has the
+//! stone joint's law. The arch is first settled under gravity with local damping, then the plate
+//! is driven down at the loading rate with local damping on, until the plate has travelled
+//! `max_displacement` or the load has fallen below `stop_fraction` of its peak.
+
+use std::time::Instant;
+
+use serde::{Deserialize, Serialize};
+
+use crate::analysis::{classify_joints, JointRef, JointState, Mechanism, MechanismCriteria};
+use crate::block::{BlockId, Dof, Fixity, RigidBlock};
+use crate::build::arch::{Arch, ArchSpec};
+use crate::constitutive::{CoulombSlip, MaterialId};
+use crate::contact::DisplacementMode;
+use crate::error::Result;
+use crate::geometry::{ContactParameters, SubcontactDensity};
+use crate::integrate::Damping;
+use crate::math::{Pose, Real, Rotation, Vector};
+use crate::model::{Model, ModelParameters};
+
+/// One analysis case. [`StaticCase::baseline`] holds the paper's values.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StaticCase {
+    /// Label for tables and files.
+    pub label: String,
+    /// Joint friction angle (degrees); initial = residual.
+    pub friction_deg: Real,
+    /// Normal joint stiffness (Pa/m).
+    pub kn: Real,
+    /// Shear stiffness (Pa/m).
+    pub ks: Real,
+    /// Plate velocity (m/s, downwards).
+    pub rate: Real,
+    /// Large or small displacements.
+    pub mode: DisplacementMode,
+    /// Out-of-plane width of the arch (m).
+    pub width: Real,
+    /// Sub-contacts per joint edge.
+    pub per_edge: u16,
+    /// Local damping coefficient.
+    pub local_damping: Real,
+    /// Stop when the plate has travelled this far (m).
+    pub max_displacement: Real,
+    /// Stop when the load falls below this fraction of its peak (after the peak).
+    pub stop_fraction: Real,
+    /// Unbalanced-force ratio at which the gravity settling stops.
+    pub settle_ratio: Real,
+    /// Plate footprint along the span (m).
+    pub plate_length: Real,
+    /// Plate thickness (m).
+    pub plate_thickness: Real,
+    /// Plate density (kg/m³, steel).
+    pub plate_density: Real,
+}
+
+impl StaticCase {
+    /// The paper's model: φ = 30.5°, kn = 4 GPa/m, ks = 1.6 GPa/m, 1e-2 m/s, large displacements,
+    /// width 0.15 m (adopted), 15 sub-contacts per edge, local damping 0.8.
+    pub fn baseline() -> Self {
+        Self {
+            label: "baseline".into(),
+            friction_deg: 30.5,
+            kn: 4e9,
+            ks: 1.6e9,
+            rate: 1e-2,
+            mode: DisplacementMode::Large,
+            width: 0.15,
+            per_edge: 15,
+            local_damping: 0.8,
+            max_displacement: 0.012,
+            stop_fraction: 0.5,
+            settle_ratio: 1e-5,
+            plate_length: 0.10,
+            plate_thickness: 0.02,
+            plate_density: 7850.0,
+        }
+    }
+}
+
+/// One sample of the load–displacement curve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Sample {
+    /// Time since loading started (s).
+    pub time: Real,
+    /// Plate displacement (m, downwards positive).
+    pub displacement: Real,
+    /// Vertical load on voussoir 5 (N).
+    pub load: Real,
+    /// Horizontal displacement of voussoir 1 (m, at its extrados midpoint).
+    pub left_support_dx: Real,
+    /// Horizontal displacement of voussoir 13 (m).
+    pub right_support_dx: Real,
+}
+
+/// Result of a case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StaticResult {
+    /// The case.
+    pub case: StaticCase,
+    /// Steps of the gravity settling.
+    pub settle_steps: u64,
+    /// Unbalanced-force ratio reached by the settling.
+    pub settle_ratio: Real,
+    /// Peak load (N).
+    pub peak_load: Real,
+    /// Plate displacement at the peak (m).
+    pub displacement_at_peak: Real,
+    /// The load–displacement curve.
+    pub curve: Vec<Sample>,
+    /// Joint states at the peak and at the end.
+    pub joints_at_peak: Vec<JointState>,
+    /// Joint states at the end.
+    pub joints_at_end: Vec<JointState>,
+    /// Mechanism at the peak.
+    pub mechanism_at_peak: Mechanism,
+    /// Mechanism at the end.
+    pub mechanism_at_end: Mechanism,
+    /// Steps of the loading phase.
+    pub steps: u64,
+    /// Time step (s).
+    pub dt: Real,
+    /// Sub-contacts.
+    pub subcontacts: usize,
+    /// Wall-clock time (s).
+    pub wall_s: Real,
+}
+
+/// The model of a case, with the ids of what it monitors.
+#[derive(Debug)]
+pub struct StaticModel {
+    /// The model, settled or not.
+    pub model: Model,
+    /// The arch.
+    pub arch: Arch,
+    /// The loading plate.
+    pub plate: BlockId,
+    /// Voussoir 5.
+    pub loaded: BlockId,
+    /// Joints of the ring.
+    pub joints: Vec<JointRef>,
+}
+
+const VOUSSOIR: usize = 5;
+
+/// Builds the model of a case (not yet settled).
+///
+/// # Errors
+/// Invalid parameters.
+pub fn build(case: &StaticCase) -> Result<StaticModel> {
+    let arch = Arch::new(&ArchSpec::reference(case.width))?;
+    let params = ModelParameters {
+        gravity: Vector::new(0.0, -9.81, 0.0),
+        contact: ContactParameters {
+            density: SubcontactDensity::PerEdge(case.per_edge),
+            ..ContactParameters::default()
+        },
+        mode: case.mode,
+        ..ModelParameters::default()
+    };
+    let mut model: Model = Model::new(params)?;
+    let stone = MaterialId(0);
+    let steel = MaterialId(1);
+    let law = CoulombSlip::dry(case.kn, case.ks, case.friction_deg)?;
+    model.set_joint_law(stone, stone, law)?;
+    model.set_joint_law(stone, steel, law)?;
+    model.set_damping(Damping::Local {
+        alpha: case.local_damping,
+    })?;
+    for b in &arch.blocks {
+        model.add_block(b.clone())?;
+    }
+    // The plate: a box seated on the extrados of voussoir 5, turned with its slope.
+    let centre = arch.extrados_midpoint(VOUSSOIR);
+    let n = arch.extrados_normal(VOUSSOIR);
+    let slope = (-n.x).atan2(n.y);
+    let half = Vector::new(0.5 * case.plate_length, 0.5 * case.plate_thickness, 0.5 * case.width);
+    let local = RigidBlock::cuboid("loading plate", -half, half, case.plate_density)?;
+    let pose = Pose::from_parts(
+        Vector::new(centre.x, centre.y, 0.5 * case.width) + n * (0.5 * case.plate_thickness),
+        Rotation::from_rotation_z(slope),
+    );
+    let plate = model.add_block(
+        local
+            .transformed(pose)
+            .with_material(steel)
+            .with_fixity(plate_fixity(0.0)),
+    )?;
+    let joints = arch.joint_refs();
+    Ok(StaticModel {
+        model,
+        arch,
+        plate,
+        loaded: BlockId(VOUSSOIR as u32),
+        joints,
+    })
+}
+
+/// Only the vertical velocity of the plate is prescribed; it may slide horizontally and turn in
+/// the plane of the arch; out-of-plane motions are fixed.
+fn plate_fixity(vy: Real) -> Fixity {
+    Fixity {
+        translation: [Dof::Free, Dof::Velocity(vy), Dof::Fixed],
+        rotation: [Dof::Fixed, Dof::Fixed, Dof::Free],
+    }
+}
+
+/// Runs a case; `on_frame` is called with the model every `frame_every` metres of plate travel
+/// (and at the start and end of loading), for ParaView frames.
+///
+/// # Errors
+/// Divergence or settling failure.
+pub fn run(
+    case: &StaticCase,
+    frame_every: Option<Real>,
+    mut on_frame: impl FnMut(&Model) -> Result<()>,
+) -> Result<StaticResult> {
+    let started = Instant::now();
+    let StaticModel {
+        mut model,
+        arch,
+        plate,
+        loaded,
+        joints,
+    } = build(case)?;
+    let settle_steps = model.run_to_equilibrium(case.settle_ratio, 200_000)?;
+    let settle_ratio = model.unbalanced_force_ratio();
+    model.set_fixity(plate, plate_fixity(-case.rate))?;
+    let criteria = MechanismCriteria::default();
+    let left = arch.extrados_midpoint(1);
+    let right = arch.extrados_midpoint(arch.spec.voussoirs);
+    let (left_id, right_id) = (BlockId(1), BlockId(arch.spec.voussoirs as u32));
+    let sample_every = ((2e-5 / case.rate) / model.dt()).ceil().max(1.0) as u64;
+    let t0 = model.time();
+    let step0 = model.step_count();
+    let mut curve = Vec::new();
+    let mut peak = (0.0, 0.0);
+    let mut at_peak = classify_joints(&model, &joints, &criteria);
+    let mut next_frame = 0.0;
+    loop {
+        model.run_steps(sample_every)?;
+        let t = model.time() - t0;
+        let displacement = case.rate * t;
+        // The resultant acts on the plate (the higher id); the load on the arch is its opposite
+        // reaction, i.e. the upward force on the plate.
+        let load = model
+            .contact_between(plate, loaded)
+            .map(|c| c.pair.resultant().y)
+            .unwrap_or(0.0);
+        let sample = Sample {
+            time: t,
+            displacement,
+            load,
+            left_support_dx: model.blocks()[left_id.index()].displacement_of(left).x,
+            right_support_dx: model.blocks()[right_id.index()].displacement_of(right).x,
+        };
+        curve.push(sample);
+        if load > peak.0 {
+            peak = (load, displacement);
+            at_peak = classify_joints(&model, &joints, &criteria);
+        }
+        if let Some(every) = frame_every {
+            if displacement >= next_frame {
+                on_frame(&model)?;
+                next_frame += every;
+            }
+        }
+        let fallen = peak.0 > 0.0 && load < case.stop_fraction * peak.0 && displacement > peak.1;
+        if displacement >= case.max_displacement || fallen {
+            break;
+        }
+    }
+    if frame_every.is_some() {
+        on_frame(&model)?;
+    }
+    let at_end = classify_joints(&model, &joints, &criteria);
+    Ok(StaticResult {
+        case: case.clone(),
+        settle_steps,
+        settle_ratio,
+        peak_load: peak.0,
+        displacement_at_peak: peak.1,
+        curve,
+        joints_at_peak: at_peak.0,
+        joints_at_end: at_end.0,
+        mechanism_at_peak: at_peak.1,
+        mechanism_at_end: at_end.1,
+        steps: model.step_count() - step0,
+        dt: model.dt(),
+        subcontacts: model.subcontact_count(),
+        wall_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// Convenience for callers that want the block of the plate by name.
+pub fn plate_mass(case: &StaticCase) -> Real {
+    case.plate_length * case.plate_thickness * case.width * case.plate_density
+}

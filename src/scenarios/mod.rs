@@ -1,0 +1,4 @@
+//! Ready-made reproductions of published tests, shared by the examples and the integration
+//! tests: the quasi-static load test of the reference arch (Pulatsu, Gonen & Lourenço 2021).
+
+pub mod arch_static;
