@@ -7,7 +7,7 @@
 //!
 //! * the equilibrium residual: `run_to_equilibrium(EQ_RATIO, ..)` stops once the largest
 //!   out-of-balance force on a free block is below `EQ_RATIO` × the mean contact force;
-//! * the discretisation of a joint into a grid of sub-contacts (mid-point quadrature of the joint
+//! * the discretisation of a joint into a grid of sub-contacts (trapezoidal quadrature of the joint
 //!   stresses), which is exact for uniform stress and has a known error for linear stress.
 //!
 //! Closed forms are written out from the geometry and the loads; nothing is read back from a
@@ -317,21 +317,23 @@ fn eccentric(e: f64) -> Eccentric {
 /// below 1e-4 L) is the horizontal shift of the joint centre under the block's small rigid
 /// rotation θ; the load is applied about the current centroid.
 ///
-/// Tolerance: on an `n × n` grid of cell-centred sub-contacts the second moment of area is the
-/// mid-point sum `A·L²/12·(1 − 1/n²)`, so the discrete solution has the slope of σ larger by
-/// `1/(n² − 1)`, an error at most `N/A·6·e/L/(n² − 1)` at the edge cells (6.3e-4 N/A at n = 40, e
-/// near L/6). To that bound we add the equilibrium residual: a resultant off by `δ` tilts the
+/// Tolerance: sub-contacts sit on the nodes of an `n × n` grid, the outer ones on the joint edges,
+/// each carrying its tributary area (trapezoidal rule), so the discrete second moment of area is
+/// `A·L²/12·(1 + 2/(n − 1)²)`. The discrete solution then has the slope of σ smaller by the factor
+/// `δ = (2/(n−1)²)/(1 + 2/(n−1)²)`, an error at most `N/A·6·e/L·δ` at the edges (1.3e-3 N/A at
+/// n = 40, e near L/6). To that bound we add the equilibrium residual: a resultant off by `δ` tilts the
 /// stresses by at most `N/A·6·δ/L`, and the resultant is checked to within `δ = 1e-6 L` (see the
 /// beyond-kern test), hence `+ 6e-6 N/A`.
 #[test]
 fn eccentric_load_inside_the_kern_gives_linear_stresses() {
-    let n2 = f64::from(N_GRID).powi(2);
+    let gaps = (f64::from(N_GRID) - 1.0).powi(2);
+    let delta = (2.0 / gaps) / (1.0 + 2.0 / gaps);
     for e in [L / 12.0, L / 8.0] {
         let r = eccentric(e);
         assert!(r.s.abs() < 1e-4 * L, "joint-centre shift {} is not small", r.s);
         let ej = r.e - r.s;
         let mean = r.n_total / (L * B);
-        let tol = mean * (6.0 * ej / L / (n2 - 1.0) + 6.0 * 1e-6);
+        let tol = mean * (6.0 * ej / L * delta + 6.0 * 1e-6);
         let mut worst: f64 = 0.0;
         for &(x, sigma, _) in &r.subs {
             let closed = mean * (1.0 + 12.0 * ej * x / (L * L));

@@ -337,21 +337,37 @@ fn face_face(
 
     let (lo, hi) = bounds(&scratch.host);
     let size = hi - lo;
+    // Sub-contacts sit at the nodes of an nu × nv grid over the host face's bounding rectangle,
+    // the outer nodes on its boundary (trapezoidal rule), so that a joint opening about an edge
+    // hinges on that edge. Each node carries the overlap within its tributary cell.
     let (nu, nv) = match params.density {
         SubcontactDensity::PerEdge(k) => (k as u32, k as u32),
-        SubcontactDensity::Spacing(h) => (((size.x / h).ceil() as u32).max(1), ((size.y / h).ceil() as u32).max(1)),
+        SubcontactDensity::Spacing(h) => (
+            ((size.x / h).ceil() as u32).max(1) + 1,
+            ((size.y / h).ceil() as u32).max(1) + 1,
+        ),
     };
-    let cell = DVec2::new(size.x / nu as Real, size.y / nv as Real);
+    let spacing = |n: u32, len: Real| if n > 1 { len / (n - 1) as Real } else { len };
+    let cell = DVec2::new(spacing(nu, size.x), spacing(nv, size.y));
+    let first = lo + DVec2::new(
+        if nu > 1 { 0.0 } else { 0.5 * size.x },
+        if nv > 1 { 0.0 } else { 0.5 * size.y },
+    );
     let (olo, ohi) = bounds(&scratch.other);
-    let i0 = (((olo.x - lo.x) / cell.x).floor().max(0.0) as u32).min(nu - 1);
-    let i1 = (((ohi.x - lo.x) / cell.x).ceil().max(1.0) as u32).min(nu);
-    let j0 = (((olo.y - lo.y) / cell.y).floor().max(0.0) as u32).min(nv - 1);
-    let j1 = (((ohi.y - lo.y) / cell.y).ceil().max(1.0) as u32).min(nv);
+    let range = |o0: Real, o1: Real, f: Real, c: Real, n: u32| {
+        let i0 = ((o0 - f) / c - 0.5).ceil().max(0.0) as u32;
+        let i1 = (((o1 - f) / c + 0.5).floor().max(0.0) as u32).min(n - 1);
+        (i0.min(n - 1), i1)
+    };
+    let (i0, i1) = range(olo.x, ohi.x, first.x, cell.x, nu);
+    let (j0, j1) = range(olo.y, ohi.y, first.y, cell.y, nv);
     let min_area = 1e-9 * cell.x * cell.y;
-    for i in i0..i1 {
-        for j in j0..j1 {
-            let clo = lo + cell * DVec2::new(i as Real, j as Real);
-            let chi = clo + cell;
+    let inside_tol = 1e-9 * size.length();
+    for i in i0..=i1 {
+        for j in j0..=j1 {
+            let node = first + cell * DVec2::new(i as Real, j as Real);
+            let clo = node - 0.5 * cell;
+            let chi = node + 0.5 * cell;
             scratch.cell.clear();
             scratch.cell.extend_from_slice(&scratch.other);
             clip_rect(&mut scratch.cell, clo, chi, &mut scratch.tmp);
@@ -363,11 +379,18 @@ fn face_face(
                 } else {
                     SubKey::cell(fo32, fh32, i, j)
                 };
+                // The node if the overlap covers it, else the centroid of its share of the overlap.
+                let poly = &scratch.other;
+                let covered = (0..poly.len()).all(|k| {
+                    let (p, q) = (poly[k], poly[(k + 1) % poly.len()]);
+                    (q - p).perp_dot(node - p) >= -inside_tol * (q - p).length()
+                });
+                let at = if covered { node } else { centroid };
                 seeds.push(SubcontactSeed {
                     key,
-                    anchor: origin + u * centroid.x + v * centroid.y,
+                    anchor: origin + u * at.x + v * at.y,
                     area,
-                    gap: gap_at(centroid),
+                    gap: gap_at(at),
                 });
             }
         }
@@ -585,9 +608,18 @@ fn hull2d(pts: &[DVec2]) -> Vec<DVec2> {
         return p;
     }
     let cross = |o: DVec2, a: DVec2, b: DVec2| (a - o).perp_dot(b - o);
+    let tol = eps * (hi - lo).length();
     let mut h: Vec<DVec2> = Vec::with_capacity(2 * p.len());
-    for &q in p.iter().chain(p.iter().rev().skip(1)) {
-        while h.len() >= 2 && cross(h[h.len() - 2], h[h.len() - 1], q) <= eps * (hi - lo).length() {
+    // Lower hull, then upper hull; the upper pass must never pop points of the lower hull.
+    for &q in &p {
+        while h.len() >= 2 && cross(h[h.len() - 2], h[h.len() - 1], q) <= tol {
+            h.pop();
+        }
+        h.push(q);
+    }
+    let lower = h.len() + 1;
+    for &q in p.iter().rev().skip(1) {
+        while h.len() >= lower && cross(h[h.len() - 2], h[h.len() - 1], q) <= tol {
             h.pop();
         }
         h.push(q);

@@ -10,7 +10,8 @@ use crate::math::{Real, Rotation, Vector};
 ///
 /// Translation: `v⁺ = [(1 − a·Δt/2)·v⁻ + Δt·F/m] / (1 + a·Δt/2)`.
 /// Rotation is integrated on the angular momentum `L` (world frame), which carries the gyroscopic
-/// term exactly: `L⁺ = [(1 − a·Δt/2)·L⁻ + Δt·M] / (1 + a·Δt/2)`, `ω⁺ = R·I⁻¹·Rᵀ·L⁺`, then
+/// term exactly: `L⁺ = [(1 − a·Δt/2)·L⁻ + Δt·M] / (1 + a·Δt/2)`, `ω⁺ = R'·I⁻¹·R'ᵀ·L⁺` with the
+/// mid-step rotation `R' = exp(ω⁺·Δt/2)·R`, then
 /// `R ← exp(ω⁺·Δt)·R`. With no moment, `L` is conserved to round-off. `a` is the Rayleigh mass
 /// coefficient; local damping modifies `F` and `M` per component before the update.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -95,7 +96,16 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
     // Rotation.
     let m = local_damp(load.moment, s0.angular_velocity, alpha, &fixity.rotation);
     let mut l = (s0.angular_momentum * c1 + m * dt) * c2;
+    // ω(t+Δt/2) = R(t+Δt/2)·I⁻¹·R(t+Δt/2)ᵀ·L(t+Δt/2), with R(t+Δt/2) = exp(ω·Δt/2)·R(t): solved by
+    // fixed-point iteration (contraction ~ |ω|Δt/2). Evaluating at R(t) instead makes the
+    // rotation update first order and pumps energy into a free asymmetric spinner.
+    let inertia = block.mass_properties().principal_inertia;
+    let r0 = s0.pose.rotation;
+    let inv_inertia_at = |r: Rotation, l: Vector| r * ((r.inverse() * l) / inertia);
     let mut w = block.world_inverse_inertia_times(l);
+    for _ in 0..3 {
+        w = inv_inertia_at(Rotation::from_scaled_axis(0.5 * dt * w) * r0, l);
+    }
     let mut constrained = false;
     for i in 0..3 {
         if let Some(p) = fixity.rotation[i].prescribed() {
