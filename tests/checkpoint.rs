@@ -15,7 +15,11 @@ fn moving_wall() -> Result<Model> {
         ..ModelParameters::default()
     };
     let mut model: Model = Model::new(params)?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::new(1e9, 4e8, 25.0, 20.0, 2e3, 1e3)?)?;
+    model.set_joint_law(
+        MaterialId(0),
+        MaterialId(0),
+        CoulombSlip::new(1e9, 4e8, 25.0, 20.0, 2e3, 1e3)?,
+    )?;
     model.set_damping(Damping::rayleigh_stiffness(0.02, 50.0)?)?;
     for b in running_bond_wall(&WallSpec {
         bricks_per_course: 4,
@@ -68,8 +72,14 @@ fn restarted_run_is_bit_identical() -> Result<()> {
     let detections = model.detection_count();
     model.run_steps(3000)?;
     restarted.run_steps(3000)?;
-    assert!(model.detection_count() > detections, "the test must cross re-detections");
-    assert!(model.contacts().flat_map(|c| c.subs).any(|s| s.slip() > 0.0), "the test must include slip");
+    assert!(
+        model.detection_count() > detections,
+        "the test must cross re-detections"
+    );
+    assert!(
+        model.contacts().flat_map(|c| c.subs).any(|s| s.slip() > 0.0),
+        "the test must include slip"
+    );
     assert_eq!(state_bits(&model), state_bits(&restarted));
     assert_eq!(model.history(), restarted.history());
     std::fs::remove_dir_all(&dir).ok();
@@ -95,10 +105,12 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     let bad_law = text.replacen("\"friction_deg\":25.0", "\"friction_deg\":95.0", 1);
     assert_ne!(bad_law, text);
     let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_law).expect_err("bad friction");
-    assert!(err.to_string().contains("joints.laws[0]") && err.to_string().contains("friction"), "{err}");
+    assert!(
+        err.to_string().contains("joints.laws[0]") && err.to_string().contains("friction"),
+        "{err}"
+    );
     // A missing file.
     let err = Model::<CoulombSlip>::load_checkpoint(std::path::Path::new("/nonexistent/x.json")).expect_err("missing");
     assert!(matches!(err, Error::Io { .. }), "{err}");
     Ok(())
 }
-

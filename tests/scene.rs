@@ -20,7 +20,10 @@ fn documented_example_builds_and_reaches_equilibrium() -> Result<()> {
     let weight = 2446.5 * 0.008 * 9.81;
     // (The base's own reaction also carries the base's weight: use the joint force instead.)
     let support = -model.contact_wrench(BlockId(0))?.force.z;
-    assert!((support - weight).abs() < 1e-4 * weight, "support {support} vs weight {weight}");
+    assert!(
+        (support - weight).abs() < 1e-4 * weight,
+        "support {support} vs weight {weight}"
+    );
     assert_eq!(model.history().names(), ["stone x", "support z"]);
     Ok(())
 }
@@ -48,13 +51,25 @@ fn bad_fields_are_reported_with_their_path() -> Result<()> {
         .expect("example file");
     let cases = [
         // (replace, with, expected fragment of the message)
-        ("\"density\": 2446.5,\n      \"load\"", "\"density\": \"heavy\",\n      \"load\"", "blocks[1].density"),
-        ("\"density\": 2446.5,\n      \"load\"", "\"density\": -1.0,\n      \"load\"", "blocks[1]"),
+        (
+            "\"density\": 2446.5,\n      \"load\"",
+            "\"density\": \"heavy\",\n      \"load\"",
+            "blocks[1].density",
+        ),
+        (
+            "\"density\": 2446.5,\n      \"load\"",
+            "\"density\": -1.0,\n      \"load\"",
+            "blocks[1]",
+        ),
         ("\"friction_deg\": 30.5", "\"friction_deg\": 95.0", "joints[0].law"),
         ("\"tolerance\": 0.001", "\"tolerance\": -0.001", "parameters"),
         ("\"alpha\": 0.8", "\"alpha\": 1.5", "damping"),
         ("\"block\": 1,", "\"block\": 7,", "monitors[0]"),
-        ("\"monitor_interval\": 10", "\"monitor_interval\": 10, \"colour\": 3", "colour"),
+        (
+            "\"monitor_interval\": 10",
+            "\"monitor_interval\": 10, \"colour\": 3",
+            "colour",
+        ),
         (
             "[-0.1, -0.1, 0.2], [0.1, -0.1, 0.2], [0.1, 0.1, 0.2], [-0.1, 0.1, 0.2]",
             "[-0.1, -0.1, 0.0], [0.1, -0.1, 0.0], [0.1, 0.1, 0.0], [-0.1, 0.1, 0.0]",
@@ -64,7 +79,9 @@ fn bad_fields_are_reported_with_their_path() -> Result<()> {
     for (from, to, expected) in cases {
         let bad = text.replacen(from, to, 1);
         assert_ne!(bad, text, "test case {from:?} does not apply");
-        let err = Scene::<CoulombSlip>::from_json(&bad).and_then(|s| s.build()).expect_err(expected);
+        let err = Scene::<CoulombSlip>::from_json(&bad)
+            .and_then(|s| s.build())
+            .expect_err(expected);
         assert!(err.to_string().contains(expected), "{expected:?} not in {err}");
     }
     Ok(())

@@ -15,8 +15,13 @@ fn vtu_frames_are_read_back_by_vtk() -> Result<()> {
     let mut model: Model = Model::new(ModelParameters::default())?;
     model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
     model.add_block(
-        RigidBlock::cuboid("base", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), 2000.0)?
-            .with_fixity(Fixity::FIXED),
+        RigidBlock::cuboid(
+            "base",
+            Vector::new(-1.0, -1.0, -0.2),
+            Vector::new(1.0, 1.0, 0.0),
+            2000.0,
+        )?
+        .with_fixity(Fixity::FIXED),
     )?;
     // A hexagonal prism (8 faces, hexagons with 6 vertices) and a wedge.
     let hex: Vec<Vector> = (0..12)
