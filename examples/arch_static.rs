@@ -242,7 +242,11 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         "case", "peak kN", "raw kN", "kN/m", "at mm", "wall s", "mechanism at peak (i/e = intrados/extrados)", "exp."
     );
     for r in &results {
-        let exp = if r.case.label == "baseline" { format!("{EXPERIMENT_PEAK_KN}") } else { String::new() };
+        let exp = if r.case.label == "baseline" {
+            format!("{EXPERIMENT_PEAK_KN}")
+        } else {
+            String::new()
+        };
         println!(
             "{:<22} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>7.1}  {:<44} {:>5}",
             r.case.label,
@@ -276,7 +280,9 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         total_wall_s: started.elapsed().as_secs_f64(),
     };
     write_json(&o.out.join("summary.json"), &summary)?;
-    let mut csv = String::from("case,displacement [mm],load [kN],load 1 mm average [kN],left support dx [mm],right support dx [mm]\n");
+    let mut csv = String::from(
+        "case,displacement [mm],load [kN],load 1 mm average [kN],left support dx [mm],right support dx [mm]\n",
+    );
     for r in &results {
         for s in &r.curve {
             csv.push_str(&format!(
@@ -306,11 +312,19 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             .iter()
             .map(|r| Curve {
                 label: format!("φ = {}° (1 mm average)", r.case.friction_deg),
-                points: r.curve.iter().map(|s| (s.displacement * 1e3, s.smoothed_load / 1e3)).collect(),
+                points: r
+                    .curve
+                    .iter()
+                    .map(|s| (s.displacement * 1e3, s.smoothed_load / 1e3))
+                    .collect(),
             })
             .chain(std::iter::once(Curve {
                 label: "φ = 30.5°, raw".into(),
-                points: results[0].curve.iter().map(|s| (s.displacement * 1e3, s.load / 1e3)).collect(),
+                points: results[0]
+                    .curve
+                    .iter()
+                    .map(|s| (s.displacement * 1e3, s.load / 1e3))
+                    .collect(),
             }))
             .collect(),
         references: vec![Reference::Horizontal {

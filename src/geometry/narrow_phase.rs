@@ -349,10 +349,11 @@ fn face_face(
     };
     let spacing = |n: u32, len: Real| if n > 1 { len / (n - 1) as Real } else { len };
     let cell = DVec2::new(spacing(nu, size.x), spacing(nv, size.y));
-    let first = lo + DVec2::new(
-        if nu > 1 { 0.0 } else { 0.5 * size.x },
-        if nv > 1 { 0.0 } else { 0.5 * size.y },
-    );
+    let first = lo
+        + DVec2::new(
+            if nu > 1 { 0.0 } else { 0.5 * size.x },
+            if nv > 1 { 0.0 } else { 0.5 * size.y },
+        );
     let (olo, ohi) = bounds(&scratch.other);
     let range = |o0: Real, o1: Real, f: Real, c: Real, n: u32| {
         let i0 = ((o0 - f) / c - 0.5).ceil().max(0.0) as u32;

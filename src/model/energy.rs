@@ -16,7 +16,7 @@ use crate::math::Real;
 pub struct Energies {
     /// Kinetic energy (J).
     pub kinetic: Real,
-    /// Kinetic energy before the first step (J).
+    /// Kinetic energy before the first step, plus any given later with [`crate::Model::set_velocity`] (J).
     pub initial_kinetic: Real,
     /// Elastic energy in the joint springs (J).
     pub elastic: Real,

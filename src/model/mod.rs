@@ -260,7 +260,8 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.refresh_time_step()
     }
 
-    /// Sets a block's velocity (m/s) and angular velocity (rad/s).
+    /// Sets a block's velocity (m/s) and angular velocity (rad/s). During a run, the change of
+    /// kinetic energy counts as energy put in ([`Energies::initial_kinetic`]).
     ///
     /// # Errors
     /// [`Error::UnknownBlock`], [`Error::NonFinite`].
@@ -271,7 +272,14 @@ impl<L: ConstitutiveLaw> Model<L> {
             });
         }
         let b = self.block_mut(id)?;
+        let before = b.kinetic_energy();
         *b = b.clone().with_velocity(velocity, angular_velocity);
+        let after = b.kinetic_energy();
+        // Kinetic energy given by the user counts as energy put in.
+        if self.started {
+            self.energy.initial_kinetic += after - before;
+            self.energy.kinetic += after - before;
+        }
         Ok(())
     }
 

@@ -269,7 +269,10 @@ pub fn run(
             .unwrap_or(0.0);
         window.push_back((displacement, load));
         window_sum += load;
-        while window.front().is_some_and(|&(d, _)| d < displacement - case.smoothing_window) {
+        while window
+            .front()
+            .is_some_and(|&(d, _)| d < displacement - case.smoothing_window)
+        {
             window_sum -= window.pop_front().map_or(0.0, |w| w.1);
         }
         let smoothed_load = window_sum / window.len() as Real;
