@@ -8,15 +8,27 @@ fn impact_energy_momentum_and_outcomes() {
     let all = setups();
     let pick = |name: &str| ImpactCase::baseline(all.iter().find(|s| s.name == name).expect("setup").clone());
     let cases = [pick("M80H45"), pick("M60H20")];
-    let r: Vec<ImpactResult> = cases.par_iter().map(|c| run(c, None, |_| Ok(())).expect("run")).collect();
+    let r: Vec<ImpactResult> = cases
+        .par_iter()
+        .map(|c| run(c, None, |_| Ok(())).expect("run"))
+        .collect();
     for x in &r {
         let case = &x.case;
         // Just before impact: the impactor left the release point at √(2gH) and fell the release
         // gap, so at first contact its speed is √(2g(H + gap)); momentum and energy follow.
         let g = 9.81;
         let expected = (2.0 * g * (case.setup.height + case.release_gap)).sqrt();
-        let hit = x.samples.iter().find(|s| s.impact_force > 0.0).expect("the impactor hits");
-        let before = x.samples.iter().take_while(|s| s.impact_force <= 0.0).last().map_or(x.v0, |s| -s.impactor_velocity);
+        let hit = x
+            .samples
+            .iter()
+            .find(|s| s.impact_force > 0.0)
+            .expect("the impactor hits");
+        let before = x
+            .samples
+            .iter()
+            .take_while(|s| s.impact_force <= 0.0)
+            .last()
+            .map_or(x.v0, |s| -s.impactor_velocity);
         println!(
             "{}: speed before impact {before:.4} m/s vs √(2g(H+gap)) {expected:.4}; first contact at {:.4} s; \
              momentum {:.2} kg·m/s; energy {:.1} J; max disp {:.1} mm; collapsed {}; energy excess {:.3} J",
@@ -41,5 +53,8 @@ fn impact_energy_momentum_and_outcomes() {
         );
     }
     assert!(r[0].collapsed, "the heaviest drop (M80H45) must bring the arch down");
-    assert!(!r[1].collapsed, "the lightest drop (M60H20) must leave the arch standing");
+    assert!(
+        !r[1].collapsed,
+        "the lightest drop (M60H20) must leave the arch standing"
+    );
 }

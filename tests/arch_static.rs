@@ -27,7 +27,10 @@ fn static_arch_behaves_like_an_arch() {
         case("small", |c| c.mode = DisplacementMode::Small),
         case("slow", |c| c.rate = 5e-3),
     ];
-    let r: Vec<StaticResult> = cases.par_iter().map(|c| run(c, None, |_| Ok(())).expect("run")).collect();
+    let r: Vec<StaticResult> = cases
+        .par_iter()
+        .map(|c| run(c, None, |_| Ok(())).expect("run"))
+        .collect();
     for x in &r {
         println!(
             "{:>6}: peak {:.3} kN at {:.2} mm (raw {:.3}); at peak {}; end load {:.3} kN",
@@ -43,20 +46,47 @@ fn static_arch_behaves_like_an_arch() {
     // The load rises from zero to a peak at a small displacement: the arch is stiff before the
     // mechanism forms.
     for x in &r {
-        assert!(x.curve[0].load < 0.2 * x.peak_load, "{}: load starts at {}", x.case.label, x.curve[0].load);
-        assert!(x.displacement_at_peak < 5e-3, "{}: peak at {} m", x.case.label, x.displacement_at_peak);
+        assert!(
+            x.curve[0].load < 0.2 * x.peak_load,
+            "{}: load starts at {}",
+            x.case.label,
+            x.curve[0].load
+        );
+        assert!(
+            x.displacement_at_peak < 5e-3,
+            "{}: peak at {} m",
+            x.case.label,
+            x.displacement_at_peak
+        );
     }
     // With hinges only (35°), the four-hinge mechanism softens: the load falls after the peak.
     let end35 = r[2].curve.last().expect("samples").smoothed_load;
-    assert!(end35 < 0.9 * p35, "35°: end load {end35} not below 90 % of the peak {p35}");
+    assert!(
+        end35 < 0.9 * p35,
+        "35°: end load {end35} not below 90 % of the peak {p35}"
+    );
     // Capacity grows with the friction angle.
     assert!(p27 < p305 && p305 < p35, "peaks {p27} {p305} {p35}");
     // At 27° a joint slides at the peak (the paper: pure sliding).
-    assert!(!r[0].mechanism_at_peak.sliding_joints.is_empty(), "27°: {}", r[0].mechanism_at_peak.describe());
+    assert!(
+        !r[0].mechanism_at_peak.sliding_joints.is_empty(),
+        "27°: {}",
+        r[0].mechanism_at_peak.describe()
+    );
     // Small and large displacements give close peaks (the peak is at ~1 mm, where geometry has
     // barely changed): within 10 %.
-    assert!((r[3].peak_load / p305 - 1.0).abs() < 0.10, "small {} vs large {}", r[3].peak_load, p305);
+    assert!(
+        (r[3].peak_load / p305 - 1.0).abs() < 0.10,
+        "small {} vs large {}",
+        r[3].peak_load,
+        p305
+    );
     // Halving the rate from 1e-2 to 5e-3 m/s changes the quasi-static peak by less than 10 %
     // (measured: 3 %); the inertial oscillation is what remains.
-    assert!((r[4].peak_load / p305 - 1.0).abs() < 0.10, "slow {} vs {}", r[4].peak_load, p305);
+    assert!(
+        (r[4].peak_load / p305 - 1.0).abs() < 0.10,
+        "slow {} vs {}",
+        r[4].peak_load,
+        p305
+    );
 }

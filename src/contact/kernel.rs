@@ -112,7 +112,8 @@ pub(crate) fn update_subcontact<L: ConstitutiveLaw>(
         }
     }
     sub.work = -0.5 * (sub.spring + spring).dot(du);
-    sub.dashpot_work = -dashpot.dot(du);
+    // Trapezoidal, like the spring work: last step's dashpot force is `total − spring`.
+    sub.dashpot_work = -0.5 * (sub.total - sub.spring + dashpot).dot(du);
     sub.spring = spring;
     sub.total = spring + dashpot;
     sub.point = p;

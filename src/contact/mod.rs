@@ -122,6 +122,11 @@ pub struct SubContact<S> {
     pub(crate) area: Real,
     /// Normal displacement `u_n` (m, positive = open).
     pub(crate) gap: Real,
+    /// Added to the geometric gap of a point contact at each re-detection (m): the overlap a
+    /// face-face joint left behind when it turned into an edge contact, which the springs do not
+    /// carry. Zero otherwise.
+    #[serde(default)]
+    pub(crate) gap_offset: Real,
     pub(crate) force: JointForce,
     pub(crate) status: JointStatus,
     /// Accumulated slip while sliding (m).

@@ -442,7 +442,9 @@ fn point_contact(
     params: &ContactParameters,
     seeds: &mut Vec<SubcontactSeed>,
 ) -> Option<DetectedContact> {
-    let band = params.tolerance;
+    // Vertices within the tolerance of the other block's surface, not of this block's deepest
+    // vertex: under penetration (`dist < 0`) the whole penetrating feature is in contact.
+    let band = params.tolerance + (-dist).max(0.0);
     let support = |g: BlockGeometry<'_>, dir: Vector| -> Vec<Vector> {
         let world: Vec<Vector> = g.shape.vertices().iter().map(|v| g.pose.transform_point(*v)).collect();
         let top = world.iter().map(|p| dir.dot(*p)).fold(Real::NEG_INFINITY, Real::max);

@@ -7,7 +7,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use super::{Model, ModelParameters};
-use crate::block::RigidBlock;
+use crate::block::{RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
 use crate::contact::{ContactPair, SubContact};
 use crate::error::{Error, Result};
@@ -47,6 +47,10 @@ struct Snapshot<L: ConstitutiveLaw> {
     monitors: Vec<(String, Monitor)>,
     history: History,
     monitor_interval: u64,
+    /// Last step's reaction and damping wrench per block: the energy bookkeeping books each of
+    /// them half in the next step.
+    #[serde(default)]
+    last_forces: Vec<(Wrench, Wrench)>,
 }
 
 impl<L> Model<L>
@@ -84,6 +88,7 @@ where
             monitors: self.monitors.clone(),
             history: self.history.clone(),
             monitor_interval: self.monitor_interval,
+            last_forces: self.records.iter().map(|r| (r.reaction, r.damping)).collect(),
         };
         serde_json::to_string(&snap).map_err(|e| Error::Io {
             path: "(checkpoint)".into(),
@@ -183,6 +188,10 @@ where
         model.monitors = snap.monitors;
         model.history = snap.history;
         model.monitor_interval = snap.monitor_interval.max(1);
+        for (r, &(reaction, damping)) in model.records.iter_mut().zip(&snap.last_forces) {
+            r.reaction = reaction;
+            r.damping = damping;
+        }
         model.scratch.force_full_detection = !model.started;
         model.rebuild_block_index();
         if model.started {

@@ -8,8 +8,10 @@ use crate::math::Real;
 /// Energies and works since the start of the run (J).
 ///
 /// Balance: `kinetic + elastic + friction + damping = initial_kinetic + gravity_work + load_work +
-/// boundary_work`. `kinetic` is evaluated at integer time levels (mean of the half-step
-/// velocities); works are the power of each force times the step; `elastic` is the energy stored
+/// boundary_work`. `kinetic` is evaluated at integer time levels as `½·m·v⁻·v⁺` (the product of
+/// the half-step velocities either side, the quantity central difference conserves; it differs
+/// from `½·m·v̄²` by `⅛·m·|v⁺ − v⁻|²`); works are each force times the displacement of the step,
+/// by the trapezoidal rule, so that the balance is exact for translation; `elastic` is the energy stored
 /// in the joint springs; `friction` is the work done on the joints (trapezoidal rule, per
 /// sub-contact) less the elastic energy, i.e. what slip and failure dissipated.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

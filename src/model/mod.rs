@@ -460,6 +460,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             self.detect()?;
         }
         self.compute_forces();
+        self.account_energy_before_advance();
         self.integrator
             .advance(&mut self.blocks, &self.forces, self.dt, &mut self.records);
         self.account_energy();
@@ -561,20 +562,44 @@ impl<L: ConstitutiveLaw> Model<L> {
         };
     }
 
-    fn account_energy(&mut self) {
+    /// Energy bookkeeping, first half. Every force `F` is booked with the trapezoidal rule over
+    /// the displacement of the step that just ended, `½(F_{n−1} + F_n)·v_{n−½}·Δt` (a force that
+    /// did not exist before the first step counts as zero), which together with the kinetic energy
+    /// `½·m·v_{n−½}·v_{n+½}` makes the balance an exact identity of central difference for
+    /// translation. Here: the gravity and load terms and the `F_{n−1}` halves of the reactions
+    /// and damping forces, while the block velocities are still `v_{n−½}` and the step records
+    /// still hold step `n − 1`.
+    fn account_energy_before_advance(&mut self) {
         let dt = self.dt;
         let g = self.params.gravity;
+        let first = if self.step == 0 { 0.5 } else { 1.0 };
+        let e = &mut self.energy;
+        for (b, r) in self.blocks.iter().zip(&self.records) {
+            let m = b.mass_properties().mass;
+            let (v, w) = (b.state.velocity, b.state.angular_velocity);
+            e.gravity_work += first * m * g.dot(v) * dt;
+            e.load_work += first * (b.load.force.dot(v) + b.load.moment.dot(w)) * dt;
+            e.boundary_work += 0.5 * (r.reaction.force.dot(v) + r.reaction.moment.dot(w)) * dt;
+            e.damping -= 0.5 * (r.damping.force.dot(v) + r.damping.moment.dot(w)) * dt;
+        }
+    }
+
+    /// Energy bookkeeping, second half (after the integrator): the `F_n` halves of the reactions
+    /// and damping forces, the kinetic energy `½·m·v_{n−½}·v_{n+½} + ½·ω_{n−½}·L_{n+½}`, and the
+    /// joint terms.
+    fn account_energy(&mut self) {
+        let dt = self.dt;
         let e = &mut self.energy;
         let mut kinetic = 0.0;
         for (b, r) in self.blocks.iter().zip(&self.records) {
             let m = b.mass_properties().mass;
-            let v = r.mean_velocity;
-            let w = r.mean_angular_velocity;
-            kinetic += 0.5 * m * v.length_squared() + 0.5 * w.dot(b.world_inertia_times(w));
-            e.gravity_work += m * g.dot(v) * dt;
-            e.load_work += (b.load.force.dot(v) + b.load.moment.dot(w)) * dt;
-            e.boundary_work += (r.reaction.force.dot(v) + r.reaction.moment.dot(w)) * dt;
-            e.damping -= (r.damping.force.dot(v) + r.damping.moment.dot(w)) * dt;
+            let (v1, w1) = (b.state.velocity, b.state.angular_velocity);
+            // The velocities before the step, from the mean the integrator reports.
+            let v0 = 2.0 * r.mean_velocity - v1;
+            let w0 = 2.0 * r.mean_angular_velocity - w1;
+            kinetic += 0.5 * m * v0.dot(v1) + 0.5 * w0.dot(b.state.angular_momentum);
+            e.boundary_work += 0.5 * (r.reaction.force.dot(v0) + r.reaction.moment.dot(w0)) * dt;
+            e.damping -= 0.5 * (r.damping.force.dot(v0) + r.damping.moment.dot(w0)) * dt;
         }
         e.kinetic = kinetic;
         let (mut work, mut dashpot, mut elastic) = (0.0, 0.0, 0.0);

@@ -1,0 +1,735 @@
+//! Every `voussoir::Error` variant, provoked from user input through the public API: the right
+//! variant comes back (never a panic), its fields name what is wrong, where, and the bad value,
+//! and so does its message.
+
+use voussoir::block::Dof;
+use voussoir::geometry::{ContactParameters, SubcontactDensity};
+use voussoir::prelude::*;
+
+/// The eight corners of the unit cube, index = x + 2y + 4z.
+fn unit_cube() -> Vec<Vector> {
+    (0..8)
+        .map(|i| Vector::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
+        .collect()
+}
+
+/// The six faces of [`unit_cube`], counter-clockwise seen from outside.
+fn unit_cube_faces() -> Vec<Vec<usize>> {
+    vec![
+        vec![0, 2, 3, 1], // z = 0
+        vec![4, 5, 7, 6], // z = 1
+        vec![0, 1, 5, 4], // y = 0
+        vec![2, 6, 7, 3], // y = 1
+        vec![0, 4, 6, 2], // x = 0
+        vec![1, 3, 7, 5], // x = 1
+    ]
+}
+
+/// Asserts that `message` contains every one of `parts`.
+#[track_caller]
+fn assert_names(message: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(message.contains(p), "message {message:?} does not mention {p:?}");
+    }
+}
+
+/// A model with a fixed 2 m slab (block #0) and a 0.2 m cube resting on it (block #1).
+fn slab_and_cube(params: ModelParameters) -> Model {
+    let mut model: Model = Model::new(params).unwrap();
+    model
+        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).unwrap())
+        .unwrap();
+    model
+        .add_block(
+            RigidBlock::cuboid(
+                "slab",
+                Vector::new(-1.0, -1.0, -0.2),
+                Vector::new(1.0, 1.0, 0.0),
+                2500.0,
+            )
+            .unwrap()
+            .with_fixity(Fixity::FIXED),
+        )
+        .unwrap();
+    model
+        .add_block(RigidBlock::cuboid("cube", Vector::ZERO, Vector::splat(0.2), 2500.0).unwrap())
+        .unwrap();
+    model
+}
+
+/// Too few points, a flat (coplanar) set and a collinear set are degenerate: the error names the
+/// block and says why.
+#[test]
+fn degenerate_vertex_sets() {
+    let three = [Vector::ZERO, Vector::X, Vector::Y];
+    let e = RigidBlock::from_vertices("sliver", &three, 2000.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::DegenerateGeometry { block, .. } if block == "sliver"),
+        "{e:?}"
+    );
+    assert_names(&e.to_string(), &["sliver", "3 vertices"]);
+
+    // Eight points on the plane z = 0.
+    let flat: Vec<Vector> = unit_cube().iter().map(|p| Vector::new(p.x, p.y, 0.0)).collect();
+    let e = RigidBlock::from_vertices("flat slab", &flat, 2000.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::DegenerateGeometry { block, .. } | Error::NonPositiveVolume { block, .. } if block == "flat slab"),
+        "{e:?}"
+    );
+    assert_names(&e.to_string(), &["flat slab"]);
+
+    let line: Vec<Vector> = (0..5).map(|i| Vector::X * i as f64).collect();
+    let e = RigidBlock::from_vertices("needle", &line, 2000.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::DegenerateGeometry { block, .. } | Error::NonPositiveVolume { block, .. } if block == "needle"),
+        "{e:?}"
+    );
+
+    // Explicit faces: a face with two vertices, and too few faces.
+    let mut faces = unit_cube_faces();
+    faces[3] = vec![2, 6];
+    let e = RigidBlock::from_faces("two-vertex face", &unit_cube(), &faces, 2000.0).unwrap_err();
+    assert!(matches!(&e, Error::DegenerateGeometry { .. }), "{e:?}");
+    assert_names(&e.to_string(), &["two-vertex face", "face 3"]);
+    let e = RigidBlock::from_faces("open box", &unit_cube(), &unit_cube_faces()[..3], 2000.0).unwrap_err();
+    assert!(matches!(&e, Error::DegenerateGeometry { .. }), "{e:?}");
+    assert_names(&e.to_string(), &["open box", "3 faces"]);
+}
+
+/// A (nearly) zero-volume solid: a tetrahedron 1e-15 m thick on a 1 m base is either rejected as
+/// degenerate by the hull or as having a non-positive volume, naming the block.
+#[test]
+fn zero_volume_solid() {
+    let pts = [Vector::ZERO, Vector::X, Vector::Y, Vector::new(0.3, 0.3, 1e-15)];
+    let e = RigidBlock::from_vertices("wafer", &pts, 2000.0).unwrap_err();
+    match &e {
+        Error::NonPositiveVolume { block, volume } => {
+            assert_eq!(block, "wafer");
+            assert!(*volume < 1e-12, "{volume}");
+            assert_names(&e.to_string(), &["wafer", "volume"]);
+        }
+        Error::DegenerateGeometry { block, .. } => assert_eq!(block, "wafer"),
+        other => panic!("unexpected {other:?}"),
+    }
+}
+
+/// Explicit faces that do not make a convex solid: a cube whose top is a pyramid pushed *into*
+/// the cube (a dimple), a non-planar face, inward-facing faces and a face index out of range.
+/// Each error names the block and the offending face or vertex.
+#[test]
+fn non_convex_explicit_faces() {
+    // Dimple: the top is four triangles meeting at vertex 8, pushed down to z = 0.5.
+    let mut pts = unit_cube();
+    pts.push(Vector::new(0.5, 0.5, 0.5));
+    let mut faces = unit_cube_faces();
+    faces[1] = vec![4, 5, 8];
+    faces.push(vec![5, 7, 8]);
+    faces.push(vec![7, 6, 8]);
+    faces.push(vec![6, 4, 8]);
+    let e = RigidBlock::from_faces("dimpled", &pts, &faces, 2000.0).unwrap_err();
+    let Error::NonConvex { block, reason } = &e else {
+        panic!("expected NonConvex, got {e:?}")
+    };
+    assert_eq!(block, "dimpled");
+    assert!(reason.contains("vertex") && reason.contains("face"), "{reason}");
+    assert_names(&e.to_string(), &["dimpled", "not convex"]);
+
+    // A warped face: vertex 7 lifted, so the top and two sides are not planar.
+    let mut warped = unit_cube();
+    warped[7].z = 1.2;
+    let e = RigidBlock::from_faces("warped", &warped, &unit_cube_faces(), 2000.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::NonConvex { block, .. } if block == "warped"),
+        "{e:?}"
+    );
+    assert_names(&e.to_string(), &["warped", "face"]);
+
+    // Inward faces (every loop reversed).
+    let inward: Vec<Vec<usize>> = unit_cube_faces()
+        .into_iter()
+        .map(|f| f.into_iter().rev().collect())
+        .collect();
+    let e = RigidBlock::from_faces("inside out", &unit_cube(), &inward, 2000.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::NonConvex { block, .. } | Error::NonPositiveVolume { block, .. } if block == "inside out"),
+        "{e:?}"
+    );
+
+    // A face that refers to a vertex that does not exist.
+    let mut faces = unit_cube_faces();
+    faces[0] = vec![0, 2, 3, 12];
+    let e = RigidBlock::from_faces("dangling", &unit_cube(), &faces, 2000.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::NonConvex { .. } | Error::DegenerateGeometry { .. }),
+        "{e:?}"
+    );
+    assert_names(&e.to_string(), &["dangling", "12"]);
+}
+
+/// A NaN or infinite vertex is rejected before any geometry is built; the message names the
+/// vertex index and the block.
+#[test]
+fn non_finite_vertices() {
+    for (bad, label) in [(f64::NAN, "NaN"), (f64::INFINITY, "inf"), (f64::NEG_INFINITY, "-inf")] {
+        let mut pts = unit_cube();
+        pts[5].y = bad;
+        let e = RigidBlock::from_vertices("voussoir 5", &pts, 2000.0).unwrap_err();
+        let Error::NonFinite { what } = &e else {
+            panic!("{label}: expected NonFinite, got {e:?}")
+        };
+        assert_names(what, &["vertex 5", "voussoir 5"]);
+        let e = RigidBlock::from_faces("voussoir 5", &pts, &unit_cube_faces(), 2000.0).unwrap_err();
+        assert!(
+            matches!(&e, Error::NonFinite { what } if what.contains("vertex 5")),
+            "{e:?}"
+        );
+    }
+    let e = RigidBlock::cuboid("box", Vector::ZERO, Vector::new(1.0, f64::NAN, 1.0), 2000.0).unwrap_err();
+    assert!(matches!(&e, Error::NonFinite { what } if what.contains("box")), "{e:?}");
+}
+
+/// Density must be positive and finite: zero, negative, NaN and infinity are each rejected with
+/// the block's name and the value.
+#[test]
+fn bad_density() {
+    for density in [0.0, -2400.0, f64::NAN, f64::INFINITY] {
+        let e = RigidBlock::cuboid("keystone", Vector::ZERO, Vector::ONE, density).unwrap_err();
+        let Error::InvalidParameter { name, value, .. } = &e else {
+            panic!("density {density}: expected InvalidParameter, got {e:?}")
+        };
+        assert!(name.contains("density") && name.contains("keystone"), "{name}");
+        assert!(value.to_bits() == density.to_bits(), "{value} vs {density}");
+        assert_names(&e.to_string(), &["density", "keystone", &format!("{density}")]);
+    }
+}
+
+/// Joint stiffness must be positive and finite, for the shipped laws and through
+/// `Model::set_joint_law` (which validates the law).
+#[test]
+fn non_positive_stiffness() {
+    let e = CoulombSlip::dry(0.0, 4e8, 30.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, value, .. } if name == "normal_stiffness" && *value == 0.0),
+        "{e:?}"
+    );
+    assert_names(&e.to_string(), &["normal_stiffness", "= 0"]);
+    let e = CoulombSlip::dry(1e9, -4e8, 30.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, value, .. } if name == "shear_stiffness" && *value == -4e8),
+        "{e:?}"
+    );
+    assert_names(&e.to_string(), &["shear_stiffness", "-400000000"]);
+    let e = CoulombSlip::dry(f64::NAN, 4e8, 30.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "normal_stiffness"),
+        "{e:?}"
+    );
+
+    let mut model: Model<LinearElastic> = Model::new(ModelParameters::default()).unwrap();
+    let law = LinearElastic {
+        normal_stiffness: -1e9,
+        shear_stiffness: 1e9,
+    };
+    let e = model.set_joint_law(MaterialId(0), MaterialId(1), law).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, value, .. } if name == "normal_stiffness" && *value == -1e9),
+        "{e:?}"
+    );
+    assert!(
+        model.joints().get(MaterialId(0), MaterialId(1)).is_none(),
+        "a rejected law must not be stored"
+    );
+}
+
+/// Friction angles outside [0°, 90°) are rejected, naming the parameter.
+///
+/// Note: the constructors take degrees but the rejected value is reported in radians (the
+/// stored unit), with the hint "(given in rad)"; the check below accepts that.
+#[test]
+fn friction_outside_range() {
+    for phi in [90.0, 95.0, -1.0, f64::NAN] {
+        let e = CoulombSlip::dry(1e9, 4e8, phi).unwrap_err();
+        let Error::InvalidParameter { name, value, expected } = &e else {
+            panic!("{phi}°: expected InvalidParameter, got {e:?}")
+        };
+        assert_eq!(name, "friction_angle");
+        assert!(
+            value.to_bits() == phi.to_radians().to_bits() || value.to_bits() == phi.to_bits(),
+            "{phi}° reported as {value}"
+        );
+        assert!(expected.contains("90"), "{expected}");
+        assert_names(&e.to_string(), &["friction_angle", &format!("{value}")]);
+    }
+    // The residual angle too.
+    let e = CoulombSlip::new(1e9, 4e8, 30.0, 90.0, 0.0, 0.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "residual_friction_angle"),
+        "{e:?}"
+    );
+    // Negative cohesion and tensile strength.
+    let e = CoulombSlip::new(1e9, 4e8, 30.0, 30.0, -1.0, 0.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, value, .. } if name == "cohesion" && *value == -1.0),
+        "{e:?}"
+    );
+    let e = CoulombSlip::new(1e9, 4e8, 30.0, 30.0, 0.0, -5.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "tensile_strength"),
+        "{e:?}"
+    );
+    // 0° is admissible (frictionless).
+    assert!(CoulombSlip::dry(1e9, 4e8, 0.0).is_ok());
+}
+
+/// NaN or infinite gravity is rejected by `Model::new` and `Model::set_parameters`, which then
+/// leaves the model's parameters unchanged.
+#[test]
+fn non_finite_gravity() {
+    for g in [Vector::new(0.0, 0.0, f64::NAN), Vector::new(f64::INFINITY, 0.0, -9.81)] {
+        let params = ModelParameters {
+            gravity: g,
+            ..ModelParameters::default()
+        };
+        let e = Model::<CoulombSlip>::new(params).unwrap_err();
+        assert!(matches!(&e, Error::NonFinite { what } if what == "gravity"), "{e:?}");
+        assert_names(&e.to_string(), &["gravity"]);
+        let mut model = slab_and_cube(ModelParameters::default());
+        let e = model.set_parameters(params).unwrap_err();
+        assert!(matches!(&e, Error::NonFinite { .. }), "{e:?}");
+        assert_eq!(model.parameters().gravity, Vector::new(0.0, 0.0, -9.81));
+    }
+}
+
+/// Bad contact-detection parameters and time-step settings name the field and value.
+#[test]
+fn bad_contact_and_run_parameters() {
+    let cases: Vec<(ContactParameters, &str, f64)> = vec![
+        (
+            ContactParameters {
+                tolerance: -1e-3,
+                ..ContactParameters::default()
+            },
+            "contact.tolerance",
+            -1e-3,
+        ),
+        (
+            ContactParameters {
+                tolerance: 0.0,
+                ..ContactParameters::default()
+            },
+            "contact.tolerance",
+            0.0,
+        ),
+        (
+            ContactParameters {
+                redetect_fraction: 0.0,
+                ..ContactParameters::default()
+            },
+            "contact.redetect_fraction",
+            0.0,
+        ),
+        (
+            ContactParameters {
+                redetect_fraction: 1.5,
+                ..ContactParameters::default()
+            },
+            "contact.redetect_fraction",
+            1.5,
+        ),
+        (
+            ContactParameters {
+                face_angle_tolerance: 1.0,
+                ..ContactParameters::default()
+            },
+            "contact.face_angle_tolerance",
+            1.0,
+        ),
+        (
+            ContactParameters {
+                density: SubcontactDensity::PerEdge(0),
+                ..ContactParameters::default()
+            },
+            "contact.density.per_edge",
+            0.0,
+        ),
+        (
+            ContactParameters {
+                density: SubcontactDensity::Spacing(-0.01),
+                ..ContactParameters::default()
+            },
+            "contact.density.spacing",
+            -0.01,
+        ),
+    ];
+    for (contact, field, bad) in cases {
+        let params = ModelParameters {
+            contact,
+            ..ModelParameters::default()
+        };
+        let e = Model::<CoulombSlip>::new(params).unwrap_err();
+        let Error::InvalidParameter { name, value, .. } = &e else {
+            panic!("{field}: expected InvalidParameter, got {e:?}")
+        };
+        assert_eq!(name, field);
+        assert_eq!(*value, bad, "{field}");
+        assert_names(&e.to_string(), &[field, &format!("{bad}")]);
+    }
+    let e = Model::<CoulombSlip>::new(ModelParameters {
+        contact: ContactParameters {
+            tolerance: f64::NAN,
+            ..ContactParameters::default()
+        },
+        ..ModelParameters::default()
+    })
+    .unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "contact.tolerance"),
+        "{e:?}"
+    );
+
+    for (time_step, field) in [
+        (TimeStep::Fixed(0.0), "time_step"),
+        (TimeStep::Fixed(f64::NAN), "time_step"),
+        (TimeStep::Auto { safety: 1.5 }, "time_step.safety"),
+        (TimeStep::Auto { safety: 0.0 }, "time_step.safety"),
+    ] {
+        let e = Model::<CoulombSlip>::new(ModelParameters {
+            time_step,
+            ..ModelParameters::default()
+        })
+        .unwrap_err();
+        assert!(
+            matches!(&e, Error::InvalidParameter { name, .. } if name == field),
+            "{time_step:?}: {e:?}"
+        );
+    }
+    let e = Model::<CoulombSlip>::new(ModelParameters {
+        max_speed: 0.0,
+        ..ModelParameters::default()
+    })
+    .unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "max_speed"),
+        "{e:?}"
+    );
+
+    // Damping coefficients.
+    let mut model = slab_and_cube(ModelParameters::default());
+    let e = model.set_damping(Damping::Local { alpha: 1.0 }).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, value, .. } if name == "damping.alpha" && *value == 1.0),
+        "{e:?}"
+    );
+    let e = model
+        .set_damping(Damping::Rayleigh {
+            mass: -1.0,
+            stiffness: 0.0,
+        })
+        .unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "damping.mass"),
+        "{e:?}"
+    );
+    let e = Damping::rayleigh_stiffness(0.05, 0.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "damping frequency"),
+        "{e:?}"
+    );
+    let e = Damping::rayleigh(-0.05, 10.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { name, .. } if name == "damping ratio"),
+        "{e:?}"
+    );
+    // The model still runs with its previous (default local) damping.
+    model.run_steps(10).unwrap();
+}
+
+/// A block id the model does not hold: every accessor and setter that takes an id says which id
+/// and how many blocks there are.
+#[test]
+fn unknown_block_id() {
+    let mut model = slab_and_cube(ModelParameters::default());
+    let check = |e: Error| {
+        assert!(
+            matches!(e, Error::UnknownBlock { id, count } if id == BlockId(99) && count == 2),
+            "{e:?}"
+        );
+        assert_names(&e.to_string(), &["99", "2 blocks"]);
+    };
+    check(model.block(BlockId(99)).unwrap_err());
+    check(model.set_load(BlockId(99), Wrench::default()).unwrap_err());
+    check(model.set_fixity(BlockId(99), Fixity::FIXED).unwrap_err());
+    check(model.set_velocity(BlockId(99), Vector::X, Vector::ZERO).unwrap_err());
+    check(model.reaction(BlockId(99)).unwrap_err());
+    check(model.contact_wrench(BlockId(99)).unwrap_err());
+    let monitor = Monitor::Reaction {
+        block: BlockId(99),
+        component: Component::Z,
+    };
+    check(model.add_monitor("ghost", monitor).unwrap_err());
+    // The model is intact and runs.
+    model.run_steps(5).unwrap();
+    assert_eq!(model.blocks().len(), 2);
+}
+
+/// NaN loads, velocities and prescribed velocities are rejected naming the block.
+#[test]
+fn non_finite_loads_and_velocities() {
+    let mut model = slab_and_cube(ModelParameters::default());
+    let cube = BlockId(1);
+    let e = model
+        .set_load(
+            cube,
+            Wrench {
+                force: Vector::new(f64::NAN, 0.0, 0.0),
+                moment: Vector::ZERO,
+            },
+        )
+        .unwrap_err();
+    assert!(
+        matches!(&e, Error::NonFinite { what } if what.contains("load") && what.contains("#1")),
+        "{e:?}"
+    );
+    let e = model
+        .set_velocity(cube, Vector::ZERO, Vector::new(0.0, f64::INFINITY, 0.0))
+        .unwrap_err();
+    assert!(
+        matches!(&e, Error::NonFinite { what } if what.contains("velocity") && what.contains("#1")),
+        "{e:?}"
+    );
+    let e = model
+        .set_fixity(
+            cube,
+            Fixity {
+                translation: [Dof::Velocity(f64::NAN), Dof::Free, Dof::Free],
+                rotation: [Dof::Free; 3],
+            },
+        )
+        .unwrap_err();
+    assert!(
+        matches!(&e, Error::NonFinite { what } if what.contains("cube")),
+        "{e:?}"
+    );
+    assert_eq!(
+        model.block(cube).unwrap().fixity(),
+        &Fixity::FREE,
+        "a rejected fixity must not stick"
+    );
+    let moving = RigidBlock::cuboid("thrown", Vector::new(0.5, 0.5, 0.0), Vector::new(0.7, 0.7, 0.2), 2500.0)
+        .unwrap()
+        .with_velocity(Vector::new(f64::NAN, 0.0, 0.0), Vector::ZERO);
+    let e = model.add_block(moving).unwrap_err();
+    assert!(
+        matches!(&e, Error::NonFinite { what } if what.contains("thrown")),
+        "{e:?}"
+    );
+    assert_eq!(model.blocks().len(), 2, "a rejected block must not be added");
+    model.run_steps(5).unwrap();
+}
+
+/// Two blocks of materials with no joint law between them touch: the first step fails, naming
+/// both materials and both blocks.
+#[test]
+fn missing_joint_law() {
+    let mut model: Model = Model::new(ModelParameters::default()).unwrap();
+    model
+        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).unwrap())
+        .unwrap();
+    model
+        .add_block(
+            RigidBlock::cuboid(
+                "slab",
+                Vector::new(-1.0, -1.0, -0.2),
+                Vector::new(1.0, 1.0, 0.0),
+                2500.0,
+            )
+            .unwrap()
+            .with_fixity(Fixity::FIXED),
+        )
+        .unwrap();
+    model
+        .add_block(
+            RigidBlock::cuboid("steel plate", Vector::ZERO, Vector::new(0.2, 0.2, 0.02), 7850.0)
+                .unwrap()
+                .with_material(MaterialId(3)),
+        )
+        .unwrap();
+    let e = model.step().unwrap_err();
+    let Error::MissingJointLaw { a, b, block_a, block_b } = e.clone() else {
+        panic!("expected MissingJointLaw, got {e:?}")
+    };
+    assert_eq!((a, b), (MaterialId(0), MaterialId(3)));
+    assert_eq!((block_a, block_b), (BlockId(0), BlockId(1)));
+    assert_names(&e.to_string(), &["material 0", "material 3", "#0", "#1"]);
+    // Supplying the law fixes it.
+    model
+        .set_joint_law(MaterialId(3), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 20.0).unwrap())
+        .unwrap();
+    model.run_steps(10).unwrap();
+}
+
+/// A user-fixed time step of 1 s is far above the critical step of a 0.2 m stone cube on 1 GPa/m
+/// springs (~1e-4 s): the first step fails naming the step, the limit and the block that sets it
+/// (the cube, #1; the slab is fixed).
+#[test]
+fn fixed_time_step_above_the_stable_limit() {
+    let params = ModelParameters {
+        time_step: TimeStep::Fixed(1.0),
+        ..ModelParameters::default()
+    };
+    let mut model = slab_and_cube(params);
+    let e = model.step().unwrap_err();
+    let Error::TimeStepTooLarge { dt, limit, block } = e.clone() else {
+        panic!("expected TimeStepTooLarge, got {e:?}")
+    };
+    assert_eq!(dt, 1.0);
+    assert!((1e-6..1e-2).contains(&limit), "limit {limit}");
+    assert_eq!(block, BlockId(1));
+    assert_names(&e.to_string(), &["time step 1 s", &format!("{limit}"), "#1"]);
+    // Half the reported limit is accepted.
+    let mut model = slab_and_cube(ModelParameters {
+        time_step: TimeStep::Fixed(0.5 * limit),
+        ..ModelParameters::default()
+    });
+    model.run_steps(10).unwrap();
+    assert_eq!(model.dt(), 0.5 * limit);
+    // Stiffness-proportional damping lowers the limit: a step just below the undamped limit
+    // becomes unstable once heavy Rayleigh damping is switched on.
+    let mut model = slab_and_cube(ModelParameters {
+        time_step: TimeStep::Fixed(0.95 * limit),
+        ..ModelParameters::default()
+    });
+    model.run_steps(1).unwrap();
+    let heavy = Damping::Rayleigh {
+        mass: 0.0,
+        stiffness: 10.0 * limit,
+    };
+    let e = model.set_damping(heavy).unwrap_err();
+    assert!(matches!(e, Error::TimeStepTooLarge { block: BlockId(1), .. }), "{e:?}");
+}
+
+/// Runs that blow up stop with `Diverged`, naming the step and the block: a 1e12 N push on a
+/// 16 kg cube (speed past the 1000 m/s default limit within a few steps), and a falling block
+/// with a tiny `max_speed`.
+#[test]
+fn diverging_runs() {
+    let mut model = slab_and_cube(ModelParameters::default());
+    model
+        .set_load(
+            BlockId(1),
+            Wrench {
+                force: Vector::new(1e12, 0.0, 0.0),
+                moment: Vector::ZERO,
+            },
+        )
+        .unwrap();
+    let e = model.run_steps(1000).unwrap_err();
+    let Error::Diverged {
+        step,
+        time,
+        block,
+        reason,
+    } = e.clone()
+    else {
+        panic!("expected Diverged, got {e:?}")
+    };
+    assert_eq!(block, BlockId(1));
+    assert!((1..1000).contains(&step), "step {step}");
+    assert_eq!(
+        step,
+        model.step_count(),
+        "the error names the step the model stopped at"
+    );
+    assert!(time > 0.0);
+    assert!(reason.contains("max_speed"), "{reason}");
+    assert_names(&e.to_string(), &[&format!("step {step}"), "#1"]);
+
+    // A block in free fall above the slab with max_speed = 1 mm/s: exceeded after ~0.1 ms.
+    let params = ModelParameters {
+        max_speed: 1e-3,
+        ..ModelParameters::default()
+    };
+    let mut model: Model = Model::new(params).unwrap();
+    model
+        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).unwrap())
+        .unwrap();
+    model
+        .add_block(
+            RigidBlock::cuboid(
+                "slab",
+                Vector::new(-1.0, -1.0, -0.2),
+                Vector::new(1.0, 1.0, 0.0),
+                2500.0,
+            )
+            .unwrap()
+            .with_fixity(Fixity::FIXED),
+        )
+        .unwrap();
+    model
+        .add_block(
+            RigidBlock::cuboid(
+                "dropped",
+                Vector::new(0.0, 0.0, 0.5),
+                Vector::new(0.2, 0.2, 0.7),
+                2500.0,
+            )
+            .unwrap(),
+        )
+        .unwrap();
+    let e = model.run_until_time(1.0).unwrap_err();
+    assert!(matches!(&e, Error::Diverged { block: BlockId(1), .. }), "{e:?}");
+}
+
+/// `run_to_equilibrium` with a budget too small for its target returns `NotConverged` with the
+/// number of steps and the last unbalanced-force ratio; a non-positive target is an
+/// `InvalidParameter`.
+#[test]
+fn equilibrium_not_reached() {
+    let mut model = slab_and_cube(ModelParameters::default());
+    let e = model.run_to_equilibrium(1e-12, 5).unwrap_err();
+    let Error::NotConverged { what, steps, last } = e.clone() else {
+        panic!("expected NotConverged, got {e:?}")
+    };
+    assert_eq!(steps, 5);
+    assert_eq!(model.step_count(), 5);
+    assert!(what.contains("unbalanced"), "{what}");
+    assert!(last > 1e-12, "{last}");
+    assert_names(&e.to_string(), &["5 steps", &format!("{last}")]);
+    let e = model.run_to_equilibrium(0.0, 5).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { value, .. } if *value == 0.0),
+        "{e:?}"
+    );
+}
+
+/// File and checkpoint errors: writing a checkpoint below a regular file fails with `Io` naming
+/// the path; corrupt checkpoint text fails with `Checkpoint` naming where.
+#[test]
+fn io_and_checkpoint_errors() {
+    let mut model = slab_and_cube(ModelParameters::default());
+    model.run_steps(3).unwrap();
+    let dir = std::env::temp_dir().join(format!("voussoir-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("not-a-directory");
+    std::fs::write(&file, "x").unwrap();
+    let target = file.join("model.json");
+    let e = model.save_checkpoint(&target).unwrap_err();
+    assert!(matches!(&e, Error::Io { .. }), "{e:?}");
+    assert_names(&e.to_string(), &["not-a-directory"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+
+    for text in ["", "{", "{\"format\": 3}", "[1, 2, 3]"] {
+        let e = Model::<CoulombSlip>::from_checkpoint_str(text).unwrap_err();
+        assert!(matches!(&e, Error::Checkpoint { .. }), "{text:?}: {e:?}");
+    }
+    // A valid checkpoint with one block's coordinates corrupted to a string.
+    let good = model.to_checkpoint_string().unwrap();
+    assert!(Model::<CoulombSlip>::from_checkpoint_str(&good).is_ok());
+    let bad = good.replacen("\"step\":3", "\"step\":\"three\"", 1);
+    assert_ne!(bad, good, "the checkpoint layout changed: update the corruption");
+    let e = Model::<CoulombSlip>::from_checkpoint_str(&bad).unwrap_err();
+    let Error::Checkpoint { path, .. } = &e else {
+        panic!("expected Checkpoint, got {e:?}")
+    };
+    assert!(path.contains("step"), "{path}");
+}
