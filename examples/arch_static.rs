@@ -126,6 +126,9 @@ struct CaseSummary {
     end_load_kn: f64,
     settle_unbalanced_ratio: f64,
     mechanism: MechanismSummary,
+    /// Per joint at the peak and at the end: open fraction, compression position, slip, hinge.
+    joints_at_peak: Vec<voussoir::analysis::JointState>,
+    joints_at_end: Vec<voussoir::analysis::JointState>,
     steps: u64,
     dt_s: f64,
     subcontacts: usize,
@@ -178,6 +181,8 @@ fn summarise(r: &StaticResult) -> CaseSummary {
             at_peak: r.mechanism_at_peak.clone(),
             at_end: r.mechanism_at_end.clone(),
         },
+        joints_at_peak: r.joints_at_peak.clone(),
+        joints_at_end: r.joints_at_end.clone(),
         steps: r.steps,
         dt_s: r.dt,
         subcontacts: r.subcontacts,
