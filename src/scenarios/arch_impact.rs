@@ -9,7 +9,8 @@
 //! damping for `duration` seconds, or until the arch collapses.
 //!
 //! Collapse rule ([`collapsed_voussoir`]): a voussoir's centroid has dropped by more than half
-//! the ring thickness below its settled position.
+//! the ring thickness below its settled position. First-impact peak: the largest downward
+//! quarter-span displacement until the impactor first leaves the seat.
 
 use std::time::Instant;
 
@@ -163,7 +164,8 @@ pub struct ImpactResult {
     pub momentum: Real,
     /// Impactor kinetic energy just before contact (J).
     pub kinetic_energy: Real,
-    /// Largest downward quarter-span displacement during the first impact (m).
+    /// Largest downward quarter-span displacement during the first impact, until the impactor
+    /// first leaves the seat (m).
     pub first_peak_disp: Real,
     /// Largest downward quarter-span displacement over the run (m).
     pub max_disp: Real,
@@ -354,8 +356,9 @@ pub fn run(
         }
         if impact_started && !first_done {
             first_peak = first_peak.max(-disp);
-            // The first impact ends when the quarter span starts moving back up.
-            if velocity > 0.0 && -disp > 0.0 {
+            // The first impact ends when the impactor leaves the seat (the contact force returns
+            // to zero); if it rides the arch down, the first peak is the overall maximum.
+            if force <= 0.0 {
                 first_done = true;
             }
         }
