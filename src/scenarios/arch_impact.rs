@@ -1,6 +1,6 @@
 //! The drop-weight impact tests of the reference arch (`BENCHMARKS.md` §4).
 //!
-//! Model: the arch of [`ArchSpec::reference`]; a steel seat resting on the extrados of voussoir 5
+//! Model: the arch of [`crate::build::arch::ArchSpec::reference`]; a steel seat resting on the extrados of voussoir 5
 //! with a horizontal top (the bearing of the test); a rigid impactor of the test's mass, 0.10 m
 //! along the span × the arch width, **guided by constrained degrees of freedom**: only its
 //! vertical translation is free. The arch and seat are first settled under gravity with local
@@ -17,13 +17,11 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Block, BlockId, Dof, Fixity, RigidBlock};
-use crate::build::arch::{Arch, ArchSpec};
-use crate::constitutive::{CoulombSlip, MaterialId};
+use crate::build::arch::Arch;
 use crate::error::Result;
-use crate::geometry::{ContactParameters, SubcontactDensity};
 use crate::integrate::Damping;
 use crate::math::{Real, Vector};
-use crate::model::{Model, ModelParameters};
+use crate::model::Model;
 
 /// One of the six tests, with what was observed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -211,24 +209,15 @@ const VOUSSOIR: usize = 5;
 /// # Errors
 /// Invalid parameters.
 pub fn build(case: &ImpactCase) -> Result<ImpactModel> {
-    let arch = Arch::new(&ArchSpec::reference(case.width))?;
-    let params = ModelParameters {
-        gravity: Vector::new(0.0, -9.81, 0.0),
-        contact: ContactParameters {
-            density: SubcontactDensity::PerEdge(case.per_edge),
-            ..ContactParameters::default()
-        },
-        ..ModelParameters::default()
-    };
-    let mut model: Model = Model::new(params)?;
-    let (stone, steel) = (MaterialId(0), MaterialId(1));
-    let law = CoulombSlip::dry(case.kn, case.ks, case.friction_deg)?;
-    model.set_joint_law(stone, stone, law)?;
-    model.set_joint_law(stone, steel, law)?;
-    model.set_joint_law(steel, steel, law)?;
-    for b in &arch.blocks {
-        model.add_block(b.clone())?;
-    }
+    let (mut model, arch) = super::reference_arch_model(super::ArchJoints {
+        width: case.width,
+        per_edge: case.per_edge,
+        kn: case.kn,
+        ks: case.ks,
+        friction_deg: case.friction_deg,
+        mode: crate::contact::DisplacementMode::Large,
+    })?;
+    let steel = super::STEEL;
     let e0 = arch.joints[VOUSSOIR - 1].extrados;
     let e1 = arch.joints[VOUSSOIR].extrados;
     let top = e0.y.max(e1.y) + case.seat_thickness;

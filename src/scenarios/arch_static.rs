@@ -1,7 +1,7 @@
 //! The quasi-static test of the reference arch (`BENCHMARKS.md` §3): a displacement-controlled
 //! vertical load on voussoir 5 through a plate that does not restrain it horizontally.
 //!
-//! Model: the arch of [`ArchSpec::reference`]; a steel plate seated on the extrados of voussoir 5
+//! Model: the arch of [`crate::build::arch::ArchSpec::reference`]; a steel plate seated on the extrados of voussoir 5
 //! (footprint 0.10 m along the span, full width), whose **vertical velocity only** is prescribed:
 //! it is free to translate horizontally and to rotate in the plane of the arch (the roller and
 //! bearing of the test), so the load it transmits is vertical. The plate–stone joint has the
@@ -15,14 +15,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::analysis::{classify_joints, JointRef, JointState, Mechanism, MechanismCriteria};
 use crate::block::{BlockId, Dof, Fixity, RigidBlock};
-use crate::build::arch::{Arch, ArchSpec};
-use crate::constitutive::{CoulombSlip, MaterialId};
+use crate::build::arch::Arch;
 use crate::contact::DisplacementMode;
 use crate::error::Result;
-use crate::geometry::{ContactParameters, SubcontactDensity};
 use crate::integrate::Damping;
 use crate::math::{Pose, Real, Rotation, Vector};
-use crate::model::{Model, ModelParameters};
+use crate::model::Model;
 
 /// One analysis case. [`StaticCase::baseline`] holds the paper's values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -165,28 +163,17 @@ const VOUSSOIR: usize = 5;
 /// # Errors
 /// Invalid parameters.
 pub fn build(case: &StaticCase) -> Result<StaticModel> {
-    let arch = Arch::new(&ArchSpec::reference(case.width))?;
-    let params = ModelParameters {
-        gravity: Vector::new(0.0, -9.81, 0.0),
-        contact: ContactParameters {
-            density: SubcontactDensity::PerEdge(case.per_edge),
-            ..ContactParameters::default()
-        },
+    let (mut model, arch) = super::reference_arch_model(super::ArchJoints {
+        width: case.width,
+        per_edge: case.per_edge,
+        kn: case.kn,
+        ks: case.ks,
+        friction_deg: case.friction_deg,
         mode: case.mode,
-        ..ModelParameters::default()
-    };
-    let mut model: Model = Model::new(params)?;
-    let stone = MaterialId(0);
-    let steel = MaterialId(1);
-    let law = CoulombSlip::dry(case.kn, case.ks, case.friction_deg)?;
-    model.set_joint_law(stone, stone, law)?;
-    model.set_joint_law(stone, steel, law)?;
+    })?;
     model.set_damping(Damping::Local {
         alpha: case.local_damping,
     })?;
-    for b in &arch.blocks {
-        model.add_block(b.clone())?;
-    }
     // The plate: a box seated on the extrados of voussoir 5, turned with its slope.
     let centre = arch.extrados_midpoint(VOUSSOIR);
     let n = arch.extrados_normal(VOUSSOIR);
@@ -200,7 +187,7 @@ pub fn build(case: &StaticCase) -> Result<StaticModel> {
     let plate = model.add_block(
         local
             .transformed(pose)
-            .with_material(steel)
+            .with_material(super::STEEL)
             .with_fixity(plate_fixity(0.0)),
     )?;
     let joints = arch.joint_refs();

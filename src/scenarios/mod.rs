@@ -4,3 +4,51 @@
 
 pub mod arch_impact;
 pub mod arch_static;
+
+use crate::build::arch::{Arch, ArchSpec};
+use crate::constitutive::{CoulombSlip, MaterialId};
+use crate::contact::DisplacementMode;
+use crate::error::Result;
+use crate::geometry::{ContactParameters, SubcontactDensity};
+use crate::math::{Real, Vector};
+use crate::model::{Model, ModelParameters};
+
+/// Material of the stones.
+pub const STONE: MaterialId = MaterialId(0);
+/// Material of the steel loading parts (plate, seat, impactor).
+pub const STEEL: MaterialId = MaterialId(1);
+
+/// The joint parameters shared by the scenarios.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ArchJoints {
+    pub width: Real,
+    pub per_edge: u16,
+    pub kn: Real,
+    pub ks: Real,
+    pub friction_deg: Real,
+    pub mode: DisplacementMode,
+}
+
+/// The reference arch in a model with gravity along −y and the dry Coulomb joint between every
+/// pair of stone and steel (the paper gives one joint law); blocks in [`Arch::blocks`] order.
+pub(crate) fn reference_arch_model(j: ArchJoints) -> Result<(Model, Arch)> {
+    let arch = Arch::new(&ArchSpec::reference(j.width))?;
+    let params = ModelParameters {
+        gravity: Vector::new(0.0, -9.81, 0.0),
+        contact: ContactParameters {
+            density: SubcontactDensity::PerEdge(j.per_edge),
+            ..ContactParameters::default()
+        },
+        mode: j.mode,
+        ..ModelParameters::default()
+    };
+    let mut model: Model = Model::new(params)?;
+    let law = CoulombSlip::dry(j.kn, j.ks, j.friction_deg)?;
+    for (a, b) in [(STONE, STONE), (STONE, STEEL), (STEEL, STEEL)] {
+        model.set_joint_law(a, b, law)?;
+    }
+    for b in &arch.blocks {
+        model.add_block(b.clone())?;
+    }
+    Ok((model, arch))
+}
