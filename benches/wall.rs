@@ -52,14 +52,13 @@ fn settle_step(bencher: divan::Bencher, blocks: usize) {
         .bench_local(|| model.step().expect("step"));
 }
 
-/// Writing one ParaView frame (blocks as polyhedron cells) of a settled wall.
+/// Writing one ParaView frame (blocks as polyhedron cells, sub-contacts as points, `.pvd`
+/// collections) of a settled wall.
 #[divan::bench(args = [10_000], sample_count = 5, sample_size = 1)]
-fn write_vtu_frame(bencher: divan::Bencher, blocks: usize) {
+fn write_paraview_frame(bencher: divan::Bencher, blocks: usize) {
     let model = wall(blocks);
     let dir = std::env::temp_dir().join(format!("voussoir-bench-vtu-{}", std::process::id()));
-    let path = dir.join("wall.vtu");
-    bencher.bench_local(|| {
-        voussoir::io::vtk::write_blocks(&path, model.blocks(), |i| *model.blocks()[i].initial_pose()).expect("write")
-    });
+    let mut series = voussoir::io::vtk::Series::new(&dir, "wall");
+    bencher.bench_local(|| series.write_frame(&model).expect("write"));
     std::fs::remove_dir_all(&dir).ok();
 }
