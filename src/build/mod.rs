@@ -1,6 +1,8 @@
 //! Generators of block assemblies used by examples, tests and users.
 
 pub mod arch;
+mod vault;
 mod wall;
 
-pub use wall::{running_bond_wall, WallSpec};
+pub use vault::{barrel_vault, BarrelVaultSpec};
+pub use wall::{multi_leaf_wall, running_bond_wall, MultiLeafSpec, WallSpec};

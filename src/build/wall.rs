@@ -94,3 +94,82 @@ pub fn running_bond_wall(spec: &WallSpec) -> Result<Vec<RigidBlock>> {
     }
     Ok(blocks)
 }
+
+/// A multi-leaf wall: `leaves` running-bond leaves side by side across the thickness (along `y`),
+/// each with its own brick size, on one fixed base; the joints between leaves are plain
+/// (collar joints, no through-stones).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MultiLeafSpec {
+    /// Length of the wall (m), along `x`.
+    pub length: Real,
+    /// Height of the wall (m).
+    pub height: Real,
+    /// Brick size of each leaf, outer to outer (m).
+    pub leaves: Vec<Vector>,
+    /// Density (kg/m³).
+    pub density: Real,
+    /// Material of the bricks and the base.
+    pub material: MaterialId,
+}
+
+impl Default for MultiLeafSpec {
+    /// A three-leaf wall: two brick leaves around a core of smaller stones.
+    fn default() -> Self {
+        Self {
+            length: 2.0,
+            height: 1.0,
+            leaves: vec![
+                Vector::new(0.25, 0.12, 0.065),
+                Vector::new(0.15, 0.2, 0.1),
+                Vector::new(0.25, 0.12, 0.065),
+            ],
+            density: 2000.0,
+            material: MaterialId(0),
+        }
+    }
+}
+
+/// Builds a multi-leaf wall; the first block is the fixed base. Each leaf has as many whole
+/// courses as fit the height and as many bricks as fit the length (so its length is rounded to
+/// whole bricks).
+///
+/// ```
+/// use voussoir::build::{multi_leaf_wall, MultiLeafSpec};
+/// let blocks = multi_leaf_wall(&MultiLeafSpec::default())?;
+/// assert!(blocks.len() > 300);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+///
+/// # Errors
+/// [`crate::Error::InvalidParameter`] for non-positive sizes.
+pub fn multi_leaf_wall(spec: &MultiLeafSpec) -> Result<Vec<RigidBlock>> {
+    positive("wall.length", spec.length)?;
+    positive("wall.height", spec.height)?;
+    positive("wall.leaves", spec.leaves.len() as Real)?;
+    let thickness: Real = spec.leaves.iter().map(|b| b.y).sum();
+    let mut blocks = vec![RigidBlock::cuboid(
+        "base",
+        Vector::new(-0.5, -0.5, -0.2),
+        Vector::new(spec.length + 0.5, thickness + 0.5, 0.0),
+        spec.density,
+    )?
+    .with_fixity(Fixity::FIXED)
+    .with_material(spec.material)];
+    let mut y0 = 0.0;
+    for brick in &spec.leaves {
+        let leaf_spec = WallSpec {
+            bricks_per_course: ((spec.length / brick.x).floor() as usize).max(1),
+            courses: ((spec.height / brick.z).floor() as usize).max(1),
+            brick: *brick,
+            density: spec.density,
+            material: spec.material,
+            base_material: spec.material,
+        };
+        let shift = crate::math::Pose::from_translation(Vector::new(0.0, y0, 0.0));
+        for b in running_bond_wall(&leaf_spec)?.into_iter().skip(1) {
+            blocks.push(b.transformed(shift));
+        }
+        y0 += brick.y;
+    }
+    Ok(blocks)
+}

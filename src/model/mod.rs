@@ -119,6 +119,27 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     monitors: Vec<(String, Monitor)>,
     history: History,
     monitor_interval: u64,
+    timings: Timings,
+}
+
+/// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Timings {
+    /// Broad and narrow phase, sub-contact history transfer and the critical step.
+    pub detection: Real,
+    /// Joint kinematics, laws and force assembly.
+    pub contacts: Real,
+    /// Central difference, energies and checks.
+    pub integration: Real,
+    /// Steps timed.
+    pub steps: u64,
+}
+
+impl Timings {
+    /// Total time (s).
+    pub fn total(&self) -> Real {
+        self.detection + self.contacts + self.integration
+    }
 }
 
 impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
@@ -170,6 +191,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             monitors: Vec::new(),
             history: History::default(),
             monitor_interval: 1,
+            timings: Timings::default(),
         })
     }
 
@@ -432,6 +454,16 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.monitor_interval
     }
 
+    /// Time spent per stage (wall clock).
+    pub fn timings(&self) -> &Timings {
+        &self.timings
+    }
+
+    /// Restarts the stage timers.
+    pub fn reset_timings(&mut self) {
+        self.timings = Timings::default();
+    }
+
     /// The integrator's damping model.
     pub fn damping(&self) -> Damping {
         self.integrator.damping()
@@ -454,16 +486,24 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// [`Error::TimeStepTooLarge`] for a fixed step above the critical one;
     /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway.
     pub fn step(&mut self) -> Result<()> {
+        let started = std::time::Instant::now();
         if !self.started {
             self.start()?;
         } else if self.params.mode == DisplacementMode::Large && self.needs_detection() {
             self.detect()?;
         }
+        let detected = std::time::Instant::now();
         self.compute_forces();
+        let forces = std::time::Instant::now();
         self.account_energy_before_advance();
         self.integrator
             .advance(&mut self.blocks, &self.forces, self.dt, &mut self.records);
         self.account_energy();
+        let t = &mut self.timings;
+        t.detection += (detected - started).as_secs_f64();
+        t.contacts += (forces - detected).as_secs_f64();
+        t.integration += forces.elapsed().as_secs_f64();
+        t.steps += 1;
         self.step += 1;
         self.time += self.dt;
         self.check_divergence()?;
