@@ -90,10 +90,28 @@ impl Polyhedron {
     /// ```
     pub fn from_hull(name: &str, points: &[Vector]) -> Result<PlacedPolyhedron> {
         check_points(name, points)?;
-        let (verts, tris) = try_convex_hull(points).map_err(|e| Error::DegenerateGeometry {
+        // parry's hull loses the thin direction of slender boxes (a 100 m × 0.3 m × 0.05 m slab
+        // came out flat). An axis scaling is affine, so it maps the hull onto the hull: compute it
+        // in coordinates scaled to the unit box, then scale back.
+        let (mut lo, mut hi) = (Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY));
+        for p in points {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        let extent = hi - lo;
+        if extent.min_element() <= 1e-12 * extent.max_element() {
+            return Err(Error::DegenerateGeometry {
+                block: name.to_owned(),
+                reason: "the vertices are flat (no extent in some direction)".into(),
+            });
+        }
+        let centre = 0.5 * (lo + hi);
+        let unit: Vec<Vector> = points.iter().map(|p| (*p - centre) / extent).collect();
+        let (verts, tris) = try_convex_hull(&unit).map_err(|e| Error::DegenerateGeometry {
             block: name.to_owned(),
             reason: format!("convex hull failed: {e:?}"),
         })?;
+        let verts = verts.into_iter().map(|v| v * extent + centre).collect();
         Self::from_triangles(name, verts, &tris)
     }
 
@@ -415,6 +433,24 @@ mod tests {
         assert!((p.pose.translation - c0).length() < 1e-12);
         let total_area: Real = p.shape.faces().iter().map(|f| f.area).sum();
         assert!((total_area - 2.0 * (a * b + b * c + a * c)).abs() < 1e-12);
+    }
+
+    /// parry's hull alone flattens this slab (volume 0); the scaled hull must not.
+    #[test]
+    fn slender_slab_keeps_its_volume() {
+        let corners: Vec<Vector> = (0..8)
+            .map(|i| {
+                Vector::new(
+                    if i & 1 == 0 { -0.1 } else { 100.0 },
+                    if i & 2 == 0 { -0.1 } else { 0.2 },
+                    if i & 4 == 0 { -0.05 } else { 0.0 },
+                )
+            })
+            .collect();
+        let p = Polyhedron::from_hull("slab", &corners).unwrap();
+        let v = 100.1 * 0.3 * 0.05;
+        assert!((p.shape.volume() - v).abs() < 1e-12 * v, "{}", p.shape.volume());
+        assert_eq!(p.shape.faces().len(), 6);
     }
 
     #[test]
