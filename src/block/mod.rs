@@ -334,6 +334,10 @@ impl RigidBlock {
 }
 
 impl RigidBlock {
+    pub(crate) fn shape_face_count(&self) -> usize {
+        self.shape.faces().len()
+    }
+
     pub(crate) fn restore(&mut self) -> Result<()> {
         self.shape.restore()?;
         self.validate()

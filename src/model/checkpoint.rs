@@ -143,7 +143,19 @@ where
         }
         let mut next = 0usize;
         for (k, p) in snap.pairs.iter().enumerate() {
-            let ok = (p.a as usize) < n
+            let faces_ok = match p.kind {
+                crate::geometry::ContactKind::FaceFace { face_a, face_b } => {
+                    (p.a as usize) < n
+                        && (p.b as usize) < n
+                        && (face_a as usize) < snap.blocks[p.a as usize].shape_face_count()
+                        && (face_b as usize) < snap.blocks[p.b as usize].shape_face_count()
+                }
+                crate::geometry::ContactKind::Point { .. } => true,
+            };
+            let sorted = k == 0 || (snap.pairs[k - 1].a, snap.pairs[k - 1].b) < (p.a, p.b);
+            let ok = faces_ok
+                && sorted
+                && (p.a as usize) < n
                 && (p.b as usize) < n
                 && p.a < p.b
                 && (p.law as usize) < snap.joints.laws().len()
@@ -194,9 +206,6 @@ where
         }
         model.scratch.force_full_detection = !model.started;
         model.rebuild_block_index();
-        if model.started {
-            model.refresh_bounds_only();
-        }
         Ok(model)
     }
 

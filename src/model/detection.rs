@@ -248,7 +248,9 @@ impl<L: ConstitutiveLaw> Model<L> {
         sc.force_full_detection = false;
         self.detections += 1;
         self.rebuild_block_index();
-        if stiffer || self.critical.is_none() {
+        // A forced full detection follows a change of laws, parameters, fixity or velocities:
+        // the step is re-evaluated then too.
+        if stiffer || full || self.critical.is_none() {
             self.refresh_time_step()
         } else {
             Ok(())
@@ -275,15 +277,6 @@ impl<L: ConstitutiveLaw> Model<L> {
                 fill[k] += 1;
             }
         }
-    }
-
-    /// Recomputes the per-block stiffness bounds without touching `dt` (after a restart).
-    pub(super) fn refresh_bounds_only(&mut self) {
-        let dt = self.dt;
-        let critical = self.critical;
-        let _ = self.refresh_time_step();
-        self.dt = dt;
-        self.critical = critical;
     }
 
     /// Re-evaluates the critical step from the current contacts and each block's potential

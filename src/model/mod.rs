@@ -224,8 +224,13 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Replaces the integrator.
     pub fn set_integrator(&mut self, integrator: impl Integrator + 'static) -> Result<()> {
         integrator.damping().validate()?;
-        self.integrator = Box::new(integrator);
-        self.refresh_time_step()
+        let old = std::mem::replace(&mut self.integrator, Box::new(integrator));
+        if let Err(e) = self.refresh_time_step() {
+            self.integrator = old;
+            let _ = self.refresh_time_step();
+            return Err(e);
+        }
+        Ok(())
     }
 
     /// Central difference with the given damping (shortcut for [`Model::set_integrator`]).
@@ -279,7 +284,15 @@ impl<L: ConstitutiveLaw> Model<L> {
             *b = b.clone().with_fixity(old);
             return Err(e);
         }
-        self.refresh_time_step()
+        // A released block may touch blocks it had no contact with while both were fixed.
+        self.scratch.force_full_detection = true;
+        if let Err(e) = self.refresh_time_step() {
+            let b = self.block_mut(id)?;
+            *b = b.clone().with_fixity(old);
+            let _ = self.refresh_time_step();
+            return Err(e);
+        }
+        Ok(())
     }
 
     /// Sets a block's velocity (m/s) and angular velocity (rad/s). During a run, the change of
@@ -297,6 +310,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let before = b.kinetic_energy();
         *b = b.clone().with_velocity(velocity, angular_velocity);
         let after = b.kinetic_energy();
+        self.scratch.force_full_detection = true;
         // Kinetic energy given by the user counts as energy put in.
         if self.started {
             self.energy.initial_kinetic += after - before;
@@ -489,7 +503,9 @@ impl<L: ConstitutiveLaw> Model<L> {
         let started = std::time::Instant::now();
         if !self.started {
             self.start()?;
-        } else if self.params.mode == DisplacementMode::Large && self.needs_detection() {
+        } else if self.scratch.force_full_detection
+            || (self.params.mode == DisplacementMode::Large && self.needs_detection())
+        {
             self.detect()?;
         }
         let detected = std::time::Instant::now();
