@@ -18,9 +18,12 @@ pub enum SubcontactDensity {
     /// `n` sub-contacts along each edge of the host face's bounding rectangle (`n × n` cells);
     /// the reference paper uses 15.
     PerEdge(u16),
-    /// Square cells of this side (m).
+    /// Nodes at most this far apart (m); at most 65,535 nodes along a face edge.
     Spacing(Real),
 }
+
+/// Largest number of sub-contact nodes along a face edge (keys hold 16-bit indices).
+const MAX_NODES_PER_EDGE: u32 = 65_535;
 
 /// Parameters of contact detection and discretisation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -347,6 +350,8 @@ fn face_face(
             ((size.y / h).ceil() as u32).max(1) + 1,
         ),
     };
+    // Sub-contact keys hold 16-bit grid indices.
+    let (nu, nv) = (nu.min(MAX_NODES_PER_EDGE), nv.min(MAX_NODES_PER_EDGE));
     let spacing = |n: u32, len: Real| if n > 1 { len / (n - 1) as Real } else { len };
     let cell = DVec2::new(spacing(nu, size.x), spacing(nv, size.y));
     let first = lo
