@@ -155,8 +155,32 @@ impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
     }
 }
 
-/// Smallest number of items per rayon task in the contact loops.
+/// Smallest number of items per rayon task in the block loops.
 const ITEMS_PER_TASK: usize = 512;
+/// Smallest number of contacts per rayon task.
+const CONTACTS_PER_TASK: usize = 32;
+
+/// The start of the sub-contact vector, shared with the tasks of the contact loop, each of which
+/// touches only its own contact's range.
+struct SubsPtr<S>(*mut S);
+
+impl<S> Clone for SubsPtr<S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S> Copy for SubsPtr<S> {}
+// SAFETY: used only in `compute_forces`, where each task dereferences a disjoint range.
+unsafe impl<S: Send> Send for SubsPtr<S> {}
+// SAFETY: as above; the pointer itself is only read.
+unsafe impl<S: Send> Sync for SubsPtr<S> {}
+
+impl<S> SubsPtr<S> {
+    fn get(self) -> *mut S {
+        self.0
+    }
+}
 
 impl<L: ConstitutiveLaw> Model<L> {
     /// An empty model.
@@ -547,34 +571,27 @@ impl<L: ConstitutiveLaw> Model<L> {
             mode: self.params.mode,
         };
         let blocks = &self.blocks;
-        if ctx.mode == DisplacementMode::Large {
-            self.pairs.par_iter_mut().with_min_len(ITEMS_PER_TASK).for_each(|p| {
-                let (a, b) = (&blocks[p.a as usize], &blocks[p.b as usize]);
-                update_pair_geometry(p, &a.state, &b.state, a.shape(), b.shape());
-            });
-        }
-        let pairs = &self.pairs;
         let laws = self.joints.laws();
-        self.subs
-            .par_iter_mut()
-            .with_min_len(ITEMS_PER_TASK)
-            .zip(self.sub_pair.par_iter())
-            .for_each(|(s, &pi)| {
-                let p = &pairs[pi as usize];
-                update_subcontact(
-                    s,
-                    p,
-                    &blocks[p.a as usize].state,
-                    &blocks[p.b as usize].state,
-                    &laws[p.law as usize],
-                    ctx,
-                );
-            });
-        let subs = &self.subs;
-        self.pairs.par_iter_mut().with_min_len(ITEMS_PER_TASK).for_each(|p| {
-            let r = p.range();
-            let (a, b) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
-            sum_contact(p, &subs[r], a, b, ctx.mode);
+        let subs = SubsPtr(self.subs.as_mut_ptr());
+        let total_subs = self.subs.len();
+        // One pass per contact: its plane, its sub-contacts (in order), its resultant.
+        self.pairs.par_iter_mut().with_min_len(CONTACTS_PER_TASK).for_each(|p| {
+            let (a, b) = (&blocks[p.a as usize], &blocks[p.b as usize]);
+            if ctx.mode == DisplacementMode::Large {
+                update_pair_geometry(p, &a.state, &b.state, a.shape(), b.shape());
+            }
+            let range = p.range();
+            assert!(range.end <= total_subs, "sub-contact range out of bounds");
+            // SAFETY: the contacts' sub-contact ranges are disjoint and within `subs` (built so
+            // by detection, checked on checkpoint load, asserted above), and `self.subs` is not
+            // otherwise borrowed during this loop, so every task has exclusive access to its
+            // own range.
+            let own = unsafe { std::slice::from_raw_parts_mut(subs.get().add(range.start), range.len()) };
+            let law = &laws[p.law as usize];
+            for s in own.iter_mut() {
+                update_subcontact(s, p, &a.state, &b.state, law, ctx);
+            }
+            sum_contact(p, own, &a.state, &b.state, ctx.mode);
         });
         let gravity = self.params.gravity;
         let pairs = &self.pairs;
