@@ -2,7 +2,7 @@
 //! settling run the unbalanced-force ratio is small and no block has moved by more than a small
 //! fraction of its size (elastic settlement on the joint springs only).
 
-use voussoir::build::{barrel_vault, multi_leaf_wall, BarrelVaultSpec, MultiLeafSpec};
+use voussoir::build::{barrel_vault, dome, multi_leaf_wall, BarrelVaultSpec, DomeSpec, MultiLeafSpec};
 use voussoir::prelude::*;
 
 /// Joint normal stiffness (Pa/m): stone-like, so that elastic settlements are a fraction of a
@@ -45,6 +45,18 @@ fn barrel_vault_settles() -> Result<()> {
     println!("barrel vault, {n} blocks: largest settlement {moved:.3e} m");
     // Elastic settlement of a 2 m vault on 10 GPa/m joints is a fraction of a millimetre; a
     // mechanism would move by centimetres.
+    assert!(moved < 1e-3, "moved {moved} m");
+    Ok(())
+}
+
+#[test]
+fn dome_settles() -> Result<()> {
+    let spec = DomeSpec {
+        per_course: vec![24, 22, 20, 16, 12],
+        ..DomeSpec::with_blocks(100)
+    };
+    let (moved, n) = settle(dome(&spec)?, Vector::new(0.0, -9.81, 0.0), 0.2)?;
+    println!("dome, {n} blocks: largest settlement {moved:.3e} m");
     assert!(moved < 1e-3, "moved {moved} m");
     Ok(())
 }

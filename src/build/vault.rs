@@ -1,6 +1,7 @@
-//! Barrel vaults of radial-jointed voussoirs on fixed supports.
+//! Barrel vaults and domes of voussoirs on fixed supports.
 //!
-//! Coordinates: `y` up; a barrel vault spans along `x` and runs along `z`.
+//! Coordinates: `y` up; a barrel vault spans along `x` and runs along `z`; a dome is centred on
+//! the `y` axis with its springing on `y = 0`.
 
 use serde::{Deserialize, Serialize};
 
@@ -98,6 +99,127 @@ pub fn barrel_vault(spec: &BarrelVaultSpec) -> Result<Vec<RigidBlock>> {
                 .collect();
             blocks.push(
                 RigidBlock::from_vertices(&format!("ring {r} voussoir {k}"), &pts, spec.density)?
+                    .with_material(spec.material),
+            );
+        }
+    }
+    Ok(blocks)
+}
+
+/// A hemispherical dome of horizontal courses with an open oculus, on a fixed ring beam.
+///
+/// Course `c` holds `per_course[c]` voussoirs between meridian planes; its bed joints are
+/// **horizontal planes** (at the heights where the intrados reaches the course's latitudes), so
+/// that courses of different voussoir counts share plane bed faces. Alternate courses are
+/// staggered by half a voussoir.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DomeSpec {
+    /// Intrados radius (m).
+    pub radius: Real,
+    /// Shell thickness (m).
+    pub thickness: Real,
+    /// Voussoirs in each course, from the springing up.
+    pub per_course: Vec<usize>,
+    /// Latitude of the oculus rim on the intrados (rad), in `(0, π/2)`.
+    pub oculus_angle: Real,
+    /// Density (kg/m³).
+    pub density: Real,
+    /// Material of every block.
+    pub material: MaterialId,
+}
+
+impl DomeSpec {
+    /// A dome of about `blocks` voussoirs of roughly square stones, oculus at 75°.
+    pub fn with_blocks(blocks: usize) -> Self {
+        let courses = ((blocks as Real / 4.0).sqrt().round() as usize).max(2);
+        let oculus: Real = 75f64.to_radians();
+        let weights: Vec<Real> = (0..courses)
+            .map(|c| (oculus * (c as Real + 0.5) / courses as Real).cos())
+            .collect();
+        let total: Real = weights.iter().sum();
+        let per_course = weights
+            .iter()
+            .map(|w| ((blocks as Real * w / total).round() as usize).max(3))
+            .collect();
+        Self {
+            radius: 5.0,
+            thickness: 0.4,
+            per_course,
+            oculus_angle: oculus,
+            density: 2200.0,
+            material: MaterialId(0),
+        }
+    }
+}
+
+/// Builds a dome; the first `per_course[0]` blocks form the fixed ring beam.
+///
+/// ```
+/// use voussoir::build::{dome, DomeSpec};
+/// let spec = DomeSpec { per_course: vec![12, 10, 8], ..DomeSpec::with_blocks(30) };
+/// let blocks = dome(&spec)?;
+/// assert_eq!(blocks.len(), 12 + 12 + 10 + 8);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+///
+/// # Errors
+/// [`Error::InvalidParameter`] for bad dimensions or a course with fewer than 3 voussoirs.
+pub fn dome(spec: &DomeSpec) -> Result<Vec<RigidBlock>> {
+    positive("dome.radius", spec.radius)?;
+    positive("dome.thickness", spec.thickness)?;
+    positive("dome.density", spec.density)?;
+    positive("dome.courses", spec.per_course.len() as Real)?;
+    crate::error::in_range(
+        "dome.oculus_angle",
+        spec.oculus_angle,
+        1e-3,
+        std::f64::consts::FRAC_PI_2,
+        "must lie in (0, π/2) rad",
+    )?;
+    for (c, &n) in spec.per_course.iter().enumerate() {
+        at_least(&format!("dome.per_course[{c}]"), n, 3)?;
+    }
+    let (ri, re) = (spec.radius, spec.radius + spec.thickness);
+    let courses = spec.per_course.len();
+    // Heights of the bed joints and the horizontal radii of intrados and extrados there.
+    let height = |c: usize| ri * (spec.oculus_angle * c as Real / courses as Real).sin();
+    let rings = |h: Real| ((ri * ri - h * h).max(0.0).sqrt(), (re * re - h * h).sqrt());
+    let point = |rho: Real, lon: Real, h: Real| Vector::new(rho * lon.cos(), h, rho * lon.sin());
+    let tau = std::f64::consts::TAU;
+    let mut blocks = Vec::new();
+    let n0 = spec.per_course[0];
+    for k in 0..n0 {
+        let (l0, l1) = (tau * k as Real / n0 as Real, tau * (k + 1) as Real / n0 as Real);
+        let pts: Vec<Vector> = [l0, l1]
+            .iter()
+            .flat_map(|&l| {
+                [
+                    point(ri, l, 0.0),
+                    point(re, l, 0.0),
+                    point(ri, l, -0.3),
+                    point(re, l, -0.3),
+                ]
+            })
+            .collect();
+        blocks.push(
+            RigidBlock::from_vertices(&format!("ring beam {k}"), &pts, spec.density)?
+                .with_fixity(Fixity::FIXED)
+                .with_material(spec.material),
+        );
+    }
+    for (c, &n) in spec.per_course.iter().enumerate() {
+        let (h0, h1) = (height(c), height(c + 1));
+        let ((i0, e0), (i1, e1)) = (rings(h0), rings(h1));
+        let shift = if c % 2 == 0 { 0.0 } else { 0.5 };
+        for k in 0..n {
+            let l0 = tau * (k as Real + shift) / n as Real;
+            let l1 = tau * (k as Real + 1.0 + shift) / n as Real;
+            let pts: Vec<Vector> = [l0, l1]
+                .iter()
+                .flat_map(|&l| [point(i0, l, h0), point(e0, l, h0), point(i1, l, h1), point(e1, l, h1)])
+                .collect();
+            blocks.push(
+                RigidBlock::from_vertices(&format!("course {c} voussoir {k}"), &pts, spec.density)?
                     .with_material(spec.material),
             );
         }
