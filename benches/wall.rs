@@ -62,3 +62,33 @@ fn write_paraview_frame(bencher: divan::Bencher, blocks: usize) {
     bencher.bench_local(|| series.write_frame(&model).expect("write"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Candidate pairs of a settled wall: parry's BVH (what the model uses) against a uniform grid.
+#[divan::bench(args = [10_000, 100_000], sample_count = 10, sample_size = 1)]
+fn broad_phase_bvh(bencher: divan::Bencher, blocks: usize) {
+    let model = wall(blocks);
+    let mut bp = voussoir::geometry::BroadPhase::default();
+    let mut out = Vec::new();
+    bencher.bench_local(|| {
+        bp.pairs(
+            model.blocks().iter().map(|b| (b.shape(), &b.state().pose)),
+            1e-3,
+            &mut out,
+        )
+    });
+}
+
+/// As [`broad_phase_bvh`] with the uniform cell grid.
+#[divan::bench(args = [10_000, 100_000], sample_count = 10, sample_size = 1)]
+fn broad_phase_grid(bencher: divan::Bencher, blocks: usize) {
+    let model = wall(blocks);
+    let mut bp = voussoir::geometry::BroadPhase::default();
+    let mut out = Vec::new();
+    bencher.bench_local(|| {
+        bp.pairs_grid(
+            model.blocks().iter().map(|b| (b.shape(), &b.state().pose)),
+            1e-3,
+            &mut out,
+        )
+    });
+}

@@ -156,9 +156,11 @@ impl DomeSpec {
 ///
 /// ```
 /// use voussoir::build::{dome, DomeSpec};
-/// let spec = DomeSpec { per_course: vec![12, 10, 8], ..DomeSpec::with_blocks(30) };
+/// let spec = DomeSpec { per_course: vec![16, 14, 12], ..DomeSpec::with_blocks(42) };
 /// let blocks = dome(&spec)?;
-/// assert_eq!(blocks.len(), 12 + 12 + 10 + 8);
+/// assert_eq!(blocks.len(), 16 + 16 + 14 + 12);
+/// // Too coarse a course for the 0.4 m shell: its staggered bed faces would not overlap.
+/// assert!(dome(&DomeSpec { per_course: vec![16, 8], ..spec }).is_err());
 /// # Ok::<(), voussoir::Error>(())
 /// ```
 ///
@@ -178,6 +180,16 @@ pub fn dome(spec: &DomeSpec) -> Result<Vec<RigidBlock>> {
     )?;
     for (c, &n) in spec.per_course.iter().enumerate() {
         at_least(&format!("dome.per_course[{c}]"), n, 3)?;
+        // Staggered chord faces overlap across a bed joint only if the shell is thicker than
+        // the chord's sagitta: t > R (1/cos(π/n) − 1).
+        let needed = spec.radius * (1.0 / (std::f64::consts::PI / n as Real).cos() - 1.0);
+        if spec.thickness <= needed {
+            return Err(Error::InvalidParameter {
+                name: format!("dome.per_course[{c}]"),
+                value: n as Real,
+                expected: "too few voussoirs for the shell thickness: staggered bed faces would not overlap",
+            });
+        }
     }
     let (ri, re) = (spec.radius, spec.radius + spec.thickness);
     let courses = spec.per_course.len();

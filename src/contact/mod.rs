@@ -109,7 +109,7 @@ impl ContactPair {
         self.count as usize
     }
     pub(crate) fn range(&self) -> std::ops::Range<usize> {
-        self.first as usize..(self.first + self.count) as usize
+        self.first as usize..self.first as usize + self.count as usize
     }
 }
 

@@ -153,21 +153,23 @@ where
                 crate::geometry::ContactKind::Point { .. } => true,
             };
             let sorted = k == 0 || (snap.pairs[k - 1].a, snap.pairs[k - 1].b) < (p.a, p.b);
+            let (start, end) = (p.first as usize, p.first as usize + p.count as usize);
             let ok = faces_ok
                 && sorted
                 && (p.a as usize) < n
                 && (p.b as usize) < n
                 && p.a < p.b
                 && (p.law as usize) < snap.joints.laws().len()
-                && p.first as usize == next
-                && snap.sub_pair[p.range()].iter().all(|&q| q as usize == k);
-            if !ok || p.range().end > snap.subs.len() {
+                && start == next
+                && end <= snap.subs.len()
+                && snap.sub_pair[start..end].iter().all(|&q| q as usize == k);
+            if !ok {
                 return Err(corrupt(
                     &format!("pairs[{k}]"),
                     "inconsistent block, law or sub-contact indices",
                 ));
             }
-            next = p.range().end;
+            next = end;
         }
         if next != snap.subs.len() {
             return Err(corrupt("subs", "sub-contacts not covered by the contacts"));

@@ -245,16 +245,16 @@ impl<L: ConstitutiveLaw> Model<L> {
                 self.ref_poses[i] = self.blocks[i].state.pose;
             }
         }
-        sc.force_full_detection = false;
         self.detections += 1;
         self.rebuild_block_index();
-        // A forced full detection follows a change of laws, parameters, fixity or velocities:
-        // the step is re-evaluated then too.
+        // A forced full detection follows a change of laws, parameters or fixity: the step is
+        // re-evaluated then too. The flag stays set if that fails, so the error repeats rather
+        // than the run going on with an unstable step.
         if stiffer || full || self.critical.is_none() {
-            self.refresh_time_step()
-        } else {
-            Ok(())
+            self.refresh_time_step()?;
         }
+        self.scratch.force_full_detection = false;
+        Ok(())
     }
 
     pub(super) fn rebuild_block_index(&mut self) {

@@ -334,7 +334,6 @@ impl<L: ConstitutiveLaw> Model<L> {
         let before = b.kinetic_energy();
         *b = b.clone().with_velocity(velocity, angular_velocity);
         let after = b.kinetic_energy();
-        self.scratch.force_full_detection = true;
         // Kinetic energy given by the user counts as energy put in.
         if self.started {
             self.energy.initial_kinetic += after - before;
@@ -527,10 +526,14 @@ impl<L: ConstitutiveLaw> Model<L> {
         let started = std::time::Instant::now();
         if !self.started {
             self.start()?;
-        } else if self.scratch.force_full_detection
-            || (self.params.mode == DisplacementMode::Large && self.needs_detection())
-        {
-            self.detect()?;
+        } else if self.params.mode == DisplacementMode::Large {
+            if self.scratch.force_full_detection || self.needs_detection() {
+                self.detect()?;
+            }
+        } else if self.scratch.force_full_detection {
+            // Small displacements keep the initial contact geometry: only the step is re-evaluated.
+            self.refresh_time_step()?;
+            self.scratch.force_full_detection = false;
         }
         let detected = std::time::Instant::now();
         self.compute_forces();
@@ -581,7 +584,10 @@ impl<L: ConstitutiveLaw> Model<L> {
                 update_pair_geometry(p, &a.state, &b.state, a.shape(), b.shape());
             }
             let range = p.range();
-            assert!(range.end <= total_subs, "sub-contact range out of bounds");
+            assert!(
+                range.start <= range.end && range.end <= total_subs,
+                "sub-contact range out of bounds"
+            );
             // SAFETY: the contacts' sub-contact ranges are disjoint and within `subs` (built so
             // by detection, checked on checkpoint load, asserted above), and `self.subs` is not
             // otherwise borrowed during this loop, so every task has exclusive access to its
