@@ -4,7 +4,7 @@
 //! updates per second.
 
 use divan::counter::ItemsCount;
-use voussoir::build::{running_bond_wall, WallSpec};
+use voussoir::build::benchmark_wall;
 use voussoir::prelude::*;
 
 fn main() {
@@ -14,31 +14,7 @@ fn main() {
 /// A wall of about `blocks` bricks, 1/10 as many courses as bricks per course, settled for a few
 /// steps so that the initial contact detection is done.
 fn wall(blocks: usize) -> Model {
-    let per_course = ((blocks as f64 * 10.0).sqrt().round() as usize).max(2);
-    let courses = (blocks / per_course).max(1);
-    let spec = WallSpec {
-        bricks_per_course: per_course,
-        courses,
-        ..WallSpec::default()
-    };
-    let params = ModelParameters {
-        contact: ContactParameters {
-            density: SubcontactDensity::Spacing(0.025),
-            ..ContactParameters::default()
-        },
-        ..ModelParameters::default()
-    };
-    let mut model = Model::new(params).expect("parameters");
-    model
-        .set_joint_law(
-            MaterialId(0),
-            MaterialId(0),
-            CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"),
-        )
-        .expect("law");
-    for b in running_bond_wall(&spec).expect("wall") {
-        model.add_block(b).expect("block");
-    }
+    let mut model = benchmark_wall(blocks).expect("wall");
     model.run_steps(20).expect("settling");
     model
 }

@@ -13,7 +13,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use serde::Serialize;
-use voussoir::build::{running_bond_wall, WallSpec};
+use voussoir::build::benchmark_wall;
 use voussoir::prelude::*;
 
 #[derive(Serialize)]
@@ -78,24 +78,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     let mut runs = Vec::new();
     for n in sizes {
         let started = Instant::now();
-        let per_course = ((n as f64 * 10.0).sqrt().round() as usize).max(2);
-        let spec = WallSpec {
-            bricks_per_course: per_course,
-            courses: (n / per_course).max(1),
-            ..WallSpec::default()
-        };
-        let params = ModelParameters {
-            contact: ContactParameters {
-                density: SubcontactDensity::Spacing(0.025),
-                ..ContactParameters::default()
-            },
-            ..ModelParameters::default()
-        };
-        let mut model: Model = Model::new(params)?;
-        model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
-        for b in running_bond_wall(&spec)? {
-            model.add_block(b)?;
-        }
+        let mut model = benchmark_wall(n)?;
         model.run_steps(20)?;
         let setup = started.elapsed().as_secs_f64();
         model.reset_timings();

@@ -5,4 +5,4 @@ mod vault;
 mod wall;
 
 pub use vault::{barrel_vault, dome, BarrelVaultSpec, DomeSpec};
-pub use wall::{multi_leaf_wall, running_bond_wall, MultiLeafSpec, WallSpec};
+pub use wall::{benchmark_wall, multi_leaf_wall, running_bond_wall, MultiLeafSpec, WallSpec};

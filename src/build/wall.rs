@@ -38,6 +38,45 @@ impl Default for WallSpec {
     }
 }
 
+impl WallSpec {
+    /// A wall of about `blocks` bricks (default bricks), about ten times as long as high.
+    pub fn with_blocks(blocks: usize) -> Self {
+        let per_course = ((blocks as Real * 10.0).sqrt().round() as usize).max(2);
+        Self {
+            bricks_per_course: per_course,
+            courses: (blocks / per_course).max(1),
+            ..Self::default()
+        }
+    }
+}
+
+/// The wall used by the benchmarks and the `scaling` example: [`WallSpec::with_blocks`] on its
+/// base, dry Coulomb joints (kn 1 GPa/m, ks 0.4 GPa/m, φ 30°), sub-contacts at most 25 mm apart,
+/// gravity along −z, local damping. Not yet stepped.
+///
+/// # Errors
+/// As [`running_bond_wall`].
+pub fn benchmark_wall(blocks: usize) -> Result<crate::Model> {
+    use crate::geometry::{ContactParameters, SubcontactDensity};
+    let params = crate::ModelParameters {
+        contact: ContactParameters {
+            density: SubcontactDensity::Spacing(0.025),
+            ..ContactParameters::default()
+        },
+        ..crate::ModelParameters::default()
+    };
+    let mut model: crate::Model = crate::Model::new(params)?;
+    model.set_joint_law(
+        MaterialId(0),
+        MaterialId(0),
+        crate::constitutive::CoulombSlip::dry(1e9, 4e8, 30.0)?,
+    )?;
+    for b in running_bond_wall(&WallSpec::with_blocks(blocks))? {
+        model.add_block(b)?;
+    }
+    Ok(model)
+}
+
 /// Builds the blocks of a running-bond wall; the first block is the fixed base.
 ///
 /// ```
