@@ -164,7 +164,10 @@ impl Monitor {
                 component.of(if b.0 > a.0 { f } else { -f })
             }
             Monitor::Energy(term) => {
-                let e = model.energies();
+                let e = match term {
+                    EnergyTerm::Elastic | EnergyTerm::Friction | EnergyTerm::BalanceError => model.energies(),
+                    _ => *model.energy_accumulators(),
+                };
                 match term {
                     EnergyTerm::Kinetic => e.kinetic,
                     EnergyTerm::Elastic => e.elastic,

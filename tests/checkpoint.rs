@@ -97,9 +97,9 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
         assert!(matches!(err, Error::Checkpoint { .. }), "{err}");
     }
     // Inconsistent indices that parse fine.
-    let bad_pair = text.replacen("\"sub_pair\":[0", "\"sub_pair\":[7777", 1);
+    let bad_pair = text.replacen("\"law\":0,\"first\":0,", "\"law\":0,\"first\":7777,", 1);
     assert_ne!(bad_pair, text);
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_pair).expect_err("bad sub_pair");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_pair).expect_err("bad sub-contact range");
     assert!(err.to_string().contains("pairs[0]"), "{err}");
     // A bad law parameter is caught by the law's own validation, with its path.
     let bad_law = text.replacen("\"friction_deg\":25.0", "\"friction_deg\":95.0", 1);

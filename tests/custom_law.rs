@@ -384,7 +384,7 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
     let steady: Vec<&Sample> = samples.iter().filter(|s| s.min_kappa > 1.2 * U_SOFT).collect();
     let residual = steady.iter().map(|s| s.resistance).sum::<f64>() / steady.len() as f64;
     let elastic_slip = last.resistance / (1e8 * area);
-    let e = *model.energies();
+    let e = model.energies();
     let dissipated_closed = weight * tan_phi * last.mean_kappa + COHESION * area * U_SOFT / 2.0;
     println!(
         "peak {peak:.2} N (closed form {peak_closed:.2}), residual {residual:.2} N over {} steps \

@@ -88,7 +88,7 @@ impl EnergyWatch {
     fn observe<L: ConstitutiveLaw>(&mut self, model: &Model<L>) {
         let e = model.energies();
         let step = model.step_count();
-        self.scale = self.scale.max(largest_term(e));
+        self.scale = self.scale.max(largest_term(&e));
         if self.scale < SCALE_FLOOR {
             return;
         }
@@ -129,7 +129,7 @@ fn check_collapse(name: &str, mut model: Model) {
     let top = BlockId(model.blocks().len() as u32 - 1);
     let start = model.block(top).unwrap().state().pose.translation;
     let watch = run_watched(&mut model, 1.0);
-    let e = *model.energies();
+    let e = model.energies();
     let moved = (model.block(top).unwrap().state().pose.translation - start).length();
     println!(
         "{name}: steps {} detections {} moved {moved:.3} m; end {e:?}; balance error {:.3e} J; {watch:?}",
@@ -237,7 +237,7 @@ fn undamped_elastic_stack_conserves_energy() {
         max_friction = max_friction.max(model.energies().friction.abs());
         assert_eq!(model.energies().damping, 0.0, "no damping model, no damping");
     }
-    let e = *model.energies();
+    let e = model.energies();
     println!(
         "undamped: {e:?}; balance error {:.3e} J; max |friction| {max_friction:.3e} J; {watch:?}",
         e.balance_error()

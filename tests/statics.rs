@@ -88,7 +88,7 @@ fn joint_sums(m: &Model, a: BlockId, b: BlockId) -> JointSums {
     for sub in c.subs {
         s.area += sub.area();
         s.normal_force += sub.normal_force();
-        s.first_moment += sub.point() * sub.normal_force();
+        s.first_moment += c.point(sub) * sub.normal_force();
     }
     // The pair's own resultant must agree with the sum over its sub-contacts (same additions,
     // possibly a different order: round-off only).
@@ -287,7 +287,7 @@ fn eccentric(e: f64) -> Eccentric {
     let mut subs = Vec::with_capacity(c.subs.len());
     for sub in c.subs {
         // Back to the material point's initial position: x along the face from its centre.
-        let x0 = b.initial_pose().transform_point(b.local_point(sub.point()));
+        let x0 = b.initial_pose().transform_point(b.local_point(c.point(sub)));
         subs.push((x0.x - face_centre0.x, sub.normal_stress(), sub.normal_force()));
     }
     let sums = joint_sums(&m, base, block);

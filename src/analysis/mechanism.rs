@@ -168,7 +168,7 @@ fn joint_state<L: ConstitutiveLaw>(model: &Model<L>, j: &JointRef, c: &Mechanism
         slip += s.slip() * s.area();
         if s.normal_force() > 0.0 {
             force += s.normal_force();
-            moment += s.point() * s.normal_force();
+            moment += contact.point(s) * s.normal_force();
         } else {
             open += s.area();
         }

@@ -174,8 +174,10 @@ impl ConstitutiveLaw for CoulombSlip {
         }
         f.shear -= s.shear_increment * (self.shear_stiffness * a);
         let limit = cohesion * a + f.normal * tan_phi;
-        let trial = f.shear.length();
-        if trial > limit {
+        // `|F_s| > limit`, without a square root while the joint sticks.
+        let trial_squared = f.shear.length_squared();
+        if limit < 0.0 || trial_squared > limit * limit {
+            let trial = trial_squared.sqrt();
             f.shear *= if trial > 0.0 { limit.max(0.0) / trial } else { 0.0 };
             if cohesion > 0.0 || tensile > 0.0 || self.tan_residual != self.tan_friction {
                 state.failed = true;

@@ -1,12 +1,14 @@
-//! The hot loop: joint kinematics, law update and dashpots at one sub-contact; resultants per pair.
+//! The hot loop: one contact at a time — its plane, then its sub-contacts in order (kinematics,
+//! law, dashpot), summed into the contact's resultant, moments and energy increments in the same
+//! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
 use super::{ContactPair, DisplacementMode, SubContact};
 use crate::block::BlockState;
 use crate::constitutive::{ConstitutiveLaw, JointStatus, JointStep};
-use crate::geometry::{ContactKind, Polyhedron};
-use crate::math::{Real, Vector};
+use crate::geometry::ContactKind;
+use crate::math::{Matrix, Real, Vector};
 
-/// Read-only data shared by all sub-contacts of a step.
+/// Read-only data shared by all contacts of a step.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct KernelContext {
     pub dt: Real,
@@ -15,144 +17,173 @@ pub(crate) struct KernelContext {
     pub mode: DisplacementMode,
 }
 
-/// Updates the pair's plane from the current poses (large-displacement mode).
-pub(crate) fn update_pair_geometry(
-    pair: &mut ContactPair,
-    sa: &BlockState,
-    sb: &BlockState,
-    shape_a: &Polyhedron,
-    shape_b: &Polyhedron,
-) {
-    match pair.kind {
-        ContactKind::FaceFace { face_a, face_b } => {
-            let fa = &shape_a.faces()[face_a as usize];
-            let fb = &shape_b.faces()[face_b as usize];
-            let na = sa.pose.rotation * fa.normal;
-            let nb = sb.pose.rotation * fb.normal;
-            pair.normal = (na - nb).normalize();
-            // Plane of the other face in world coordinates.
-            let (host_n, other_n, other_off, other_pose) = if pair.host_is_a {
-                (na, nb, fb.offset, &sb.pose)
-            } else {
-                (nb, na, fa.offset, &sa.pose)
-            };
-            pair.host_normal = host_n;
-            pair.other_normal = other_n;
-            pair.other_offset = other_off + other_n.dot(other_pose.translation);
-        }
-        ContactKind::Point { normal_local } => {
-            pair.normal = sa.pose.rotation * normal_local;
-        }
-    }
-}
-
-/// One step of one sub-contact: kinematics, law, dashpots, energy increments.
+/// Updates one contact for one step: its plane (large-displacement mode), the forces of its
+/// sub-contacts (`subs` is the contact's own range) and its resultant, moments about both
+/// centroids and energy increments. Sums run in sub-contact order, so the result does not depend
+/// on how contacts are spread over threads.
+///
+/// Everything common to the contact is computed once: the host rotation as a matrix, the
+/// relative velocity field `v_rel(r) = v₀ + Δω × r` with `r` the lever arm from the host
+/// centroid, and the face-face gap `g(r) = g₀ − q·r`; a sub-contact then costs one
+/// matrix-vector product and one cross product for its kinematics and one for its moment.
 #[inline]
-pub(crate) fn update_subcontact<L: ConstitutiveLaw>(
-    sub: &mut SubContact<L::State>,
-    pair: &ContactPair,
+pub(crate) fn update_contact<L: ConstitutiveLaw>(
+    pair: &mut ContactPair,
+    subs: &mut [SubContact<L::State>],
     sa: &BlockState,
     sb: &BlockState,
     law: &L,
     ctx: KernelContext,
 ) {
-    let n = pair.normal;
-    let (p, xa, xb, geometric_gap) = match ctx.mode {
-        DisplacementMode::Large => {
-            let host = if pair.host_is_a { sa } else { sb };
-            let p = host.pose.transform_point(sub.anchor);
-            let gap = match pair.kind {
-                ContactKind::FaceFace { .. } => {
-                    Some((pair.other_offset - pair.other_normal.dot(p)) / pair.other_normal.dot(pair.host_normal))
-                }
-                ContactKind::Point { .. } => None,
-            };
-            (p, sa.pose.translation, sb.pose.translation, gap)
-        }
-        DisplacementMode::Small => (sub.point, pair.ref_a, pair.ref_b, None),
-    };
-    let v_rel = (sb.velocity + sb.angular_velocity.cross(p - xb)) - (sa.velocity + sa.angular_velocity.cross(p - xa));
-    let du = v_rel * ctx.dt;
-    let du_n = n.dot(du);
-    let du_s = du - n * du_n;
-    let gap = geometric_gap.unwrap_or(sub.gap + du_n);
-
-    // Keep last step's shear force in the current plane, with its magnitude.
-    let fs = sub.force.shear;
-    let magnitude = fs.length();
-    if magnitude > 0.0 {
-        let projected = fs - n * n.dot(fs);
-        let len = projected.length();
-        sub.force.shear = if len > 0.0 {
-            projected * (magnitude / len)
-        } else {
-            Vector::ZERO
-        };
-    }
-    let step = JointStep {
-        area: sub.area,
-        normal_displacement: gap,
-        normal_increment: du_n,
-        shear_increment: du_s,
-        normal: n,
-        dt: ctx.dt,
-    };
-    let status = law.update(&step, &mut sub.force, &mut sub.state);
-    if status == JointStatus::Sliding {
-        sub.slip += du_s.length();
-    }
-    let spring = n * sub.force.normal + sub.force.shear;
-    let mut dashpot = Vector::ZERO;
-    if ctx.stiffness_damping > 0.0 && status != JointStatus::Open {
-        let k = law.stiffness();
-        let c = ctx.stiffness_damping * sub.area;
-        dashpot -= n * (c * k.normal * du_n / ctx.dt);
-        if status != JointStatus::Sliding {
-            dashpot -= du_s * (c * k.shear / ctx.dt);
-        }
-    }
-    sub.work = -0.5 * (sub.spring + spring).dot(du);
-    // Trapezoidal, like the spring work: last step's dashpot force is `total − spring`.
-    sub.dashpot_work = -0.5 * (sub.total - sub.spring + dashpot).dot(du);
-    sub.spring = spring;
-    sub.total = spring + dashpot;
-    sub.point = p;
-    sub.gap = gap;
-    sub.status = status;
-    sub.elastic = law.elastic_energy(sub.area, &sub.force, &sub.state);
-}
-
-/// Sums a pair's sub-contacts into its resultant and moments (fixed order: deterministic).
-#[inline]
-pub(crate) fn sum_contact<S>(
-    pair: &mut ContactPair,
-    subs: &[SubContact<S>],
-    sa: &BlockState,
-    sb: &BlockState,
-    mode: DisplacementMode,
-) {
-    let (xa, xb) = match mode {
+    // The normal of the previous step, in which the stored spring forces were composed.
+    let previous_normal = pair.normal;
+    let host = pair.frame(&sa.pose, &sb.pose, ctx.mode);
+    let (xa, xb) = match ctx.mode {
         DisplacementMode::Large => (sa.pose.translation, sb.pose.translation),
         DisplacementMode::Small => (pair.ref_a, pair.ref_b),
     };
-    let mut force = Vector::ZERO;
-    let mut moment_a = Vector::ZERO;
-    let mut moment_b = Vector::ZERO;
-    let (mut normal, mut work, mut dashpot, mut elastic) = (0.0, 0.0, 0.0, 0.0);
-    for s in subs {
-        force += s.total;
-        moment_b += (s.point - xb).cross(s.total);
-        moment_a -= (s.point - xa).cross(s.total);
-        normal += s.force.normal;
-        work += s.work;
-        dashpot += s.dashpot_work;
-        elastic += s.elastic;
+    let xh = host.translation;
+    // Face-face, large displacements: gap(p) = (d − m·p)/(m·h) for the other face's plane
+    // m·x = d and the host face's normal h; with p = x_h + r, gap = g₀ − q·r.
+    let mut face_gap = None;
+    if ctx.mode == DisplacementMode::Large {
+        match pair.kind {
+            ContactKind::FaceFace { .. } => {
+                let na = sa.pose.rotation * pair.local_normal_a;
+                let nb = sb.pose.rotation * pair.local_normal_b;
+                pair.normal = (na - nb).normalize();
+                let (host_n, other_n, other_x) = if pair.host_is_a {
+                    (na, nb, sb.pose.translation)
+                } else {
+                    (nb, na, sa.pose.translation)
+                };
+                let other_offset = pair.local_other_offset + other_n.dot(other_x);
+                let inv_cos = 1.0 / other_n.dot(host_n);
+                face_gap = Some(((other_offset - other_n.dot(xh)) * inv_cos, other_n * inv_cos));
+            }
+            ContactKind::Point { normal_local } => {
+                pair.normal = sa.pose.rotation * normal_local;
+            }
+        }
     }
+    let n = pair.normal;
+    let shear_rotation = rotation_between(previous_normal, n);
+    let rotation = Matrix::from_quat(host.rotation);
+    // v_rel(p) = v_b + ω_b × (p − x_b) − v_a − ω_a × (p − x_a) = v₀ + (ω_b − ω_a) × r.
+    let dw = sb.angular_velocity - sa.angular_velocity;
+    let v0 = sb.velocity - sa.velocity + sb.angular_velocity.cross(xh - xb) - sa.angular_velocity.cross(xh - xa);
+    let dt = ctx.dt;
+    let damped = ctx.stiffness_damping > 0.0;
+    let k = law.stiffness();
+
+    let mut force = Vector::ZERO;
+    let mut moment_host = Vector::ZERO;
+    let (mut normal_force, mut work, mut dashpot_work) = (0.0, 0.0, 0.0);
+    for sub in subs.iter_mut() {
+        let r = rotation * sub.anchor;
+        let du = (v0 + dw.cross(r)) * dt;
+        let du_n = n.dot(du);
+        let du_s = du - n * du_n;
+        let gap = match face_gap {
+            Some((g0, q)) => g0 - q.dot(r),
+            None => sub.gap + du_n,
+        };
+        let spring_before = previous_normal * sub.force.normal + sub.force.shear;
+        let dashpot_before = sub.dashpot;
+
+        // Last step's shear force turns with the joint plane.
+        if let Some(turn) = shear_rotation {
+            sub.force.shear = turn * sub.force.shear;
+        }
+        let step = JointStep {
+            area: sub.area,
+            normal_displacement: gap,
+            normal_increment: du_n,
+            shear_increment: du_s,
+            normal: n,
+            dt,
+        };
+        let status = law.update(&step, &mut sub.force, &mut sub.state);
+        if status == JointStatus::Sliding {
+            sub.slip += du_s.length();
+        }
+        let spring = n * sub.force.normal + sub.force.shear;
+        let mut dashpot = Vector::ZERO;
+        if damped && status != JointStatus::Open {
+            let c = ctx.stiffness_damping * sub.area / dt;
+            dashpot -= n * (c * k.normal * du_n);
+            if status != JointStatus::Sliding {
+                dashpot -= du_s * (c * k.shear);
+            }
+        }
+        // Trapezoidal rule over the step's displacement, for the springs and the dashpots.
+        work -= 0.5 * (spring_before + spring).dot(du);
+        dashpot_work -= 0.5 * (dashpot_before + dashpot).dot(du);
+        let total = spring + dashpot;
+        force += total;
+        moment_host += r.cross(total);
+        normal_force += sub.force.normal;
+        sub.dashpot = dashpot;
+        sub.gap = gap;
+        sub.status = status;
+    }
+    // Moments about the centroids: Σ (p − x)×F with p = x_h + r on block b, −F on block a.
     pair.force = force;
-    pair.moment_a = moment_a;
-    pair.moment_b = moment_b;
-    pair.normal_force = normal;
+    if pair.host_is_a {
+        pair.moment_a = -moment_host;
+        pair.moment_b = moment_host + (xa - xb).cross(force);
+    } else {
+        pair.moment_b = moment_host;
+        pair.moment_a = -(moment_host + (xb - xa).cross(force));
+    }
+    pair.normal_force = normal_force;
     pair.work = work;
-    pair.dashpot_work = dashpot;
-    pair.elastic = elastic;
+    pair.dashpot_work = dashpot_work;
+}
+
+/// The smallest rotation taking unit vector `from` to unit vector `to`, `None` when they are
+/// equal: `R = c·I + [v]× + v vᵀ/(1 + c)` with `v = from × to`, `c = from · to` (Rodrigues'
+/// formula with `sin θ·k = v`). A shear force in the old joint plane is turned into the new one
+/// with its magnitude and its direction relative to the plane kept.
+#[inline]
+fn rotation_between(from: Vector, to: Vector) -> Option<Matrix> {
+    let v = from.cross(to);
+    let c = from.dot(to);
+    if v == Vector::ZERO && c > 0.0 {
+        return None;
+    }
+    if c <= -1.0 + 1e-12 {
+        // Opposite normals (not a physical step): a half turn about any perpendicular axis.
+        let axis = from.any_orthonormal_vector();
+        return Some(Matrix::from_axis_angle(axis, std::f64::consts::PI));
+    }
+    let k = 1.0 / (1.0 + c);
+    Some(Matrix::from_cols(
+        Vector::new(c, v.z, -v.y) + v * (k * v.x),
+        Vector::new(-v.z, c, v.x) + v * (k * v.y),
+        Vector::new(v.y, -v.x, c) + v * (k * v.z),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rotation_between_turns_the_plane_and_keeps_lengths() {
+        let from = Vector::new(0.1, -0.3, 0.9).normalize();
+        let to = Vector::new(-0.2, 0.25, 0.95).normalize();
+        let r = rotation_between(from, to).expect("a rotation");
+        assert!((r * from - to).length() < 1e-15);
+        // An in-plane vector stays in the (new) plane with its length.
+        let s = from.cross(Vector::X).normalize() * 3.0;
+        let t = r * s;
+        assert!(t.dot(to).abs() < 1e-14 && (t.length() - 3.0).abs() < 1e-14);
+        // Orthogonal with determinant one.
+        assert!((r.transpose() * r - Matrix::IDENTITY).abs_diff_eq(Matrix::ZERO, 1e-15));
+        assert!((r.determinant() - 1.0).abs() < 1e-15);
+        assert!(rotation_between(to, to).is_none());
+        let flip = rotation_between(to, -to).expect("a half turn");
+        assert!((flip * to + to).length() < 1e-14);
+    }
 }

@@ -5,12 +5,13 @@ mod kernel;
 
 use serde::{Deserialize, Serialize};
 
-pub(crate) use kernel::{sum_contact, update_pair_geometry, update_subcontact, KernelContext};
+pub(crate) use kernel::{update_contact, KernelContext};
 
 use crate::block::BlockId;
 use crate::constitutive::{JointForce, JointStatus};
 use crate::geometry::{ContactKind, SubKey};
-use crate::math::{Real, Vector};
+use crate::geometry::Polyhedron;
+use crate::math::{Pose, Real, Rotation, Vector};
 
 /// Typed index of a contact in the model's current contact list (valid until the next
 /// re-detection).
@@ -53,16 +54,24 @@ pub struct ContactPair {
     pub(crate) law: u32,
     pub(crate) first: u32,
     pub(crate) count: u32,
-    /// Unit normal a → b (world), updated every step in large-displacement mode.
+    /// Unit normal a → b (world), updated every step in large-displacement mode. At the start of
+    /// a step it still holds the previous step's normal, in which the stored spring forces were
+    /// composed.
     pub(crate) normal: Vector,
-    /// Outward normal of the host face (world).
-    pub(crate) host_normal: Vector,
-    /// Plane of the other face: `other_normal · x = other_offset` (world).
-    pub(crate) other_normal: Vector,
-    pub(crate) other_offset: Real,
+    /// Face-face: outward normals of face `a` and face `b` in their blocks' body frames, and the
+    /// plane offset of the face that is not the host, in its body frame. Cached from the shapes
+    /// at detection and on checkpoint load, so that the step loop does not visit the polyhedra.
+    #[serde(skip)]
+    pub(crate) local_normal_a: Vector,
+    #[serde(skip)]
+    pub(crate) local_normal_b: Vector,
+    #[serde(skip)]
+    pub(crate) local_other_offset: Real,
     /// Centroids at detection (lever arms in small-displacement mode).
     pub(crate) ref_a: Vector,
     pub(crate) ref_b: Vector,
+    /// Rotation of the host block at detection (anchors to world in small-displacement mode).
+    pub(crate) ref_host_rotation: Rotation,
     /// Resultant force on `b` (N).
     pub(crate) force: Vector,
     /// Moments of the sub-contact forces about the centroids of `a` and `b` (N·m).
@@ -72,7 +81,6 @@ pub struct ContactPair {
     pub(crate) normal_force: Real,
     pub(crate) work: Real,
     pub(crate) dashpot_work: Real,
-    pub(crate) elastic: Real,
     /// Sum of the sub-contact areas (m²).
     pub(crate) area: Real,
     /// `area` when the critical step was last evaluated (0 for a new contact).
@@ -108,12 +116,44 @@ impl ContactPair {
     pub fn subcontact_count(&self) -> usize {
         self.count as usize
     }
+    /// Fills the body-frame face data the step loop uses (face-face contacts).
+    pub(crate) fn cache_local_faces(&mut self, shape_a: &Polyhedron, shape_b: &Polyhedron) {
+        if let ContactKind::FaceFace { face_a, face_b } = self.kind {
+            let (fa, fb) = (&shape_a.faces()[face_a as usize], &shape_b.faces()[face_b as usize]);
+            self.local_normal_a = fa.normal;
+            self.local_normal_b = fb.normal;
+            self.local_other_offset = if self.host_is_a { fb.offset } else { fa.offset };
+        }
+    }
+
+    /// The pose mapping sub-contact anchors to world points, given the current poses of `a`
+    /// and `b`: the host's pose, or its pose at detection in small-displacement mode.
+    pub(crate) fn frame(&self, pose_a: &Pose, pose_b: &Pose, mode: DisplacementMode) -> Pose {
+        match mode {
+            DisplacementMode::Large => {
+                if self.host_is_a {
+                    *pose_a
+                } else {
+                    *pose_b
+                }
+            }
+            DisplacementMode::Small => Pose::from_parts(
+                if self.host_is_a { self.ref_a } else { self.ref_b },
+                self.ref_host_rotation,
+            ),
+        }
+    }
+
     pub(crate) fn range(&self) -> std::ops::Range<usize> {
         self.first as usize..self.first as usize + self.count as usize
     }
 }
 
 /// A sub-contact: a point of a joint with a tributary area, its spring forces and history.
+///
+/// Only what the next step needs is stored (128 bytes with [`crate::constitutive::CoulombSlip`]'s
+/// state): its world position and total force follow from the anchor and the contact's frame,
+/// see [`ContactView::point`] and [`ContactView::total_force`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SubContact<S> {
     pub(crate) key: SubKey,
@@ -128,22 +168,14 @@ pub struct SubContact<S> {
     #[serde(default)]
     pub(crate) gap_offset: Real,
     pub(crate) force: JointForce,
-    pub(crate) status: JointStatus,
     /// Accumulated slip while sliding (m).
     pub(crate) slip: Real,
+    /// Stiffness-proportional (Rayleigh) dashpot force on `b` (world) of the last step; zero
+    /// without Rayleigh damping.
+    #[serde(default)]
+    pub(crate) dashpot: Vector,
+    pub(crate) status: JointStatus,
     pub(crate) state: S,
-    /// World position (fixed in small-displacement mode).
-    pub(crate) point: Vector,
-    /// Spring force on `b` (world) after the last update.
-    pub(crate) spring: Vector,
-    /// Spring plus dashpot force on `b` (world).
-    pub(crate) total: Vector,
-    /// Work done on the joint springs during the last step (J).
-    pub(crate) work: Real,
-    /// Energy dissipated by the dashpot during the last step (J).
-    pub(crate) dashpot_work: Real,
-    /// Elastic energy stored (J).
-    pub(crate) elastic: Real,
 }
 
 impl<S> SubContact<S> {
@@ -151,9 +183,10 @@ impl<S> SubContact<S> {
     pub fn key(&self) -> SubKey {
         self.key
     }
-    /// Current world position (m).
-    pub fn point(&self) -> Vector {
-        self.point
+    /// Material point on the host block, in its body frame (m); [`ContactView::point`] gives
+    /// its world position.
+    pub fn anchor(&self) -> Vector {
+        self.anchor
     }
     /// Tributary area (m²).
     pub fn area(&self) -> Real {
@@ -175,6 +208,11 @@ impl<S> SubContact<S> {
     pub fn shear_force(&self) -> Vector {
         self.force.shear
     }
+    /// Stiffness-proportional dashpot force on block `b` (N, world); zero without Rayleigh
+    /// damping.
+    pub fn dashpot_force(&self) -> Vector {
+        self.dashpot
+    }
     /// Status after the last update.
     pub fn status(&self) -> JointStatus {
         self.status
@@ -187,10 +225,6 @@ impl<S> SubContact<S> {
     pub fn law_state(&self) -> &S {
         &self.state
     }
-    /// Spring plus dashpot force on block `b` (N, world).
-    pub fn total_force(&self) -> Vector {
-        self.total
-    }
 }
 
 /// A borrowed view of one contact and its sub-contacts.
@@ -200,6 +234,24 @@ pub struct ContactView<'a, S> {
     pub pair: &'a ContactPair,
     /// Its sub-contacts.
     pub subs: &'a [SubContact<S>],
+    /// Maps sub-contact anchors to world points: the host block's pose (its pose at detection in
+    /// small-displacement mode).
+    pub frame: Pose,
+}
+
+impl<S> ContactView<'_, S> {
+    /// World position of one of this contact's sub-contacts (m).
+    pub fn point(&self, sub: &SubContact<S>) -> Vector {
+        self.frame.transform_point(sub.anchor)
+    }
+    /// World positions of the sub-contacts, in order.
+    pub fn points(&self) -> impl ExactSizeIterator<Item = Vector> + '_ {
+        self.subs.iter().map(|s| self.point(s))
+    }
+    /// Spring plus dashpot force of one of this contact's sub-contacts on block `b` (N, world).
+    pub fn total_force(&self, sub: &SubContact<S>) -> Vector {
+        self.pair.normal * sub.force.normal + sub.force.shear + sub.dashpot
+    }
 }
 
 impl<S> Contact for ContactView<'_, S> {

@@ -121,7 +121,7 @@ pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> R
     for (ci, c) in model.contacts().enumerate() {
         let l = &law[c.pair.law_index()];
         for s in c.subs {
-            points.extend(s.point().to_array());
+            points.extend(c.point(s).to_array());
             shear.extend(s.shear_force().to_array());
             normal_force.push(s.normal_force());
             normal_stress.push(s.normal_stress());

@@ -7,7 +7,7 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use super::{Model, ModelParameters};
-use crate::block::{RigidBlock, Wrench};
+use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
 use crate::contact::{ContactPair, SubContact};
 use crate::error::{Error, Result};
@@ -18,7 +18,7 @@ use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 #[derive(Serialize, Deserialize)]
 #[serde(bound(
@@ -34,7 +34,6 @@ struct Snapshot<L: ConstitutiveLaw> {
     joints: JointTable<L>,
     pairs: Vec<ContactPair>,
     subs: Vec<SubContact<L::State>>,
-    sub_pair: Vec<u32>,
     ref_poses: Vec<Pose>,
     dt: Real,
     critical: Option<CriticalStep>,
@@ -75,13 +74,12 @@ where
             joints: self.joints.clone(),
             pairs: self.pairs.clone(),
             subs: self.subs.clone(),
-            sub_pair: self.sub_pair.clone(),
             ref_poses: self.ref_poses.clone(),
             dt: self.dt,
             critical: self.critical,
             step: self.step,
             time: self.time,
-            energy: self.energy,
+            energy: self.energies(),
             started: self.started,
             unbalanced_ratio: self.unbalanced_ratio.is_finite().then_some(self.unbalanced_ratio),
             detections: self.detections,
@@ -138,9 +136,6 @@ where
         if snap.ref_poses.len() != n {
             return Err(corrupt("ref_poses", "one pose per block expected"));
         }
-        if snap.sub_pair.len() != snap.subs.len() {
-            return Err(corrupt("sub_pair", "one entry per sub-contact expected"));
-        }
         let mut next = 0usize;
         for (k, p) in snap.pairs.iter().enumerate() {
             let faces_ok = match p.kind {
@@ -161,8 +156,7 @@ where
                 && p.a < p.b
                 && (p.law as usize) < snap.joints.laws().len()
                 && start == next
-                && end <= snap.subs.len()
-                && snap.sub_pair[start..end].iter().all(|&q| q as usize == k);
+                && end <= snap.subs.len();
             if !ok {
                 return Err(corrupt(
                     &format!("pairs[{k}]"),
@@ -188,8 +182,11 @@ where
         model.joints = snap.joints;
         model.integrator = Box::new(CentralDifference::new(snap.damping));
         model.pairs = snap.pairs;
+        for p in &mut model.pairs {
+            let (a, b) = (&model.blocks[p.a as usize], &model.blocks[p.b as usize]);
+            p.cache_local_faces(Block::shape(a), Block::shape(b));
+        }
         model.subs = snap.subs;
-        model.sub_pair = snap.sub_pair;
         model.ref_poses = snap.ref_poses;
         model.dt = snap.dt;
         model.critical = snap.critical;

@@ -20,7 +20,6 @@ pub(crate) struct DetectionScratch<S> {
     moved: Vec<bool>,
     pairs: Vec<ContactPair>,
     subs: Vec<SubContact<S>>,
-    sub_pair: Vec<u32>,
 }
 
 impl<S> Default for DetectionScratch<S> {
@@ -34,7 +33,6 @@ impl<S> Default for DetectionScratch<S> {
             moved: Vec::new(),
             pairs: Vec::new(),
             subs: Vec::new(),
-            sub_pair: Vec::new(),
         }
     }
 }
@@ -74,7 +72,6 @@ impl<L: ConstitutiveLaw> Model<L> {
         );
         sc.pairs.clear();
         sc.subs.clear();
-        sc.sub_pair.clear();
         for &(i, j) in &sc.candidates {
             let old = self.pairs.binary_search_by_key(&(i, j), |p| (p.a, p.b)).ok();
             let (bi, bj) = (&self.blocks[i as usize], &self.blocks[j as usize]);
@@ -87,8 +84,6 @@ impl<L: ConstitutiveLaw> Model<L> {
                     let mut kept = p.clone();
                     kept.first = sc.subs.len() as u32;
                     sc.subs.extend_from_slice(&self.subs[p.range()]);
-                    sc.sub_pair
-                        .extend(std::iter::repeat_n(sc.pairs.len() as u32, p.count as usize));
                     sc.pairs.push(kept);
                 }
                 continue;
@@ -126,11 +121,16 @@ impl<L: ConstitutiveLaw> Model<L> {
                 let p = &self.pairs[k];
                 (p.kind == dc.kind && p.host_is_a == dc.host_is_a).then(|| &self.subs[p.range()])
             });
-            let old_subs = old_subs.flatten().unwrap_or(&[]);
-            let pair_index = sc.pairs.len() as u32;
+            let old_subs = old_subs.flatten();
+            // Carried spring forces were composed in the old contact's normal, which the next
+            // step's energy increment needs as the previous normal.
+            let previous_normal = match (old, old_subs) {
+                (Some(k), Some(_)) => self.pairs[k].normal,
+                _ => dc.normal,
+            };
+            let old_subs = old_subs.unwrap_or(&[]);
             let first = sc.subs.len() as u32;
             for seed in &sc.seeds {
-                let point = host.state.pose.transform_point(seed.anchor);
                 let mut sub = SubContact {
                     key: seed.key,
                     anchor: seed.anchor,
@@ -138,15 +138,10 @@ impl<L: ConstitutiveLaw> Model<L> {
                     gap: seed.gap,
                     gap_offset: 0.0,
                     force: JointForce::default(),
-                    status: JointStatus::Open,
                     slip: 0.0,
+                    dashpot: Vector::ZERO,
+                    status: JointStatus::Open,
                     state: L::State::default(),
-                    point,
-                    spring: Vector::ZERO,
-                    total: Vector::ZERO,
-                    work: 0.0,
-                    dashpot_work: 0.0,
-                    elastic: 0.0,
                 };
                 if let Ok(k) = old_subs.binary_search_by_key(&seed.key, |s| s.key) {
                     let o = &old_subs[k];
@@ -155,13 +150,10 @@ impl<L: ConstitutiveLaw> Model<L> {
                     sub.gap = seed.gap + o.gap_offset;
                     sub.status = o.status;
                     sub.slip = o.slip;
+                    sub.dashpot = o.dashpot;
                     sub.state = o.state.clone();
-                    sub.spring = o.spring;
-                    sub.total = o.total;
-                    sub.elastic = o.elastic;
                 }
                 sc.subs.push(sub);
-                sc.sub_pair.push(pair_index);
             }
             // A face-face joint that rocks onto an edge becomes an edge-face (point) contact once
             // the faces are more than `face_angle_tolerance` apart. The two discretise the joint
@@ -193,14 +185,12 @@ impl<L: ConstitutiveLaw> Model<L> {
                             s.gap_offset = gap - s.gap;
                             s.gap = gap;
                             s.status = JointStatus::Elastic;
-                            s.spring = n * s.force.normal + s.force.shear;
-                            s.total = s.spring;
-                            s.elastic = law_ref.elastic_energy(s.area, &s.force, &s.state);
+                            s.dashpot = Vector::ZERO;
                         }
                     }
                 }
             }
-            sc.pairs.push(ContactPair {
+            let mut pair = ContactPair {
                 a: i,
                 b: j,
                 kind: dc.kind,
@@ -208,22 +198,24 @@ impl<L: ConstitutiveLaw> Model<L> {
                 law,
                 first,
                 count: sc.seeds.len() as u32,
-                normal: dc.normal,
-                host_normal: dc.normal,
-                other_normal: -dc.normal,
-                other_offset: 0.0,
+                normal: previous_normal,
+                local_normal_a: Vector::ZERO,
+                local_normal_b: Vector::ZERO,
+                local_other_offset: 0.0,
                 ref_a: bi.state.pose.translation,
                 ref_b: bj.state.pose.translation,
+                ref_host_rotation: host.state.pose.rotation,
                 force: Vector::ZERO,
                 moment_a: Vector::ZERO,
                 moment_b: Vector::ZERO,
                 normal_force: 0.0,
                 work: 0.0,
                 dashpot_work: 0.0,
-                elastic: 0.0,
                 area: sc.seeds.iter().map(|s| s.area).sum(),
                 bound_area,
-            });
+            };
+            pair.cache_local_faces(bi.shape(), bj.shape());
+            sc.pairs.push(pair);
         }
         // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
         // since the last evaluation (lost contacts only make the step safer).
@@ -239,7 +231,6 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.energy.damping += dashpot;
         std::mem::swap(&mut self.pairs, &mut sc.pairs);
         std::mem::swap(&mut self.subs, &mut sc.subs);
-        std::mem::swap(&mut self.sub_pair, &mut sc.sub_pair);
         for (i, moved) in sc.moved.iter().enumerate() {
             if *moved {
                 self.ref_poses[i] = self.blocks[i].state.pose;
@@ -309,10 +300,12 @@ impl<L: ConstitutiveLaw> Model<L> {
             p.bound_area = p.area;
             let k = self.joints.laws()[p.law as usize].stiffness();
             // Area moments of the sub-contact points about the first one (for digits).
-            let origin = subs.first().map_or(Vector::ZERO, |s| s.point);
+            let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
+            let frame = p.frame(&sa.pose, &sb.pose, self.params.mode);
+            let origin = subs.first().map_or(Vector::ZERO, |s| frame.transform_point(s.anchor));
             let mut moments = AreaMoments::default();
             for s in subs {
-                moments.add(s.point - origin, s.area);
+                moments.add(frame.transform_point(s.anchor) - origin, s.area);
             }
             let side = |i: usize| -> Option<Stiffness6> {
                 let (inv_sqrt_m, rot, inv_sqrt_i) = scaling[i]?;
@@ -528,29 +521,25 @@ fn dropped_work<S>(
             .filter(|q| q.kind == p.kind && q.host_is_a == p.host_is_a)
             .map(|q| &new.1[q.range()]);
         let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
+        let frame = p.frame(&sa.pose, &sb.pose, mode);
+        let (xa, xb) = match mode {
+            DisplacementMode::Large => (sa.pose.translation, sb.pose.translation),
+            DisplacementMode::Small => (p.ref_a, p.ref_b),
+        };
         for s in &old.1[p.range()] {
-            if s.spring == Vector::ZERO && s.total == Vector::ZERO {
+            let spring = p.normal * s.force.normal + s.force.shear;
+            if spring == Vector::ZERO && s.dashpot == Vector::ZERO {
                 continue;
             }
             if carried.is_some_and(|subs| subs.binary_search_by_key(&s.key, |t| t.key).is_ok()) {
                 continue;
             }
-            let (pt, xa, xb) = match mode {
-                DisplacementMode::Large => {
-                    let host = if p.host_is_a { sa } else { sb };
-                    (
-                        host.pose.transform_point(s.anchor),
-                        sa.pose.translation,
-                        sb.pose.translation,
-                    )
-                }
-                DisplacementMode::Small => (s.point, p.ref_a, p.ref_b),
-            };
+            let pt = frame.transform_point(s.anchor);
             let v_rel =
                 (sb.velocity + sb.angular_velocity.cross(pt - xb)) - (sa.velocity + sa.angular_velocity.cross(pt - xa));
             let du = v_rel * dt;
-            work -= 0.5 * s.spring.dot(du);
-            dashpot -= 0.5 * (s.total - s.spring).dot(du);
+            work -= 0.5 * spring.dot(du);
+            dashpot -= 0.5 * s.dashpot.dot(du);
         }
     }
     (work, dashpot)

@@ -12,9 +12,7 @@ pub use energy::Energies;
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
 use crate::contact::{
-    sum_contact, update_pair_geometry, update_subcontact, ContactPair, ContactView, DisplacementMode, KernelContext,
-    SubContact,
-};
+    update_contact, ContactPair, ContactView, DisplacementMode, KernelContext, SubContact};
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
@@ -100,7 +98,6 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     integrator: Box<dyn Integrator>,
     pairs: Vec<ContactPair>,
     subs: Vec<SubContact<L::State>>,
-    sub_pair: Vec<u32>,
     block_contacts: Vec<u32>,
     block_offsets: Vec<u32>,
     forces: Vec<Wrench>,
@@ -196,7 +193,6 @@ impl<L: ConstitutiveLaw> Model<L> {
             integrator: Box::new(CentralDifference::default()),
             pairs: Vec::new(),
             subs: Vec::new(),
-            sub_pair: Vec::new(),
             block_contacts: Vec::new(),
             block_offsets: vec![0],
             forces: Vec::new(),
@@ -370,10 +366,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// The current contacts, each with its sub-contacts.
     pub fn contacts(&self) -> impl ExactSizeIterator<Item = ContactView<'_, L::State>> + '_ {
-        self.pairs.iter().map(move |p| ContactView {
-            pair: p,
-            subs: &self.subs[p.range()],
-        })
+        self.pairs.iter().map(move |p| self.view(p))
     }
 
     /// The contact between two blocks, if any.
@@ -382,10 +375,16 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.pairs
             .binary_search_by_key(&key, |p| (p.a, p.b))
             .ok()
-            .map(|i| ContactView {
-                pair: &self.pairs[i],
-                subs: &self.subs[self.pairs[i].range()],
-            })
+            .map(|i| self.view(&self.pairs[i]))
+    }
+
+    fn view<'a>(&'a self, p: &'a ContactPair) -> ContactView<'a, L::State> {
+        let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
+        ContactView {
+            pair: p,
+            subs: &self.subs[p.range()],
+            frame: p.frame(&sa.pose, &sb.pose, self.params.mode),
+        }
     }
 
     /// Total number of sub-contacts.
@@ -414,7 +413,43 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     /// Energies since the start.
-    pub fn energies(&self) -> &Energies {
+    ///
+    /// The elastic energy stored in the joints (and with it the friction term, the joint work
+    /// less the elastic energy) is not needed to step, so it is summed over the sub-contacts
+    /// here, when asked for: a call costs about one pass over the sub-contacts.
+    pub fn energies(&self) -> Energies {
+        let mut e = self.energy;
+        e.elastic = self.elastic_energy();
+        e.friction = e.joint_work - e.elastic;
+        e
+    }
+
+    /// Elastic energy in the joint springs (J): per contact in sub-contact order, contacts in
+    /// fixed chunks, chunks in order, so the sum does not depend on the thread count.
+    fn elastic_energy(&self) -> Real {
+        let laws = self.joints.laws();
+        let chunk_sums: Vec<Real> = self
+            .pairs
+            .par_chunks(1024)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(|p| {
+                        let law = &laws[p.law as usize];
+                        self.subs[p.range()]
+                            .iter()
+                            .map(|s| law.elastic_energy(s.area, &s.force, &s.state))
+                            .sum::<Real>()
+                    })
+                    .sum::<Real>()
+            })
+            .collect();
+        chunk_sums.iter().sum()
+    }
+
+    /// The accumulated energy terms without the elastic and friction terms (which
+    /// [`Model::energies`] fills in).
+    pub(crate) fn energy_accumulators(&self) -> &Energies {
         &self.energy
     }
 
@@ -580,9 +615,6 @@ impl<L: ConstitutiveLaw> Model<L> {
         // One pass per contact: its plane, its sub-contacts (in order), its resultant.
         self.pairs.par_iter_mut().with_min_len(CONTACTS_PER_TASK).for_each(|p| {
             let (a, b) = (&blocks[p.a as usize], &blocks[p.b as usize]);
-            if ctx.mode == DisplacementMode::Large {
-                update_pair_geometry(p, &a.state, &b.state, a.shape(), b.shape());
-            }
             let range = p.range();
             assert!(
                 range.start <= range.end && range.end <= total_subs,
@@ -593,11 +625,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             // otherwise borrowed during this loop, so every task has exclusive access to its
             // own range.
             let own = unsafe { std::slice::from_raw_parts_mut(subs.get().add(range.start), range.len()) };
-            let law = &laws[p.law as usize];
-            for s in own.iter_mut() {
-                update_subcontact(s, p, &a.state, &b.state, law, ctx);
-            }
-            sum_contact(p, own, &a.state, &b.state, ctx.mode);
+            update_contact(p, own, &a.state, &b.state, &laws[p.law as usize], ctx);
         });
         let gravity = self.params.gravity;
         let pairs = &self.pairs;
@@ -681,16 +709,13 @@ impl<L: ConstitutiveLaw> Model<L> {
             e.damping -= 0.5 * (r.damping.force.dot(v0) + r.damping.moment.dot(w0)) * dt;
         }
         e.kinetic = kinetic;
-        let (mut work, mut dashpot, mut elastic) = (0.0, 0.0, 0.0);
+        let (mut work, mut dashpot) = (0.0, 0.0);
         for p in &self.pairs {
             work += p.work;
             dashpot += p.dashpot_work;
-            elastic += p.elastic;
         }
         e.joint_work += work;
         e.damping += dashpot;
-        e.elastic = elastic;
-        e.friction = e.joint_work - elastic;
     }
 
     fn check_divergence(&self) -> Result<()> {

@@ -296,7 +296,7 @@ pub fn run(
     model.set_damping(Damping::rayleigh_stiffness(case.damping_ratio, case.damping_frequency)?)?;
     let t0 = model.time();
     let step0 = model.step_count();
-    let e0 = *model.energies();
+    let e0 = model.energies();
     let input0 = e0.input();
     let mut samples = Vec::new();
     let mut last_v = 0.0;
