@@ -25,6 +25,10 @@ struct Run {
     s_per_step: f64,
     subcontact_updates_per_s: f64,
     detection_share: f64,
+    /// Share of the stepping time in the contact pass (kinematics, laws, resultants, gather).
+    contact_share: f64,
+    /// Share in the integrator and energy bookkeeping.
+    integration_share: f64,
     peak_rss_bytes: u64,
     peak_rss_bytes_per_block: f64,
     build_and_first_detection_s: f64,
@@ -40,6 +44,14 @@ fn peak_rss_bytes() -> u64 {
                 .and_then(|l| l.split_whitespace().nth(1).and_then(|kb| kb.parse::<u64>().ok()))
         })
         .map_or(0, |kb| kb * 1024)
+}
+
+fn share(part: f64, total: f64) -> f64 {
+    if total > 0.0 {
+        part / total
+    } else {
+        0.0
+    }
 }
 
 fn main() {
@@ -72,8 +84,8 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     let threads = rayon::current_num_threads();
     println!("running-bond wall, bricks 0.2 × 0.1 × 0.05 m, sub-contact spacing 25 mm, {threads} threads");
     println!(
-        "{:>8} {:>9} {:>11} {:>11} {:>14} {:>10} {:>12}",
-        "blocks", "contacts", "subcontacts", "ms/step", "updates/s", "detection", "bytes/block"
+        "{:>8} {:>9} {:>11} {:>11} {:>14} {:>10} {:>9} {:>11} {:>12}",
+        "blocks", "contacts", "subcontacts", "ms/step", "updates/s", "detection", "contacts", "integration", "bytes/block"
     );
     let mut runs = Vec::new();
     for n in sizes {
@@ -93,19 +105,23 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             threads,
             s_per_step: per_step,
             subcontact_updates_per_s: model.subcontact_count() as f64 / per_step,
-            detection_share: if t.total() > 0.0 { t.detection / t.total() } else { 0.0 },
+            detection_share: share(t.detection, t.total()),
+            contact_share: share(t.contacts, t.total()),
+            integration_share: share(t.integration, t.total()),
             peak_rss_bytes: peak_rss_bytes(),
             peak_rss_bytes_per_block: peak_rss_bytes() as f64 / model.blocks().len() as f64,
             build_and_first_detection_s: setup,
         };
         println!(
-            "{:>8} {:>9} {:>11} {:>11.3} {:>14.3e} {:>9.1}% {:>12.0}",
+            "{:>8} {:>9} {:>11} {:>11.3} {:>14.3e} {:>9.1}% {:>8.1}% {:>10.1}% {:>12.0}",
             run.blocks,
             run.contacts,
             run.subcontacts,
             run.s_per_step * 1e3,
             run.subcontact_updates_per_s,
             run.detection_share * 100.0,
+            run.contact_share * 100.0,
+            run.integration_share * 100.0,
             run.peak_rss_bytes_per_block
         );
         runs.push(run);

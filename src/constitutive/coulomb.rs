@@ -149,6 +149,7 @@ impl CoulombSlip {
 impl ConstitutiveLaw for CoulombSlip {
     type State = CoulombState;
 
+    #[inline]
     fn stiffness(&self) -> JointStiffness {
         JointStiffness {
             normal: self.normal_stiffness,
@@ -156,6 +157,7 @@ impl ConstitutiveLaw for CoulombSlip {
         }
     }
 
+    #[inline]
     fn update(&self, s: &JointStep, f: &mut JointForce, state: &mut CoulombState) -> JointStatus {
         let a = s.area;
         f.normal = -self.normal_stiffness * s.normal_displacement * a;

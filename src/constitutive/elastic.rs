@@ -17,6 +17,7 @@ pub struct LinearElastic {
 impl ConstitutiveLaw for LinearElastic {
     type State = ();
 
+    #[inline]
     fn stiffness(&self) -> JointStiffness {
         JointStiffness {
             normal: self.normal_stiffness,
@@ -24,6 +25,7 @@ impl ConstitutiveLaw for LinearElastic {
         }
     }
 
+    #[inline]
     fn update(&self, s: &JointStep, f: &mut JointForce, _: &mut ()) -> JointStatus {
         f.normal = -self.normal_stiffness * s.normal_displacement * s.area;
         f.shear -= s.shear_increment * (self.shear_stiffness * s.area);

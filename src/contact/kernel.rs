@@ -73,15 +73,23 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let dw = sb.angular_velocity - sa.angular_velocity;
     let v0 = sb.velocity - sa.velocity + sb.angular_velocity.cross(xh - xb) - sa.angular_velocity.cross(xh - xa);
     let dt = ctx.dt;
-    let damped = ctx.stiffness_damping > 0.0;
+    // Displacement increments over the step: du(r) = v₀Δt + (Δω Δt) × r.
+    let (du0, dwdt) = (v0 * dt, dw * dt);
     let k = law.stiffness();
+    // Dashpot coefficients per unit area (zero without Rayleigh damping).
+    let (cn, cs) = (
+        ctx.stiffness_damping * k.normal / dt,
+        ctx.stiffness_damping * k.shear / dt,
+    );
+    let damped = ctx.stiffness_damping > 0.0;
 
     let mut force = Vector::ZERO;
     let mut moment_host = Vector::ZERO;
-    let (mut normal_force, mut work, mut dashpot_work) = (0.0, 0.0, 0.0);
+    // Σ (F_before + F_after)·du for the springs and for the dashpots (times −½ at the end).
+    let (mut normal_force, mut spring_sum, mut dashpot_sum) = (0.0, 0.0, 0.0);
     for sub in subs.iter_mut() {
         let r = rotation * sub.anchor;
-        let du = (v0 + dw.cross(r)) * dt;
+        let du = du0 + dwdt.cross(r);
         let du_n = n.dot(du);
         let du_s = du - n * du_n;
         let gap = match face_gap {
@@ -108,22 +116,24 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             sub.slip += du_s.length();
         }
         let spring = n * sub.force.normal + sub.force.shear;
-        let mut dashpot = Vector::ZERO;
-        if damped && status != JointStatus::Open {
-            let c = ctx.stiffness_damping * sub.area / dt;
-            dashpot -= n * (c * k.normal * du_n);
-            if status != JointStatus::Sliding {
-                dashpot -= du_s * (c * k.shear);
-            }
-        }
         // Trapezoidal rule over the step's displacement, for the springs and the dashpots.
-        work -= 0.5 * (spring_before + spring).dot(du);
-        dashpot_work -= 0.5 * (dashpot_before + dashpot).dot(du);
-        let total = spring + dashpot;
+        spring_sum += (spring_before + spring).dot(du);
+        let mut total = spring;
+        if damped || dashpot_before != Vector::ZERO {
+            let mut dashpot = Vector::ZERO;
+            if damped && status != JointStatus::Open {
+                dashpot -= n * (cn * sub.area * du_n);
+                if status != JointStatus::Sliding {
+                    dashpot -= du_s * (cs * sub.area);
+                }
+            }
+            dashpot_sum += (dashpot_before + dashpot).dot(du);
+            total += dashpot;
+            sub.dashpot = dashpot;
+        }
         force += total;
         moment_host += r.cross(total);
         normal_force += sub.force.normal;
-        sub.dashpot = dashpot;
         sub.gap = gap;
         sub.status = status;
     }
@@ -137,8 +147,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         pair.moment_a = -(moment_host + (xb - xa).cross(force));
     }
     pair.normal_force = normal_force;
-    pair.work = work;
-    pair.dashpot_work = dashpot_work;
+    pair.work = -0.5 * spring_sum;
+    pair.dashpot_work = -0.5 * dashpot_sum;
 }
 
 /// The smallest rotation taking unit vector `from` to unit vector `to`, `None` when they are

@@ -4,7 +4,7 @@ use rayon::prelude::*;
 
 use super::{Damping, Integrator, StepRecord};
 use crate::block::{Block, Dof, RigidBlock, Wrench};
-use crate::math::{Real, Rotation, Vector};
+use crate::math::{rotation_from_vector, Real, Rotation, Vector};
 
 /// Explicit central difference: velocities at half steps, positions at full steps.
 ///
@@ -104,7 +104,12 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
     let inv_inertia_at = |r: Rotation, l: Vector| r * ((r.inverse() * l) / inertia);
     let mut w = block.world_inverse_inertia_times(l);
     for _ in 0..3 {
-        w = inv_inertia_at(Rotation::from_scaled_axis(0.5 * dt * w) * r0, l);
+        let next = inv_inertia_at(rotation_from_vector(0.5 * dt * w) * r0, l);
+        let converged = next == w;
+        w = next;
+        if converged {
+            break;
+        }
     }
     let mut constrained = false;
     for i in 0..3 {
@@ -148,7 +153,7 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
     st.pose.translation += v * dt;
     let angle = w * dt;
     if angle.length_squared() > 0.0 {
-        st.pose.rotation = (Rotation::from_scaled_axis(angle) * st.pose.rotation).normalize();
+        st.pose.rotation = (rotation_from_vector(angle) * st.pose.rotation).normalize();
     }
     StepRecord {
         reaction,
