@@ -102,6 +102,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     block_offsets: Vec<u32>,
     forces: Vec<Wrench>,
     records: Vec<StepRecord>,
+    pair_sums: Vec<PairSums>,
+    block_sums: Vec<BlockSums>,
     ref_poses: Vec<Pose>,
     bounds: Vec<StiffnessBound>,
     dt: Real,
@@ -152,10 +154,51 @@ impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
     }
 }
 
-/// Smallest number of items per rayon task in the block loops.
-const ITEMS_PER_TASK: usize = 512;
-/// Smallest number of contacts per rayon task.
-const CONTACTS_PER_TASK: usize = 32;
+/// Blocks per chunk of the block passes: sums are taken per chunk, then over the chunks in order,
+/// so that they do not depend on the number of threads.
+const BLOCK_CHUNK: usize = 512;
+/// Contacts per chunk of the contact pass (as [`BLOCK_CHUNK`]).
+const CONTACT_CHUNK: usize = 64;
+
+/// Per-chunk sums of the contact pass.
+#[derive(Debug, Clone, Copy, Default)]
+struct PairSums {
+    /// Σ |resultant| (N), for the unbalanced-force ratio.
+    force_magnitude: Real,
+    work: Real,
+    dashpot_work: Real,
+}
+
+/// Per-chunk sums of the block passes.
+#[derive(Debug, Clone, Copy, Default)]
+struct BlockSums {
+    max_unbalanced: Real,
+    gravity_work: Real,
+    load_work: Real,
+    boundary_work: Real,
+    damping: Real,
+    kinetic: Real,
+    /// First block of the chunk that diverged.
+    diverged: Option<usize>,
+}
+
+/// Whether a block's state is non-finite or faster than `√max_speed2`.
+fn diverged(b: &RigidBlock, max_speed2: Real) -> bool {
+    let s = &b.state;
+    let r = b.shape().radius();
+    let speed2 = s
+        .velocity
+        .length_squared()
+        .max(s.angular_velocity.length_squared() * r * r);
+    !(speed2 <= max_speed2) || !is_finite_state(s)
+}
+
+fn is_finite_state(s: &crate::block::BlockState) -> bool {
+    is_finite_vector(s.velocity)
+        && is_finite_vector(s.angular_velocity)
+        && is_finite_vector(s.pose.translation)
+        && s.pose.rotation.is_finite()
+}
 
 /// The start of the sub-contact vector, shared with the tasks of the contact loop, each of which
 /// touches only its own contact's range.
@@ -197,6 +240,8 @@ impl<L: ConstitutiveLaw> Model<L> {
             block_offsets: vec![0],
             forces: Vec::new(),
             records: Vec::new(),
+            pair_sums: Vec::new(),
+            block_sums: Vec::new(),
             ref_poses: Vec::new(),
             bounds: Vec::new(),
             dt: 0.0,
@@ -573,10 +618,9 @@ impl<L: ConstitutiveLaw> Model<L> {
         let detected = std::time::Instant::now();
         self.compute_forces();
         let forces = std::time::Instant::now();
-        self.account_energy_before_advance();
         self.integrator
             .advance(&mut self.blocks, &self.forces, self.dt, &mut self.records);
-        self.account_energy();
+        let diverged = self.account_energy();
         let t = &mut self.timings;
         t.detection += (detected - started).as_secs_f64();
         t.contacts += (forces - detected).as_secs_f64();
@@ -584,7 +628,9 @@ impl<L: ConstitutiveLaw> Model<L> {
         t.steps += 1;
         self.step += 1;
         self.time += self.dt;
-        self.check_divergence()?;
+        if let Some(i) = diverged {
+            return Err(self.divergence_error(i));
+        }
         if self.step % self.monitor_interval == 0 && !self.monitors.is_empty() {
             self.sample();
         }
@@ -612,55 +658,94 @@ impl<L: ConstitutiveLaw> Model<L> {
         let laws = self.joints.laws();
         let subs = SubsPtr(self.subs.as_mut_ptr());
         let total_subs = self.subs.len();
-        // One pass per contact: its plane, its sub-contacts (in order), its resultant.
-        self.pairs.par_iter_mut().with_min_len(CONTACTS_PER_TASK).for_each(|p| {
-            let (a, b) = (&blocks[p.a as usize], &blocks[p.b as usize]);
-            let range = p.range();
-            assert!(
-                range.start <= range.end && range.end <= total_subs,
-                "sub-contact range out of bounds"
-            );
-            // SAFETY: the contacts' sub-contact ranges are disjoint and within `subs` (built so
-            // by detection, checked on checkpoint load, asserted above), and `self.subs` is not
-            // otherwise borrowed during this loop, so every task has exclusive access to its
-            // own range.
-            let own = unsafe { std::slice::from_raw_parts_mut(subs.get().add(range.start), range.len()) };
-            update_contact(p, own, &a.state, &b.state, &laws[p.law as usize], ctx);
-        });
+        // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed
+        // per fixed chunk of contacts, so that the totals do not depend on the thread count.
+        self.pair_sums.clear();
+        self.pair_sums
+            .resize(self.pairs.len().div_ceil(CONTACT_CHUNK), PairSums::default());
+        self.pairs
+            .par_chunks_mut(CONTACT_CHUNK)
+            .zip(self.pair_sums.par_iter_mut())
+            .for_each(|(chunk, sums)| {
+                for p in chunk {
+                    let (a, b) = (&blocks[p.a as usize], &blocks[p.b as usize]);
+                    let range = p.range();
+                    assert!(
+                        range.start <= range.end && range.end <= total_subs,
+                        "sub-contact range out of bounds"
+                    );
+                    // SAFETY: the contacts' sub-contact ranges are disjoint and within `subs`
+                    // (built so by detection, checked on checkpoint load, asserted above), and
+                    // `self.subs` is not otherwise borrowed during this loop, so every task has
+                    // exclusive access to its own ranges.
+                    let own = unsafe { std::slice::from_raw_parts_mut(subs.get().add(range.start), range.len()) };
+                    update_contact(p, own, &a.state, &b.state, &laws[p.law as usize], ctx);
+                    sums.force_magnitude += p.force.length();
+                    sums.work += p.work;
+                    sums.dashpot_work += p.dashpot_work;
+                }
+            });
+        // One pass per block: gather its contacts (block → contact index), add gravity and
+        // loads; and the energy terms booked before the integrator moves the blocks.
         let gravity = self.params.gravity;
+        let dt = self.dt;
+        let first = if self.step == 0 { 0.5 } else { 1.0 };
         let pairs = &self.pairs;
         let (contacts, offsets) = (&self.block_contacts, &self.block_offsets);
+        let records = &self.records;
+        self.block_sums.clear();
+        self.block_sums
+            .resize(self.blocks.len().div_ceil(BLOCK_CHUNK), BlockSums::default());
         self.forces
-            .par_iter_mut()
-            .with_min_len(ITEMS_PER_TASK)
+            .par_chunks_mut(BLOCK_CHUNK)
+            .zip(self.block_sums.par_iter_mut())
             .enumerate()
-            .for_each(|(i, w)| {
-                let b = &blocks[i];
-                let mut total = b.load;
-                total.force += gravity * b.mass_properties().mass;
-                for &c in &contacts[offsets[i] as usize..offsets[i + 1] as usize] {
-                    let p = &pairs[c as usize];
-                    if p.b as usize == i {
-                        total.force += p.force;
-                        total.moment += p.moment_b;
-                    } else {
-                        total.force -= p.force;
-                        total.moment += p.moment_a;
+            .for_each(|(k, (chunk, sums))| {
+                for (j, w) in chunk.iter_mut().enumerate() {
+                    let i = k * BLOCK_CHUNK + j;
+                    let b = &blocks[i];
+                    let m = b.mass_properties().mass;
+                    let mut total = b.load;
+                    total.force += gravity * m;
+                    for &c in &contacts[offsets[i] as usize..offsets[i + 1] as usize] {
+                        let p = &pairs[c as usize];
+                        if p.b as usize == i {
+                            total.force += p.force;
+                            total.moment += p.moment_b;
+                        } else {
+                            total.force -= p.force;
+                            total.moment += p.moment_a;
+                        }
                     }
+                    *w = total;
+                    if b.fixity().is_free() {
+                        sums.max_unbalanced = sums.max_unbalanced.max(total.force.length());
+                    }
+                    // Energy, first half (see `account_energy`): gravity and loads, and the
+                    // `F_{n−1}` halves of the reactions and damping forces, while the velocities
+                    // are still `v_{n−½}` and the step records still hold step `n − 1`.
+                    let r = &records[i];
+                    let (v, om) = (b.state.velocity, b.state.angular_velocity);
+                    sums.gravity_work += first * m * gravity.dot(v) * dt;
+                    sums.load_work += first * (b.load.force.dot(v) + b.load.moment.dot(om)) * dt;
+                    sums.boundary_work += 0.5 * (r.reaction.force.dot(v) + r.reaction.moment.dot(om)) * dt;
+                    sums.damping -= 0.5 * (r.damping.force.dot(v) + r.damping.moment.dot(om)) * dt;
                 }
-                *w = total;
             });
-        // Unbalanced-force ratio.
         let mut max_unbalanced: Real = 0.0;
-        for (b, w) in self.blocks.iter().zip(&self.forces) {
-            if b.fixity().is_free() {
-                max_unbalanced = max_unbalanced.max(w.force.length());
-            }
+        let e = &mut self.energy;
+        for s in &self.block_sums {
+            max_unbalanced = max_unbalanced.max(s.max_unbalanced);
+            e.gravity_work += s.gravity_work;
+            e.load_work += s.load_work;
+            e.boundary_work += s.boundary_work;
+            e.damping += s.damping;
         }
+        let force_magnitudes: Real = self.pair_sums.iter().map(|s| s.force_magnitude).sum();
         let mean_contact = if self.pairs.is_empty() {
             0.0
         } else {
-            self.pairs.iter().map(|p| p.force.length()).sum::<Real>() / self.pairs.len() as Real
+            force_magnitudes / self.pairs.len() as Real
         };
         self.unbalanced_ratio = if mean_contact > 0.0 {
             max_unbalanced / mean_contact
@@ -669,86 +754,79 @@ impl<L: ConstitutiveLaw> Model<L> {
         };
     }
 
-    /// Energy bookkeeping, first half. Every force `F` is booked with the trapezoidal rule over
-    /// the displacement of the step that just ended, `½(F_{n−1} + F_n)·v_{n−½}·Δt` (a force that
-    /// did not exist before the first step counts as zero), which together with the kinetic energy
-    /// `½·m·v_{n−½}·v_{n+½}` makes the balance an exact identity of central difference for
-    /// translation. Here: the gravity and load terms and the `F_{n−1}` halves of the reactions
-    /// and damping forces, while the block velocities are still `v_{n−½}` and the step records
-    /// still hold step `n − 1`.
-    fn account_energy_before_advance(&mut self) {
+    /// Energy bookkeeping, second half, after the integrator; returns the first block whose
+    /// state is no longer finite or faster than `max_speed`.
+    ///
+    /// Every force `F` is booked with the trapezoidal rule over the displacement of the step that
+    /// just ended, `½(F_{n−1} + F_n)·v_{n−½}·Δt` (a force that did not exist before the first
+    /// step counts as zero), which together with the kinetic energy `½·m·v_{n−½}·v_{n+½}` makes
+    /// the balance an exact identity of central difference for translation. The first half was
+    /// booked in [`Model::compute_forces`]; here: the `F_n` halves of the reactions and damping
+    /// forces, the kinetic energy `½·m·v_{n−½}·v_{n+½} + ½·ω_{n−½}·L_{n+½}`, and the joint terms.
+    fn account_energy(&mut self) -> Option<usize> {
         let dt = self.dt;
-        let g = self.params.gravity;
-        let first = if self.step == 0 { 0.5 } else { 1.0 };
-        let e = &mut self.energy;
-        for (b, r) in self.blocks.iter().zip(&self.records) {
-            let m = b.mass_properties().mass;
-            let (v, w) = (b.state.velocity, b.state.angular_velocity);
-            e.gravity_work += first * m * g.dot(v) * dt;
-            e.load_work += first * (b.load.force.dot(v) + b.load.moment.dot(w)) * dt;
-            e.boundary_work += 0.5 * (r.reaction.force.dot(v) + r.reaction.moment.dot(w)) * dt;
-            e.damping -= 0.5 * (r.damping.force.dot(v) + r.damping.moment.dot(w)) * dt;
-        }
-    }
-
-    /// Energy bookkeeping, second half (after the integrator): the `F_n` halves of the reactions
-    /// and damping forces, the kinetic energy `½·m·v_{n−½}·v_{n+½} + ½·ω_{n−½}·L_{n+½}`, and the
-    /// joint terms.
-    fn account_energy(&mut self) {
-        let dt = self.dt;
+        let max2 = self.params.max_speed * self.params.max_speed;
+        let records = &self.records;
+        self.block_sums
+            .par_iter_mut()
+            .zip(self.blocks.par_chunks(BLOCK_CHUNK))
+            .enumerate()
+            .for_each(|(k, (sums, chunk))| {
+                sums.kinetic = 0.0;
+                sums.boundary_work = 0.0;
+                sums.damping = 0.0;
+                sums.diverged = None;
+                for (j, b) in chunk.iter().enumerate() {
+                    let i = k * BLOCK_CHUNK + j;
+                    let r = &records[i];
+                    let m = b.mass_properties().mass;
+                    let (v1, w1) = (b.state.velocity, b.state.angular_velocity);
+                    // The velocities before the step, from the mean the integrator reports.
+                    let v0 = 2.0 * r.mean_velocity - v1;
+                    let w0 = 2.0 * r.mean_angular_velocity - w1;
+                    sums.kinetic += 0.5 * m * v0.dot(v1) + 0.5 * w0.dot(b.state.angular_momentum);
+                    sums.boundary_work += 0.5 * (r.reaction.force.dot(v0) + r.reaction.moment.dot(w0)) * dt;
+                    sums.damping -= 0.5 * (r.damping.force.dot(v0) + r.damping.moment.dot(w0)) * dt;
+                    if sums.diverged.is_none() && diverged(b, max2) {
+                        sums.diverged = Some(i);
+                    }
+                }
+            });
         let e = &mut self.energy;
         let mut kinetic = 0.0;
-        for (b, r) in self.blocks.iter().zip(&self.records) {
-            let m = b.mass_properties().mass;
-            let (v1, w1) = (b.state.velocity, b.state.angular_velocity);
-            // The velocities before the step, from the mean the integrator reports.
-            let v0 = 2.0 * r.mean_velocity - v1;
-            let w0 = 2.0 * r.mean_angular_velocity - w1;
-            kinetic += 0.5 * m * v0.dot(v1) + 0.5 * w0.dot(b.state.angular_momentum);
-            e.boundary_work += 0.5 * (r.reaction.force.dot(v0) + r.reaction.moment.dot(w0)) * dt;
-            e.damping -= 0.5 * (r.damping.force.dot(v0) + r.damping.moment.dot(w0)) * dt;
+        let mut first_diverged = None;
+        for s in &self.block_sums {
+            kinetic += s.kinetic;
+            e.boundary_work += s.boundary_work;
+            e.damping += s.damping;
+            first_diverged = first_diverged.or(s.diverged);
         }
         e.kinetic = kinetic;
-        let (mut work, mut dashpot) = (0.0, 0.0);
-        for p in &self.pairs {
-            work += p.work;
-            dashpot += p.dashpot_work;
+        for s in &self.pair_sums {
+            e.joint_work += s.work;
+            e.damping += s.dashpot_work;
         }
-        e.joint_work += work;
-        e.damping += dashpot;
+        first_diverged
     }
 
-    fn check_divergence(&self) -> Result<()> {
-        let max2 = self.params.max_speed * self.params.max_speed;
-        for (i, b) in self.blocks.iter().enumerate() {
-            let s = &b.state;
-            let finite = is_finite_vector(s.velocity)
-                && is_finite_vector(s.angular_velocity)
-                && is_finite_vector(s.pose.translation)
-                && s.pose.rotation.is_finite();
-            let r = b.shape().radius();
-            let speed2 = s
-                .velocity
-                .length_squared()
-                .max(s.angular_velocity.length_squared() * r * r);
-            if !finite || speed2 > max2 {
-                return Err(Error::Diverged {
-                    step: self.step,
-                    time: self.time,
-                    block: BlockId(i as u32),
-                    reason: if finite {
-                        format!(
-                            "speed {:.3e} m/s exceeds max_speed {} m/s",
-                            speed2.sqrt(),
-                            self.params.max_speed
-                        )
-                    } else {
-                        "position or velocity is not finite".into()
-                    },
-                });
-            }
+    fn divergence_error(&self, i: usize) -> Error {
+        let s = &self.blocks[i].state;
+        let r = self.blocks[i].shape().radius();
+        let speed = s
+            .velocity
+            .length_squared()
+            .max(s.angular_velocity.length_squared() * r * r)
+            .sqrt();
+        Error::Diverged {
+            step: self.step,
+            time: self.time,
+            block: BlockId(i as u32),
+            reason: if speed.is_finite() && is_finite_state(s) {
+                format!("speed {speed:.3e} m/s exceeds max_speed {} m/s", self.params.max_speed)
+            } else {
+                "position or velocity is not finite".into()
+            },
         }
-        Ok(())
     }
 
     fn sample(&mut self) {
