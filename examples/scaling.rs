@@ -85,7 +85,15 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     println!("running-bond wall, bricks 0.2 × 0.1 × 0.05 m, sub-contact spacing 25 mm, {threads} threads");
     println!(
         "{:>8} {:>9} {:>11} {:>11} {:>14} {:>10} {:>9} {:>11} {:>12}",
-        "blocks", "contacts", "subcontacts", "ms/step", "updates/s", "detection", "contacts", "integration", "bytes/block"
+        "blocks",
+        "contacts",
+        "subcontacts",
+        "ms/step",
+        "updates/s",
+        "detection",
+        "contacts",
+        "integration",
+        "bytes/block"
     );
     let mut runs = Vec::new();
     for n in sizes {

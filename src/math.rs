@@ -46,7 +46,10 @@ mod tests {
             let v = Vector::new(0.3, -0.5, 0.81).normalize() * angle;
             let (a, b) = (rotation_from_vector(v), Rotation::from_scaled_axis(v));
             assert!((a.w - b.w).abs() < 1e-16, "{angle}: {a:?} {b:?}");
-            assert!((a.xyz() - b.xyz()).length() < 1e-16 * angle.max(1e-300) + 1e-300, "{angle}");
+            assert!(
+                (a.xyz() - b.xyz()).length() < 1e-16 * angle.max(1e-300) + 1e-300,
+                "{angle}"
+            );
             assert!((a.length() - 1.0).abs() < 2e-16, "{angle}");
         }
     }

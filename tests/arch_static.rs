@@ -43,8 +43,10 @@ fn static_arch_behaves_like_an_arch() {
         );
     }
     let (p27, p305, p35) = (r[0].peak_load, r[1].peak_load, r[2].peak_load);
-    // The load rises from zero to a peak at a small displacement: the arch is stiff before the
-    // mechanism forms.
+    // The load rises from zero to (nearly) its peak at a small displacement: the arch is stiff
+    // before the mechanism forms. (Where the mechanism slides, the load then stays on a plateau
+    // within round-off-sensitive wiggles of 2 %, so the displacement at the very peak is not a
+    // robust measure; the displacement at which 95 % of it is first reached is.)
     for x in &r {
         assert!(
             x.curve[0].load < 0.2 * x.peak_load,
@@ -52,11 +54,16 @@ fn static_arch_behaves_like_an_arch() {
             x.case.label,
             x.curve[0].load
         );
+        let near_peak = x
+            .curve
+            .iter()
+            .find(|s| s.smoothed_load >= 0.95 * x.peak_load)
+            .map_or(f64::INFINITY, |s| s.displacement);
         assert!(
-            x.displacement_at_peak < 5e-3,
-            "{}: peak at {} m",
+            near_peak < 5e-3,
+            "{}: 95 % of the peak first at {} m",
             x.case.label,
-            x.displacement_at_peak
+            near_peak
         );
     }
     // With hinges only (35°), the four-hinge mechanism softens: the load falls after the peak.

@@ -218,7 +218,9 @@ fn slide_acceleration(incline: Incline, psi_deg: Real, phi_deg: Real) -> Result<
     s.model.set_damping(Damping::None)?;
     let (block, d) = (s.block, s.downslope);
     let mut samples = Vec::new();
+    let mut turned: Real = 0.0;
     let reached = s.model.run_until(1_000_000, |m| {
+        turned = turned.max(tilt(m, block).unwrap_or(Real::NAN));
         if m.time() >= 0.1 {
             let v = m.block(block).map(|b| b.state().velocity).unwrap_or(Vector::NAN);
             samples.push((m.time(), v.dot(d)));
@@ -226,9 +228,12 @@ fn slide_acceleration(incline: Incline, psi_deg: Real, phi_deg: Real) -> Result<
         m.time() >= 1.0
     })?;
     assert!(reached, "did not reach t = 1 s");
-    // The block must have slid as a block, not tumbled.
-    let turned = tilt(&s.model, s.block)?;
-    assert!(turned < 1e-3, "block rotated by {turned} rad while sliding");
+    // The block must have slid as a block, not tumbled. It does rock: the friction at its base
+    // puts the normal force at e = tan φ · h/2 = 58 mm from the centre, beyond the kern (b/6 =
+    // 33 mm), so the heel opens, and without damping the base rattles (static tilt of the partly
+    // open joint 2N/(kn c² d) ≈ 1e-4 rad with c = 3(b/2 − e); about 1e-3 rad at the peaks,
+    // depending on round-off). A tumble passes 0.1 rad within a few hundredths of a second.
+    assert!(turned < 1e-2, "block rotated by up to {turned} rad while sliding");
     let (psi, phi) = (psi_deg.to_radians(), phi_deg.to_radians());
     let expected = G * (psi.sin() - phi.tan() * psi.cos());
     Ok((fitted_slope(&samples), expected))

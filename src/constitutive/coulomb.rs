@@ -166,7 +166,14 @@ impl ConstitutiveLaw for CoulombSlip {
         } else {
             (self.tensile_strength, self.cohesion, self.tan_friction)
         };
-        if f.normal < -tensile * a || (f.normal < 0.0 && tensile == 0.0) || (f.normal <= 0.0 && state.failed) {
+        // Open: beyond the tensile strength of a bonded joint; any tension for a dry one (`-0·A`);
+        // no compression for a failed one.
+        let open = if state.failed {
+            f.normal <= 0.0
+        } else {
+            f.normal < -tensile * a
+        };
+        if open {
             if f.normal < 0.0 && tensile > 0.0 {
                 state.failed = true;
             }

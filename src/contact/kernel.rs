@@ -67,7 +67,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         }
     }
     let n = pair.normal;
-    let shear_rotation = rotation_between(previous_normal, n);
+    let shear_turn = plane_turn(previous_normal, n);
     let rotation = Matrix::from_quat(host.rotation);
     // v_rel(p) = v_b + ω_b × (p − x_b) − v_a − ω_a × (p − x_a) = v₀ + (ω_b − ω_a) × r.
     let dw = sb.angular_velocity - sa.angular_velocity;
@@ -82,11 +82,13 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         ctx.stiffness_damping * k.shear / dt,
     );
     let damped = ctx.stiffness_damping > 0.0;
+    // Last step's dashpot forces still owe the second half of their work (also in the step
+    // after Rayleigh damping was switched off).
+    let dashpots = damped || pair.dashpots;
 
-    let mut force = Vector::ZERO;
-    let mut moment_host = Vector::ZERO;
+    let (mut force, mut moment_host, mut normal_force) = (Vector::ZERO, Vector::ZERO, 0.0);
     // Σ (F_before + F_after)·du for the springs and for the dashpots (times −½ at the end).
-    let (mut normal_force, mut spring_sum, mut dashpot_sum) = (0.0, 0.0, 0.0);
+    let (mut spring_sum, mut dashpot_sum) = (0.0, 0.0);
     for sub in subs.iter_mut() {
         let r = rotation * sub.anchor;
         let du = du0 + dwdt.cross(r);
@@ -96,12 +98,12 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             Some((g0, q)) => g0 - q.dot(r),
             None => sub.gap + du_n,
         };
-        let spring_before = previous_normal * sub.force.normal + sub.force.shear;
-        let dashpot_before = sub.dashpot;
+        // Last step's spring force n'·F_n + F_s, dotted with this step's displacement.
+        let spring_before = sub.force.normal * previous_normal.dot(du) + sub.force.shear.dot(du);
 
         // Last step's shear force turns with the joint plane.
-        if let Some(turn) = shear_rotation {
-            sub.force.shear = turn * sub.force.shear;
+        if let Some(m) = shear_turn {
+            sub.force.shear -= m * n.dot(sub.force.shear);
         }
         let step = JointStep {
             area: sub.area,
@@ -115,11 +117,12 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         if status == JointStatus::Sliding {
             sub.slip += du_s.length();
         }
-        let spring = n * sub.force.normal + sub.force.shear;
+        let (fn_, fs) = (sub.force.normal, sub.force.shear);
         // Trapezoidal rule over the step's displacement, for the springs and the dashpots.
-        spring_sum += (spring_before + spring).dot(du);
-        let mut total = spring;
-        if damped || dashpot_before != Vector::ZERO {
+        spring_sum += spring_before + fn_ * du_n + fs.dot(du);
+        normal_force += fn_;
+        let mut total = n * fn_ + fs;
+        if dashpots {
             let mut dashpot = Vector::ZERO;
             if damped && status != JointStatus::Open {
                 dashpot -= n * (cn * sub.area * du_n);
@@ -127,16 +130,16 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                     dashpot -= du_s * (cs * sub.area);
                 }
             }
-            dashpot_sum += (dashpot_before + dashpot).dot(du);
+            dashpot_sum += (sub.dashpot + dashpot).dot(du);
             total += dashpot;
             sub.dashpot = dashpot;
         }
         force += total;
         moment_host += r.cross(total);
-        normal_force += sub.force.normal;
         sub.gap = gap;
         sub.status = status;
     }
+    pair.dashpots = damped;
     // Moments about the centroids: Σ (p − x)×F with p = x_h + r on block b, −F on block a.
     pair.force = force;
     if pair.host_is_a {
@@ -151,49 +154,46 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair.dashpot_work = -0.5 * dashpot_sum;
 }
 
-/// The smallest rotation taking unit vector `from` to unit vector `to`, `None` when they are
-/// equal: `R = c·I + [v]× + v vᵀ/(1 + c)` with `v = from × to`, `c = from · to` (Rodrigues'
-/// formula with `sin θ·k = v`). A shear force in the old joint plane is turned into the new one
-/// with its magnitude and its direction relative to the plane kept.
+/// How a vector in the plane normal to `from` turns into the plane normal to `to` (unit
+/// vectors) by the smallest rotation taking `from` to `to`: `s ↦ s − (to·s) m` with
+/// `m = (from + to)/(1 + from·to)`, `None` when the planes are the same.
+///
+/// The smallest rotation is `R = I − (a+b)(a+b)ᵀ/(1+c) + 2 b aᵀ` (`a = from`, `b = to`,
+/// `c = a·b`); for `s·a = 0` it reduces to the above. It keeps the magnitude of `s` and its
+/// direction relative to the plane.
 #[inline]
-fn rotation_between(from: Vector, to: Vector) -> Option<Matrix> {
-    let v = from.cross(to);
-    let c = from.dot(to);
-    if v == Vector::ZERO && c > 0.0 {
+fn plane_turn(from: Vector, to: Vector) -> Option<Vector> {
+    if from == to {
         return None;
     }
-    if c <= -1.0 + 1e-12 {
-        // Opposite normals (not a physical step): a half turn about any perpendicular axis.
-        let axis = from.any_orthonormal_vector();
-        return Some(Matrix::from_axis_angle(axis, std::f64::consts::PI));
-    }
-    let k = 1.0 / (1.0 + c);
-    Some(Matrix::from_cols(
-        Vector::new(c, v.z, -v.y) + v * (k * v.x),
-        Vector::new(-v.z, c, v.x) + v * (k * v.y),
-        Vector::new(v.y, -v.x, c) + v * (k * v.z),
-    ))
+    let c = from.dot(to);
+    // Opposite normals are not a physical step; keep the vector rather than divide by zero.
+    (c > -1.0 + 1e-12).then(|| (from + to) / (1.0 + c))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::Rotation;
 
     #[test]
-    fn rotation_between_turns_the_plane_and_keeps_lengths() {
+    fn plane_turn_keeps_in_plane_vectors_in_plane_with_their_length() {
         let from = Vector::new(0.1, -0.3, 0.9).normalize();
         let to = Vector::new(-0.2, 0.25, 0.95).normalize();
-        let r = rotation_between(from, to).expect("a rotation");
-        assert!((r * from - to).length() < 1e-15);
-        // An in-plane vector stays in the (new) plane with its length.
-        let s = from.cross(Vector::X).normalize() * 3.0;
-        let t = r * s;
-        assert!(t.dot(to).abs() < 1e-14 && (t.length() - 3.0).abs() < 1e-14);
-        // Orthogonal with determinant one.
-        assert!((r.transpose() * r - Matrix::IDENTITY).abs_diff_eq(Matrix::ZERO, 1e-15));
-        assert!((r.determinant() - 1.0).abs() < 1e-15);
-        assert!(rotation_between(to, to).is_none());
-        let flip = rotation_between(to, -to).expect("a half turn");
-        assert!((flip * to + to).length() < 1e-14);
+        let m = plane_turn(from, to).expect("a turn");
+        let turn = |s: Vector| s - m * to.dot(s);
+        // The smallest rotation (axis from × to) applied to an in-plane vector.
+        let axis = from.cross(to).normalize();
+        let angle = from.dot(to).clamp(-1.0, 1.0).acos();
+        let rotation = Rotation::from_axis_angle(axis, angle);
+        for s in [from.cross(Vector::X), from.cross(Vector::Y), axis, from.cross(axis)] {
+            let s = s.normalize() * 3.0;
+            let t = turn(s);
+            assert!(t.dot(to).abs() < 1e-14, "in the new plane");
+            assert!((t.length() - 3.0).abs() < 1e-14, "same magnitude");
+            assert!((t - rotation * s).length() < 1e-14, "the smallest rotation");
+        }
+        assert!(plane_turn(to, to).is_none());
+        assert!(plane_turn(to, -to).is_none());
     }
 }

@@ -9,8 +9,8 @@ pub(crate) use kernel::{update_contact, KernelContext};
 
 use crate::block::BlockId;
 use crate::constitutive::{JointForce, JointStatus};
-use crate::geometry::{ContactKind, SubKey};
 use crate::geometry::Polyhedron;
+use crate::geometry::{ContactKind, SubKey};
 use crate::math::{Pose, Real, Rotation, Vector};
 
 /// Typed index of a contact in the model's current contact list (valid until the next
@@ -67,6 +67,10 @@ pub struct ContactPair {
     pub(crate) local_normal_b: Vector,
     #[serde(skip)]
     pub(crate) local_other_offset: Real,
+    /// Whether the sub-contacts may hold dashpot forces (Rayleigh damping in the last step, or
+    /// history carried over at detection); only saves reading them when not.
+    #[serde(skip, default = "always")]
+    pub(crate) dashpots: bool,
     /// Centroids at detection (lever arms in small-displacement mode).
     pub(crate) ref_a: Vector,
     pub(crate) ref_b: Vector,
@@ -85,6 +89,10 @@ pub struct ContactPair {
     pub(crate) area: Real,
     /// `area` when the critical step was last evaluated (0 for a new contact).
     pub(crate) bound_area: Real,
+}
+
+fn always() -> bool {
+    true
 }
 
 impl ContactPair {

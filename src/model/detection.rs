@@ -202,6 +202,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 local_normal_a: Vector::ZERO,
                 local_normal_b: Vector::ZERO,
                 local_other_offset: 0.0,
+                dashpots: true,
                 ref_a: bi.state.pose.translation,
                 ref_b: bj.state.pose.translation,
                 ref_host_rotation: host.state.pose.rotation,

@@ -11,8 +11,7 @@ pub use energy::Energies;
 
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
-use crate::contact::{
-    update_contact, ContactPair, ContactView, DisplacementMode, KernelContext, SubContact};
+use crate::contact::{update_contact, ContactPair, ContactView, DisplacementMode, KernelContext, SubContact};
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
@@ -190,7 +189,7 @@ fn diverged(b: &RigidBlock, max_speed2: Real) -> bool {
         .velocity
         .length_squared()
         .max(s.angular_velocity.length_squared() * r * r);
-    !(speed2 <= max_speed2) || !is_finite_state(s)
+    speed2.is_nan() || speed2 > max_speed2 || !is_finite_state(s)
 }
 
 fn is_finite_state(s: &crate::block::BlockState) -> bool {
