@@ -58,6 +58,7 @@ pub mod block;
 pub mod build;
 pub mod constitutive;
 pub mod contact;
+mod dispatch;
 pub mod error;
 pub mod geometry;
 pub mod integrate;

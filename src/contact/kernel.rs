@@ -26,7 +26,7 @@ pub(crate) struct KernelContext {
 /// relative velocity field `v_rel(r) = v₀ + Δω × r` with `r` the lever arm from the host
 /// centroid, and the face-face gap `g(r) = g₀ − q·r`; a sub-contact then costs one
 /// matrix-vector product and one cross product for its kinematics and one for its moment.
-#[inline]
+#[inline(always)]
 pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
     subs: &mut [SubContact<L::State>],

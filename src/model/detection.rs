@@ -224,6 +224,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let (work, dashpot) = dropped_work(
             (&self.pairs, &self.subs),
             (&sc.pairs, &sc.subs),
+            &sc.moved,
             &self.blocks,
             self.params.mode,
             self.dt,
@@ -263,9 +264,10 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.block_contacts.clear();
         self.block_contacts.resize(self.block_offsets[n] as usize, 0);
         let mut fill: Vec<u32> = self.block_offsets[..n].to_vec();
+        // Each entry is `2 × contact + side`, side 1 when the block is the contact's `b`.
         for (c, p) in self.pairs.iter().enumerate() {
-            for k in [p.a as usize, p.b as usize] {
-                self.block_contacts[fill[k] as usize] = c as u32;
+            for (k, side) in [(p.a as usize, 0), (p.b as usize, 1)] {
+                self.block_contacts[fill[k] as usize] = 2 * c as u32 + side;
                 fill[k] += 1;
             }
         }
@@ -508,6 +510,7 @@ fn outer(a: Vector, b: Vector) -> crate::math::Matrix {
 fn dropped_work<S>(
     old: (&[ContactPair], &[SubContact<S>]),
     new: (&[ContactPair], &[SubContact<S>]),
+    moved: &[bool],
     blocks: &[crate::block::RigidBlock],
     mode: DisplacementMode,
     dt: Real,
@@ -521,6 +524,11 @@ fn dropped_work<S>(
             .map(|k| &new.0[k])
             .filter(|q| q.kind == p.kind && q.host_is_a == p.host_is_a)
             .map(|q| &new.1[q.range()]);
+        // A contact between two blocks that did not move is kept as it was, with all its
+        // sub-contacts.
+        if carried.is_some() && !moved[p.a as usize] && !moved[p.b as usize] {
+            continue;
+        }
         let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
         let frame = p.frame(&sa.pose, &sb.pose, mode);
         let (xa, xb) = match mode {
