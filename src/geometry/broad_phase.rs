@@ -18,6 +18,11 @@ const FAT_FACTOR: Real = 1.0;
 /// above it, in one O(n) pass (`Bvh::refit`).
 const REFIT_PARTIAL_RATIO: usize = 32;
 
+/// The incremental tree is rebuilt once its leaves have been re-inserted this many times the
+/// number of leaves since it was built: re-insertion never rebalances it, and blocks that travel
+/// far (a collapse) would otherwise leave a tree that is exact but slow to traverse.
+const REBUILD_AFTER_REINSERTIONS: usize = 4;
+
 /// Reusable broad-phase state.
 #[derive(Default)]
 pub struct BroadPhase {
@@ -30,6 +35,8 @@ pub struct BroadPhase {
 struct Incremental {
     /// `margin` the tree was built for; another margin rebuilds it.
     margin: Real,
+    /// Leaves re-inserted since the tree was built.
+    reinserted: usize,
     /// Leaves are the boxes of [`BroadPhase::pairs`] enlarged by `FAT_FACTOR * margin`.
     bvh: Bvh,
     /// Copy of the leaves, by block: checking them in order is much cheaper than asking the tree
@@ -114,7 +121,15 @@ impl BroadPhase {
         let fat = FAT_FACTOR * margin;
         let ws = &mut self.workspace;
         let reinserted = match &mut self.incremental {
-            Some(inc) if inc.margin == margin && inc.bvh.leaf_count() as usize == n => inc.update(&self.aabbs, fat, ws),
+            Some(inc)
+                if inc.margin == margin
+                    && inc.bvh.leaf_count() as usize == n
+                    && inc.reinserted <= REBUILD_AFTER_REINSERTIONS * n =>
+            {
+                let count = inc.update(&self.aabbs, fat, ws);
+                inc.reinserted += count;
+                count
+            }
             _ => {
                 self.incremental = Some(Incremental::build(&self.aabbs, margin, fat, ws));
                 n
@@ -206,6 +221,7 @@ impl Incremental {
         fat_pairs.dedup();
         Self {
             margin,
+            reinserted: 0,
             bvh,
             fat_leaves,
             fat_pairs,

@@ -65,7 +65,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 .zip(&self.ref_poses)
                 .map(|(b, r)| full || movement(b, r) > trigger),
         );
-        sc.broad.pairs(
+        sc.broad.pairs_incremental(
             self.blocks.iter().map(|b| (b.shape(), &b.state.pose)),
             params.tolerance,
             &mut sc.candidates,
