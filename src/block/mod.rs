@@ -178,17 +178,22 @@ pub trait Block {
 /// assert!((base.mass_properties().mass - 2500.0 * 0.8).abs() < 1e-9);
 /// # Ok::<(), voussoir::Error>(())
 /// ```
+///
+/// Layout: what every step reads (state, mass, fixity, load) comes first and together, and the
+/// shape sits behind a pointer, so that the passes over blocks stream about 300 bytes per block
+/// rather than 700 (`docs/performance.md`).
 #[derive(Debug, Clone, Serialize, Deserialize)]
+#[repr(C)]
 pub struct RigidBlock {
-    name: String,
-    shape: Polyhedron,
-    density: Real,
-    mass: MassProperties,
-    material: MaterialId,
-    fixity: Fixity,
     pub(crate) state: BlockState,
-    pub(crate) initial_pose: Pose,
+    mass: MassProperties,
+    fixity: Fixity,
     pub(crate) load: Wrench,
+    material: MaterialId,
+    shape: Box<Polyhedron>,
+    name: String,
+    density: Real,
+    pub(crate) initial_pose: Pose,
 }
 
 impl RigidBlock {
@@ -225,7 +230,7 @@ impl RigidBlock {
         let mass = shape.mass_properties(density);
         Self {
             name: name.to_owned(),
-            shape,
+            shape: Box::new(shape),
             density,
             mass,
             material: MaterialId::default(),
@@ -305,12 +310,6 @@ impl RigidBlock {
     pub(crate) fn world_inertia_times(&self, w: Vector) -> Vector {
         let r = self.state.pose.rotation;
         r * (self.mass.principal_inertia * (r.inverse() * w))
-    }
-
-    /// `I_world⁻¹ · l` with the current rotation.
-    pub(crate) fn world_inverse_inertia_times(&self, l: Vector) -> Vector {
-        let r = self.state.pose.rotation;
-        r * ((r.inverse() * l) / self.mass.principal_inertia)
     }
 
     pub(crate) fn validate(&self) -> Result<()> {

@@ -77,11 +77,15 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let (du0, dwdt) = (v0 * dt, dw * dt);
     let k = law.stiffness();
     // Dashpot coefficients per unit area (zero without Rayleigh damping).
-    let (cn, cs) = (
-        ctx.stiffness_damping * k.normal / dt,
-        ctx.stiffness_damping * k.shear / dt,
-    );
     let damped = ctx.stiffness_damping > 0.0;
+    let (cn, cs) = if damped {
+        (
+            ctx.stiffness_damping * k.normal / dt,
+            ctx.stiffness_damping * k.shear / dt,
+        )
+    } else {
+        (0.0, 0.0)
+    };
     // Last step's dashpot forces still owe the second half of their work (also in the step
     // after Rayleigh damping was switched off).
     let dashpots = damped || pair.dashpots;

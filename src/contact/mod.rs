@@ -45,7 +45,11 @@ pub trait Contact {
 }
 
 /// One contact between blocks `a < b`, with a contiguous range of sub-contacts.
+///
+/// Layout: the fields a large-displacement step reads and writes come first and together; the
+/// reference geometry of small-displacement mode and the detection bookkeeping come last.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[repr(C)]
 pub struct ContactPair {
     pub(crate) a: u32,
     pub(crate) b: u32,
@@ -71,11 +75,6 @@ pub struct ContactPair {
     /// history carried over at detection); only saves reading them when not.
     #[serde(skip, default = "always")]
     pub(crate) dashpots: bool,
-    /// Centroids at detection (lever arms in small-displacement mode).
-    pub(crate) ref_a: Vector,
-    pub(crate) ref_b: Vector,
-    /// Rotation of the host block at detection (anchors to world in small-displacement mode).
-    pub(crate) ref_host_rotation: Rotation,
     /// Resultant force on `b` (N).
     pub(crate) force: Vector,
     /// Moments of the sub-contact forces about the centroids of `a` and `b` (N·m).
@@ -85,6 +84,11 @@ pub struct ContactPair {
     pub(crate) normal_force: Real,
     pub(crate) work: Real,
     pub(crate) dashpot_work: Real,
+    /// Centroids at detection (lever arms in small-displacement mode).
+    pub(crate) ref_a: Vector,
+    pub(crate) ref_b: Vector,
+    /// Rotation of the host block at detection (anchors to world in small-displacement mode).
+    pub(crate) ref_host_rotation: Rotation,
     /// Sum of the sub-contact areas (m²).
     pub(crate) area: Real,
     /// `area` when the critical step was last evaluated (0 for a new contact).

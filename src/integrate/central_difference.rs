@@ -4,7 +4,7 @@ use rayon::prelude::*;
 
 use super::{Damping, Integrator, StepRecord};
 use crate::block::{Block, Dof, RigidBlock, Wrench};
-use crate::math::{rotation_from_vector, Real, Rotation, Vector};
+use crate::math::{rotation_from_vector, Matrix, Real, Rotation, Vector};
 
 /// Explicit central difference: velocities at half steps, positions at full steps.
 ///
@@ -131,12 +131,17 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
     // ω(t+Δt/2) = R(t+Δt/2)·I⁻¹·R(t+Δt/2)ᵀ·L(t+Δt/2), with R(t+Δt/2) = exp(ω·Δt/2)·R(t): solved by
     // fixed-point iteration (contraction ~ |ω|Δt/2). Evaluating at R(t) instead makes the
     // rotation update first order and pumps energy into a free asymmetric spinner.
-    let inertia = block.mass_properties().principal_inertia;
+    // Rotations as matrices (two products each, with the transpose for the inverse), the
+    // principal inertia inverted once.
+    let inverse_inertia = Vector::ONE / block.mass_properties().principal_inertia;
     let r0 = s0.pose.rotation;
-    let inv_inertia_at = |r: Rotation, l: Vector| r * ((r.inverse() * l) / inertia);
+    let inv_inertia_at = |r: Rotation, l: Vector| {
+        let m = Matrix::from_quat(r);
+        m * ((m.transpose() * l) * inverse_inertia)
+    };
     // The iteration contracts by about |ω|Δt/2 per pass: it stops when the next correction
     // would fall below round-off (two passes for a block of masonry moving slowly, three at most).
-    let mut w = block.world_inverse_inertia_times(l);
+    let mut w = inv_inertia_at(r0, l);
     for _ in 0..3 {
         let next = inv_inertia_at(rotation_from_vector(0.5 * dt * w) * r0, l);
         let change = (next - w).length();
