@@ -189,6 +189,10 @@ pub struct RigidBlock {
     mass: MassProperties,
     fixity: Fixity,
     pub(crate) load: Wrench,
+    /// `shape.radius()`, kept next to the state for the per-step movement and speed checks
+    /// (set on construction, by `Model::add_block` and on restore).
+    #[serde(skip)]
+    pub(crate) radius: Real,
     material: MaterialId,
     shape: Box<Polyhedron>,
     name: String,
@@ -230,6 +234,7 @@ impl RigidBlock {
         let mass = shape.mass_properties(density);
         Self {
             name: name.to_owned(),
+            radius: shape.radius(),
             shape: Box::new(shape),
             density,
             mass,
@@ -339,6 +344,7 @@ impl RigidBlock {
 
     pub(crate) fn restore(&mut self) -> Result<()> {
         self.shape.restore()?;
+        self.radius = self.shape.radius();
         self.validate()
     }
 }

@@ -1,5 +1,7 @@
 //! Contact re-detection with history transfer, the block → contact index, and the time step.
 
+use rayon::prelude::*;
+
 use super::Model;
 use crate::block::{Block, BlockId};
 use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus};
@@ -46,9 +48,10 @@ impl<L: ConstitutiveLaw> Model<L> {
         }
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
         self.blocks
-            .iter()
-            .zip(&self.ref_poses)
-            .any(|(b, r)| movement(b, r) > trigger)
+            .par_iter()
+            .with_min_len(1024)
+            .zip(self.ref_poses.par_iter())
+            .any(|(b, r)| moved_beyond(b, r, trigger))
     }
 
     /// Re-detects contacts: pairs where a block moved beyond the trigger get a fresh narrow phase
@@ -63,7 +66,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             self.blocks
                 .iter()
                 .zip(&self.ref_poses)
-                .map(|(b, r)| full || movement(b, r) > trigger),
+                .map(|(b, r)| full || moved_beyond(b, r, trigger)),
         );
         sc.broad.pairs_incremental(
             self.blocks.iter().map(|b| (b.shape(), &b.state.pose)),
@@ -400,12 +403,24 @@ fn all_constrained(b: &crate::block::RigidBlock) -> bool {
         .all(|d| d.prescribed().is_some())
 }
 
-/// Largest displacement of a point of the block since pose `r`: translation plus radius × angle.
-fn movement(b: &crate::block::RigidBlock, r: &crate::math::Pose) -> Real {
-    let s = &b.state.pose;
-    let dq = s.rotation * r.rotation.inverse();
-    let angle = 2.0 * dq.xyz().length().atan2(dq.w.abs());
-    (s.translation - r.translation).length() + b.shape().radius() * angle
+/// Whether the largest displacement of a point of the block since pose `r`, bounded by the
+/// translation plus radius × rotation angle, exceeds `trigger`.
+///
+/// The angle `θ = 2 asin(s)`, with `s` the norm of the vector part of the relative rotation,
+/// lies between `2s` and `πs`: the arcsine is evaluated only when the two bounds disagree.
+fn moved_beyond(b: &crate::block::RigidBlock, r: &crate::math::Pose, trigger: Real) -> bool {
+    let p = &b.state.pose;
+    let translation = (p.translation - r.translation).length();
+    let dq = p.rotation * r.rotation.inverse();
+    let s = dq.xyz().length().min(1.0);
+    let radius = b.radius;
+    if translation + radius * 2.0 * s > trigger {
+        return true;
+    }
+    if translation + radius * std::f64::consts::PI * s <= trigger {
+        return false;
+    }
+    translation + radius * 2.0 * s.asin() > trigger
 }
 
 /// Zeroth, first and second area moments of a contact's sub-contact points: enough to assemble

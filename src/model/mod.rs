@@ -249,7 +249,7 @@ struct BlockSums {
 /// Whether a block's state is non-finite or faster than `√max_speed2`.
 fn diverged(b: &RigidBlock, max_speed2: Real) -> bool {
     let s = &b.state;
-    let r = b.shape().radius();
+    let r = b.radius;
     let speed2 = s
         .velocity
         .length_squared()
@@ -329,8 +329,9 @@ impl<L: ConstitutiveLaw> Model<L> {
     ///
     /// # Errors
     /// [`Error::NonFinite`] for a NaN or infinite velocity, position, load or prescribed velocity.
-    pub fn add_block(&mut self, block: RigidBlock) -> Result<BlockId> {
+    pub fn add_block(&mut self, mut block: RigidBlock) -> Result<BlockId> {
         block.validate()?;
+        block.radius = block.shape().radius();
         let id = BlockId(self.blocks.len() as u32);
         self.ref_poses.push(block.state.pose);
         self.blocks.push(block);
