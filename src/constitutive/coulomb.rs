@@ -196,6 +196,19 @@ impl ConstitutiveLaw for CoulombSlip {
         JointStatus::Elastic
     }
 
+    /// The open test of [`CoulombSlip::update`], evaluated the same way: true for a failed
+    /// joint without compression, and for an intact one beyond its tensile strength only when
+    /// that strength is zero (else opening is a failure, a change of state).
+    #[inline]
+    fn stays_open(&self, area: Real, normal_displacement: Real, state: &CoulombState) -> bool {
+        let normal = -self.normal_stiffness * normal_displacement * area;
+        if state.failed {
+            normal <= 0.0
+        } else {
+            self.tensile_strength == 0.0 && normal < -self.tensile_strength * area
+        }
+    }
+
     fn is_failed(&self, state: &CoulombState) -> bool {
         state.failed
     }
@@ -277,6 +290,43 @@ mod tests {
         assert!(s.failed && f.normal == 0.0);
         // Once failed, no tension at all.
         assert_eq!(law.update(&step(1e-6, Vector::ZERO), &mut f, &mut s), JointStatus::Open);
+    }
+
+    /// `stays_open` promises what `update` does: open, zero forces, state unchanged; and it does
+    /// promise it for separated dry and failed joints, not for intact bonded ones.
+    #[test]
+    fn stays_open_agrees_with_update() {
+        let laws = [
+            CoulombSlip::dry(4e9, 1.6e9, 30.0).unwrap(),
+            CoulombSlip::new(4e9, 1.6e9, 35.0, 25.0, 0.0, 0.0).unwrap(),
+            CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap(),
+        ];
+        let gaps = [-1e-3, -1e-9, -0.0, 0.0, 1e-300, 1e-12, 4e-5, 6e-5, 1.0];
+        let shears = [Vector::ZERO, Vector::new(1e-3, -2e-4, 0.0)];
+        let mut promised = [0usize; 3];
+        for (l, law) in laws.iter().enumerate() {
+            for failed in [false, true] {
+                for &gap in &gaps {
+                    for &du in &shears {
+                        let mut state = CoulombState { failed };
+                        let before = state;
+                        if !law.stays_open(1.0, gap, &state) {
+                            continue;
+                        }
+                        promised[l] += 1;
+                        let mut f = JointForce::default();
+                        assert_eq!(law.update(&step(gap, du), &mut f, &mut state), JointStatus::Open);
+                        assert_eq!(f, JointForce::default(), "law {l}, gap {gap}");
+                        assert_eq!(state, before, "law {l}, gap {gap}");
+                    }
+                }
+            }
+        }
+        // Dry joints: every positive gap, intact or failed, and zero gap once failed.
+        assert_eq!(promised[0], 2 * (5 + 7));
+        // The bonded joint only once failed (opening an intact one is a failure).
+        assert_eq!(promised[2], 2 * 7);
+        assert!(!laws[2].stays_open(1.0, 1.0, &CoulombState { failed: false }));
     }
 
     #[test]

@@ -119,6 +119,18 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     /// plane) and `state` for this step's kinematics; returns the resulting status.
     fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut Self::State) -> JointStatus;
 
+    /// Whether a sub-contact that is open with zero force stays so at total normal displacement
+    /// `normal_displacement` (m), whatever its shear increment: [`ConstitutiveLaw::update`]
+    /// would return [`JointStatus::Open`], leave the forces at zero and `state` unchanged.
+    ///
+    /// The contact kernel then skips the sub-contact's kinematics and update (separated parts
+    /// of joints are common: a quarter of the sub-contacts of a settled running-bond wall). It
+    /// must agree exactly with `update`; the default, `false`, never skips.
+    #[inline]
+    fn stays_open(&self, _area: Real, _normal_displacement: Real, _state: &Self::State) -> bool {
+        false
+    }
+
     /// Elastic energy stored in the joint springs (J). The default assumes linear springs with the
     /// stiffness of [`ConstitutiveLaw::stiffness`].
     fn elastic_energy(&self, area: Real, force: &JointForce, _state: &Self::State) -> Real {

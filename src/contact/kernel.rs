@@ -4,7 +4,7 @@
 
 use super::{ContactPair, DisplacementMode, SubContact};
 use crate::block::BlockState;
-use crate::constitutive::{ConstitutiveLaw, JointStatus, JointStep};
+use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep};
 use crate::geometry::ContactKind;
 use crate::math::{Matrix, Real, Vector};
 
@@ -73,8 +73,17 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let dw = sb.angular_velocity - sa.angular_velocity;
     let v0 = sb.velocity - sa.velocity + sb.angular_velocity.cross(xh - xb) - sa.angular_velocity.cross(xh - xa);
     let dt = ctx.dt;
-    // Displacement increments over the step: du(r) = v₀Δt + (Δω Δt) × r.
-    let (du0, dwdt) = (v0 * dt, dw * dt);
+    // Displacement increments over the step, affine in the anchor `a` (host body frame):
+    // du = v₀Δt + (ΔωΔt) × (R a) = du₀ + D a, with D = [ΔωΔt]× R.
+    let du0 = v0 * dt;
+    let dwdt = dw * dt;
+    let d = Matrix::from_cols(
+        dwdt.cross(rotation.x_axis),
+        dwdt.cross(rotation.y_axis),
+        dwdt.cross(rotation.z_axis),
+    );
+    // Face gap in the anchor: g₀ − q·(R a) = g₀ − (Rᵀq)·a.
+    let face_gap = face_gap.map(|(g0, q)| (g0, rotation.transpose() * q));
     let k = law.stiffness();
     // Dashpot coefficients per unit area (zero without Rayleigh damping).
     let damped = ctx.stiffness_damping > 0.0;
@@ -90,21 +99,31 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // after Rayleigh damping was switched off).
     let dashpots = damped || pair.dashpots;
 
-    let (mut force, mut moment_host, mut normal_force) = (Vector::ZERO, Vector::ZERO, 0.0);
-    // Σ (F_before + F_after)·du for the springs and for the dashpots (times −½ at the end).
-    let (mut spring_sum, mut dashpot_sum) = (0.0, 0.0);
+    let mut springs = ForceMoments::default();
+    let mut dashpot_moments = ForceMoments::default();
+    let mut normal_force = 0.0;
+    // Σ (F_before + F_after)·du for the dashpots (times −½ at the end).
+    let mut dashpot_sum = 0.0;
     for sub in subs.iter_mut() {
-        let r = rotation * sub.anchor;
-        let du = du0 + dwdt.cross(r);
+        let a = sub.anchor;
+        let face = face_gap.map(|(g0, q)| g0 - q.dot(a));
+        // A separated sub-contact that the law says stays open with no force and no change of
+        // state needs neither kinematics nor an update (nor a dashpot: it had none and gets none).
+        if let Some(gap) = face {
+            if sub.status == JointStatus::Open
+                && sub.force.normal == 0.0
+                && sub.force.shear == Vector::ZERO
+                && (!dashpots || sub.dashpot == Vector::ZERO)
+                && law.stays_open(sub.area, gap, &sub.state)
+            {
+                sub.gap = gap;
+                continue;
+            }
+        }
+        let du = du0 + d * a;
         let du_n = n.dot(du);
         let du_s = du - n * du_n;
-        let gap = match face_gap {
-            Some((g0, q)) => g0 - q.dot(r),
-            None => sub.gap + du_n,
-        };
-        // Last step's spring force n'·F_n + F_s, dotted with this step's displacement.
-        let spring_before = sub.force.normal * previous_normal.dot(du) + sub.force.shear.dot(du);
-
+        let gap = face.unwrap_or(sub.gap + du_n);
         // Last step's shear force turns with the joint plane.
         if let Some(m) = shear_turn {
             sub.force.shear -= m * n.dot(sub.force.shear);
@@ -121,11 +140,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         if status == JointStatus::Sliding {
             sub.slip += du_s.length();
         }
-        let (fn_, fs) = (sub.force.normal, sub.force.shear);
-        // Trapezoidal rule over the step's displacement, for the springs and the dashpots.
-        spring_sum += spring_before + fn_ * du_n + fs.dot(du);
-        normal_force += fn_;
-        let mut total = n * fn_ + fs;
+        normal_force += sub.force.normal;
+        springs.add(spring_force(n, &sub.force), a);
         if dashpots {
             let mut dashpot = Vector::ZERO;
             if damped && status != JointStatus::Open {
@@ -135,15 +151,24 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 }
             }
             dashpot_sum += (sub.dashpot + dashpot).dot(du);
-            total += dashpot;
+            dashpot_moments.add(dashpot, a);
             sub.dashpot = dashpot;
         }
-        force += total;
-        moment_host += r.cross(total);
         sub.gap = gap;
         sub.status = status;
     }
     pair.dashpots = damped;
+    // Joint work by the trapezoidal rule, Σ (F_before + F_after)·du summed through the moments:
+    // Σ F·(du₀ + D a) = du₀·ΣF + D : Σ F aᵀ.
+    let spring_sum = pair.springs.work(du0, &d) + springs.work(du0, &d);
+    pair.springs = springs;
+    let total = if dashpots {
+        springs.plus(&dashpot_moments)
+    } else {
+        springs
+    };
+    let force = total.force;
+    let moment_host = total.moment(&rotation);
     // Moments about the centroids: Σ (p − x)×F with p = x_h + r on block b, −F on block a.
     pair.force = force;
     if pair.host_is_a {
@@ -156,6 +181,76 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair.normal_force = normal_force;
     pair.work = -0.5 * spring_sum;
     pair.dashpot_work = -0.5 * dashpot_sum;
+}
+
+/// A sub-contact's spring force on block `b` (N, world): normal plus shear.
+#[inline(always)]
+pub(crate) fn spring_force(n: Vector, force: &JointForce) -> Vector {
+    n * force.normal + force.shear
+}
+
+/// Zeroth and first moments of a contact's sub-contact forces over their anchors `a` (host body
+/// frame): `F = Σ Fᵢ` and `S = Σ Fᵢ aᵢᵀ`. They give the moment about the host centroid,
+/// `Σ (R aᵢ) × Fᵢ`, and the work over a displacement field affine in the anchor,
+/// `Σ Fᵢ·(du₀ + D aᵢ) = du₀·F + D : S`, without a per-sub-contact cross or dot product.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ForceMoments {
+    pub force: Vector,
+    pub first: Matrix,
+}
+
+impl Default for ForceMoments {
+    fn default() -> Self {
+        Self {
+            force: Vector::ZERO,
+            first: Matrix::ZERO,
+        }
+    }
+}
+
+impl ForceMoments {
+    /// Adds force `f` at anchor `a`.
+    #[inline(always)]
+    pub fn add(&mut self, f: Vector, a: Vector) {
+        self.force += f;
+        self.first.x_axis += f * a.x;
+        self.first.y_axis += f * a.y;
+        self.first.z_axis += f * a.z;
+    }
+
+    /// The moments of the spring forces of `subs`, whose forces were composed with normal `n`.
+    pub fn of_springs<S>(n: Vector, subs: &[SubContact<S>]) -> Self {
+        let mut m = Self::default();
+        for s in subs {
+            m.add(spring_force(n, &s.force), s.anchor);
+        }
+        m
+    }
+
+    fn plus(&self, other: &Self) -> Self {
+        Self {
+            force: self.force + other.force,
+            first: self.first + other.first,
+        }
+    }
+
+    /// `Σ Fᵢ·(du₀ + D aᵢ)`.
+    #[inline]
+    fn work(&self, du0: Vector, d: &Matrix) -> Real {
+        du0.dot(self.force)
+            + (d.x_axis.dot(self.first.x_axis) + d.y_axis.dot(self.first.y_axis) + d.z_axis.dot(self.first.z_axis))
+    }
+
+    /// `Σ (R aᵢ) × Fᵢ`, from `T = R Sᵀ` (`T_jk = Σ (R aᵢ)_j F_ik`).
+    #[inline]
+    fn moment(&self, rotation: &Matrix) -> Vector {
+        let t = *rotation * self.first.transpose();
+        Vector::new(
+            t.z_axis.y - t.y_axis.z,
+            t.x_axis.z - t.z_axis.x,
+            t.y_axis.x - t.x_axis.y,
+        )
+    }
 }
 
 /// How a vector in the plane normal to `from` turns into the plane normal to `to` (unit

@@ -5,7 +5,7 @@ mod kernel;
 
 use serde::{Deserialize, Serialize};
 
-pub(crate) use kernel::{update_contact, KernelContext};
+pub(crate) use kernel::{spring_force, update_contact, ForceMoments, KernelContext};
 
 use crate::block::BlockId;
 use crate::constitutive::{JointForce, JointStatus};
@@ -84,6 +84,11 @@ pub struct ContactPair {
     pub(crate) normal_force: Real,
     pub(crate) work: Real,
     pub(crate) dashpot_work: Real,
+    /// Force and first moment of the sub-contacts' spring forces as they stand (composed with
+    /// `normal`), for the first half of the next step's joint work. Kept by the step and
+    /// recomputed from the sub-contacts at detection and on checkpoint load.
+    #[serde(skip)]
+    pub(crate) springs: ForceMoments,
     /// Centroids at detection (lever arms in small-displacement mode).
     pub(crate) ref_a: Vector,
     pub(crate) ref_b: Vector,
@@ -154,6 +159,11 @@ impl ContactPair {
                 self.ref_host_rotation,
             ),
         }
+    }
+
+    /// Recomputes [`ContactPair::springs`] from the contact's own sub-contacts.
+    pub(crate) fn refresh_springs<S>(&mut self, subs: &[SubContact<S>]) {
+        self.springs = ForceMoments::of_springs(self.normal, &subs[self.range()]);
     }
 
     pub(crate) fn range(&self) -> std::ops::Range<usize> {
@@ -262,7 +272,7 @@ impl<S> ContactView<'_, S> {
     }
     /// Spring plus dashpot force of one of this contact's sub-contacts on block `b` (N, world).
     pub fn total_force(&self, sub: &SubContact<S>) -> Vector {
-        self.pair.normal * sub.force.normal + sub.force.shear + sub.dashpot
+        spring_force(self.pair.normal, &sub.force) + sub.dashpot
     }
 }
 

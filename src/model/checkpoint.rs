@@ -182,11 +182,12 @@ where
         model.joints = snap.joints;
         model.integrator = Box::new(CentralDifference::new(snap.damping));
         model.pairs = snap.pairs;
+        model.subs = snap.subs;
         for p in &mut model.pairs {
             let (a, b) = (&model.blocks[p.a as usize], &model.blocks[p.b as usize]);
             p.cache_local_faces(Block::shape(a), Block::shape(b));
+            p.refresh_springs(&model.subs);
         }
-        model.subs = snap.subs;
         model.ref_poses = snap.ref_poses;
         model.dt = snap.dt;
         model.critical = snap.critical;

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use super::Model;
 use crate::block::{Block, BlockId};
 use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus};
-use crate::contact::{ContactPair, DisplacementMode, SubContact};
+use crate::contact::{spring_force, ContactPair, DisplacementMode, ForceMoments, SubContact};
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, ContactKind, NarrowPhaseScratch, SubcontactSeed};
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
@@ -215,10 +215,12 @@ impl<L: ConstitutiveLaw> Model<L> {
                 normal_force: 0.0,
                 work: 0.0,
                 dashpot_work: 0.0,
+                springs: ForceMoments::default(),
                 area: sc.seeds.iter().map(|s| s.area).sum(),
                 bound_area,
             };
             pair.cache_local_faces(bi.shape(), bj.shape());
+            pair.refresh_springs(&sc.subs);
             sc.pairs.push(pair);
         }
         // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
@@ -551,7 +553,7 @@ fn dropped_work<S>(
             DisplacementMode::Small => (p.ref_a, p.ref_b),
         };
         for s in &old.1[p.range()] {
-            let spring = p.normal * s.force.normal + s.force.shear;
+            let spring = spring_force(p.normal, &s.force);
             if spring == Vector::ZERO && s.dashpot == Vector::ZERO {
                 continue;
             }
