@@ -77,7 +77,7 @@ fn restarted_run_is_bit_identical() -> Result<()> {
         "the test must cross re-detections"
     );
     assert!(
-        model.contacts().flat_map(|c| c.subs).any(|s| s.slip() > 0.0),
+        model.contacts().flat_map(|c| c.records).any(|r| r.slip() > 0.0),
         "the test must include slip"
     );
     assert_eq!(state_bits(&model), state_bits(&restarted));

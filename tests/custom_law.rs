@@ -351,14 +351,14 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
         let subs = joint.subs;
         let mut sum = 0.0;
         let mut min_kappa = f64::INFINITY;
-        for s in subs {
+        for (s, r) in joint.iter() {
             let kappa = s.law_state().plastic_slip;
             // History is never lost: per sub-contact (by key), plastic slip only grows.
-            let previous = kappa_by_key.insert(s.key().0, kappa).unwrap_or(0.0);
+            let previous = kappa_by_key.insert(r.key().0, kappa).unwrap_or(0.0);
             assert!(
                 kappa >= previous,
                 "sub-contact {:?} lost plastic slip at step {}: {previous} -> {kappa}",
-                s.key(),
+                r.key(),
                 model.step_count()
             );
             sum += kappa;
@@ -476,9 +476,8 @@ fn law_state_survives_a_checkpoint() {
     let kappas = |m: &Model<SofteningCoulomb>| -> Vec<(u64, u64)> {
         let joint = m.contact_between(slab, block).unwrap();
         joint
-            .subs
             .iter()
-            .map(|s| (s.key().0, s.law_state().plastic_slip.to_bits()))
+            .map(|(s, r)| (r.key().0, s.law_state().plastic_slip.to_bits()))
             .collect()
     };
     assert_eq!(kappas(&model), kappas(&restored), "state restored exactly");

@@ -2,7 +2,7 @@
 //! law, dashpot), summed into the contact's resultant, moments and energy increments in the same
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
-use super::{ContactPair, DisplacementMode, SubContact};
+use super::{ContactPair, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep};
 use crate::geometry::ContactKind;
@@ -18,7 +18,7 @@ pub(crate) struct KernelContext {
 }
 
 /// Updates one contact for one step: its plane (large-displacement mode), the forces of its
-/// sub-contacts (`subs` is the contact's own range) and its resultant, moments about both
+/// sub-contacts (`subs` and `records` are the contact's own ranges) and its resultant, moments about both
 /// centroids and energy increments. Sums run in sub-contact order, so the result does not depend
 /// on how contacts are spread over threads.
 ///
@@ -30,6 +30,7 @@ pub(crate) struct KernelContext {
 pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
     subs: &mut [SubContact<L::State>],
+    records: &mut [SubContactRecord],
     sa: &BlockState,
     sb: &BlockState,
     law: &L,
@@ -104,7 +105,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let mut normal_force = 0.0;
     // Σ (F_before + F_after)·du for the dashpots (times −½ at the end).
     let mut dashpot_sum = 0.0;
-    for sub in subs.iter_mut() {
+    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
         let a = sub.anchor;
         let face = face_gap.map(|(g0, q)| g0 - q.dot(a));
         // A separated sub-contact that the law says stays open with no force and no change of
@@ -113,7 +114,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             if sub.status == JointStatus::Open
                 && sub.force.normal == 0.0
                 && sub.force.shear == Vector::ZERO
-                && (!dashpots || sub.dashpot == Vector::ZERO)
+                && (!dashpots || record.dashpot == Vector::ZERO)
                 && law.stays_open(sub.area, gap, &sub.state)
             {
                 sub.gap = gap;
@@ -138,7 +139,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         };
         let status = law.update(&step, &mut sub.force, &mut sub.state);
         if status == JointStatus::Sliding {
-            sub.slip += du_s.length();
+            record.slip += du_s.length();
         }
         normal_force += sub.force.normal;
         springs.add(spring_force(n, &sub.force), a);
@@ -150,9 +151,9 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                     dashpot -= du_s * (cs * sub.area);
                 }
             }
-            dashpot_sum += (sub.dashpot + dashpot).dot(du);
+            dashpot_sum += (record.dashpot + dashpot).dot(du);
             dashpot_moments.add(dashpot, a);
-            sub.dashpot = dashpot;
+            record.dashpot = dashpot;
         }
         sub.gap = gap;
         sub.status = status;

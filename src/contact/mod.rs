@@ -171,40 +171,25 @@ impl ContactPair {
     }
 }
 
-/// A sub-contact: a point of a joint with a tributary area, its spring forces and history.
-///
-/// Only what the next step needs is stored (128 bytes with [`crate::constitutive::CoulombSlip`]'s
-/// state): its world position and total force follow from the anchor and the contact's frame,
-/// see [`ContactView::point`] and [`ContactView::total_force`].
+/// A sub-contact: a point of a joint with a tributary area, its spring forces and the law's
+/// state — what the step reads and writes for every sub-contact, and nothing else (80 bytes with
+/// [`crate::constitutive::CoulombSlip`]'s state). Its identity, accumulated slip and dashpot
+/// force sit in a parallel [`SubContactRecord`]; its world position and total force follow from
+/// the anchor and the contact's frame, see [`ContactView::point`] and
+/// [`ContactView::total_force`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SubContact<S> {
-    pub(crate) key: SubKey,
     /// Material point on the host block (body frame).
     pub(crate) anchor: Vector,
     pub(crate) area: Real,
     /// Normal displacement `u_n` (m, positive = open).
     pub(crate) gap: Real,
-    /// Added to the geometric gap of a point contact at each re-detection (m): the overlap a
-    /// face-face joint left behind when it turned into an edge contact, which the springs do not
-    /// carry. Zero otherwise.
-    #[serde(default)]
-    pub(crate) gap_offset: Real,
     pub(crate) force: JointForce,
-    /// Accumulated slip while sliding (m).
-    pub(crate) slip: Real,
-    /// Stiffness-proportional (Rayleigh) dashpot force on `b` (world) of the last step; zero
-    /// without Rayleigh damping.
-    #[serde(default)]
-    pub(crate) dashpot: Vector,
     pub(crate) status: JointStatus,
     pub(crate) state: S,
 }
 
 impl<S> SubContact<S> {
-    /// Stable identity within the pair.
-    pub fn key(&self) -> SubKey {
-        self.key
-    }
     /// Material point on the host block, in its body frame (m); [`ContactView::point`] gives
     /// its world position.
     pub fn anchor(&self) -> Vector {
@@ -230,22 +215,57 @@ impl<S> SubContact<S> {
     pub fn shear_force(&self) -> Vector {
         self.force.shear
     }
-    /// Stiffness-proportional dashpot force on block `b` (N, world); zero without Rayleigh
-    /// damping.
-    pub fn dashpot_force(&self) -> Vector {
-        self.dashpot
-    }
     /// Status after the last update.
     pub fn status(&self) -> JointStatus {
         self.status
+    }
+    /// The law's own state.
+    pub fn law_state(&self) -> &S {
+        &self.state
+    }
+}
+
+/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity, accumulated
+/// slip, dashpot force and gap offset. Stored in a parallel array (same index as the
+/// sub-contact), so that the step streams only the [`SubContact`]s and touches a record only
+/// while the sub-contact slides or carries a dashpot force.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SubContactRecord {
+    pub(crate) key: SubKey,
+    /// Accumulated slip while sliding (m).
+    pub(crate) slip: Real,
+    /// Stiffness-proportional (Rayleigh) dashpot force on `b` (world) of the last step; zero
+    /// without Rayleigh damping.
+    #[serde(default)]
+    pub(crate) dashpot: Vector,
+    /// Added to the geometric gap of a point contact at each re-detection (m): the overlap a
+    /// face-face joint left behind when it turned into an edge contact, which the springs do not
+    /// carry. Zero otherwise.
+    #[serde(default)]
+    pub(crate) gap_offset: Real,
+}
+
+impl SubContactRecord {
+    pub(crate) fn new(key: SubKey) -> Self {
+        Self {
+            key,
+            slip: 0.0,
+            dashpot: Vector::ZERO,
+            gap_offset: 0.0,
+        }
+    }
+    /// Stable identity within the pair.
+    pub fn key(&self) -> SubKey {
+        self.key
     }
     /// Accumulated slip (m).
     pub fn slip(&self) -> Real {
         self.slip
     }
-    /// The law's own state.
-    pub fn law_state(&self) -> &S {
-        &self.state
+    /// Stiffness-proportional dashpot force on block `b` (N, world); zero without Rayleigh
+    /// damping.
+    pub fn dashpot_force(&self) -> Vector {
+        self.dashpot
     }
 }
 
@@ -256,6 +276,8 @@ pub struct ContactView<'a, S> {
     pub pair: &'a ContactPair,
     /// Its sub-contacts.
     pub subs: &'a [SubContact<S>],
+    /// Their records (key, slip, dashpot force), index for index.
+    pub records: &'a [SubContactRecord],
     /// Maps sub-contact anchors to world points: the host block's pose (its pose at detection in
     /// small-displacement mode).
     pub frame: Pose,
@@ -270,9 +292,16 @@ impl<S> ContactView<'_, S> {
     pub fn points(&self) -> impl ExactSizeIterator<Item = Vector> + '_ {
         self.subs.iter().map(|s| self.point(s))
     }
-    /// Spring plus dashpot force of one of this contact's sub-contacts on block `b` (N, world).
-    pub fn total_force(&self, sub: &SubContact<S>) -> Vector {
-        spring_force(self.pair.normal, &sub.force) + sub.dashpot
+    /// The sub-contacts with their records, in order.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = (&SubContact<S>, &SubContactRecord)> + '_ {
+        self.subs.iter().zip(self.records)
+    }
+    /// Spring plus dashpot force of the sub-contact at `index` on block `b` (N, world).
+    ///
+    /// # Panics
+    /// If `index` is not below `subs.len()`.
+    pub fn total_force(&self, index: usize) -> Vector {
+        spring_force(self.pair.normal, &self.subs[index].force) + self.records[index].dashpot
     }
 }
 

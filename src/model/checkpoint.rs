@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
-use crate::contact::{ContactPair, SubContact};
+use crate::contact::{ContactPair, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
 use crate::io::io_error;
@@ -18,7 +18,7 @@ use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 
 #[derive(Serialize, Deserialize)]
 #[serde(bound(
@@ -34,6 +34,8 @@ struct Snapshot<L: ConstitutiveLaw> {
     joints: JointTable<L>,
     pairs: Vec<ContactPair>,
     subs: Vec<SubContact<L::State>>,
+    /// The sub-contacts' records, index for index.
+    sub_records: Vec<SubContactRecord>,
     ref_poses: Vec<Pose>,
     dt: Real,
     critical: Option<CriticalStep>,
@@ -74,6 +76,7 @@ where
             joints: self.joints.clone(),
             pairs: self.pairs.clone(),
             subs: self.subs.clone(),
+            sub_records: self.sub_records.clone(),
             ref_poses: self.ref_poses.clone(),
             dt: self.dt,
             critical: self.critical,
@@ -168,6 +171,9 @@ where
         if next != snap.subs.len() {
             return Err(corrupt("subs", "sub-contacts not covered by the contacts"));
         }
+        if snap.sub_records.len() != snap.subs.len() {
+            return Err(corrupt("sub_records", "one record per sub-contact expected"));
+        }
         for (name, m) in &snap.monitors {
             if m.blocks().iter().any(|b| b.index() >= n) {
                 return Err(corrupt(&format!("monitors.{name}"), "refers to a missing block"));
@@ -183,6 +189,7 @@ where
         model.integrator = Box::new(CentralDifference::new(snap.damping));
         model.pairs = snap.pairs;
         model.subs = snap.subs;
+        model.sub_records = snap.sub_records;
         for p in &mut model.pairs {
             let (a, b) = (&model.blocks[p.a as usize], &model.blocks[p.b as usize]);
             p.cache_local_faces(Block::shape(a), Block::shape(b));

@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use super::Model;
 use crate::block::{Block, BlockId};
 use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus};
-use crate::contact::{spring_force, ContactPair, DisplacementMode, ForceMoments, SubContact};
+use crate::contact::{spring_force, ContactPair, DisplacementMode, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, ContactKind, NarrowPhaseScratch, SubcontactSeed};
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
@@ -22,6 +22,7 @@ pub(crate) struct DetectionScratch<S> {
     moved: Vec<bool>,
     pairs: Vec<ContactPair>,
     subs: Vec<SubContact<S>>,
+    records: Vec<SubContactRecord>,
 }
 
 impl<S> Default for DetectionScratch<S> {
@@ -35,6 +36,7 @@ impl<S> Default for DetectionScratch<S> {
             moved: Vec::new(),
             pairs: Vec::new(),
             subs: Vec::new(),
+            records: Vec::new(),
         }
     }
 }
@@ -75,6 +77,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         );
         sc.pairs.clear();
         sc.subs.clear();
+        sc.records.clear();
         for &(i, j) in &sc.candidates {
             let old = self.pairs.binary_search_by_key(&(i, j), |p| (p.a, p.b)).ok();
             let (bi, bj) = (&self.blocks[i as usize], &self.blocks[j as usize]);
@@ -87,6 +90,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     let mut kept = p.clone();
                     kept.first = sc.subs.len() as u32;
                     sc.subs.extend_from_slice(&self.subs[p.range()]);
+                    sc.records.extend_from_slice(&self.sub_records[p.range()]);
                     sc.pairs.push(kept);
                 }
                 continue;
@@ -122,7 +126,8 @@ impl<L: ConstitutiveLaw> Model<L> {
             let bound_area = old.map_or(0.0, |k| self.pairs[k].bound_area);
             let old_subs = old.map(|k| {
                 let p = &self.pairs[k];
-                (p.kind == dc.kind && p.host_is_a == dc.host_is_a).then(|| &self.subs[p.range()])
+                (p.kind == dc.kind && p.host_is_a == dc.host_is_a)
+                    .then(|| (&self.subs[p.range()], &self.sub_records[p.range()]))
             });
             let old_subs = old_subs.flatten();
             // Carried spring forces were composed in the old contact's normal, which the next
@@ -131,32 +136,28 @@ impl<L: ConstitutiveLaw> Model<L> {
                 (Some(k), Some(_)) => self.pairs[k].normal,
                 _ => dc.normal,
             };
-            let old_subs = old_subs.unwrap_or(&[]);
+            let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
             let first = sc.subs.len() as u32;
             for seed in &sc.seeds {
                 let mut sub = SubContact {
-                    key: seed.key,
                     anchor: seed.anchor,
                     area: seed.area,
                     gap: seed.gap,
-                    gap_offset: 0.0,
                     force: JointForce::default(),
-                    slip: 0.0,
-                    dashpot: Vector::ZERO,
                     status: JointStatus::Open,
                     state: L::State::default(),
                 };
-                if let Ok(k) = old_subs.binary_search_by_key(&seed.key, |s| s.key) {
+                let mut record = SubContactRecord::new(seed.key);
+                if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
                     let o = &old_subs[k];
                     sub.force = o.force;
-                    sub.gap_offset = o.gap_offset;
-                    sub.gap = seed.gap + o.gap_offset;
+                    sub.gap = seed.gap + old_records[k].gap_offset;
                     sub.status = o.status;
-                    sub.slip = o.slip;
-                    sub.dashpot = o.dashpot;
                     sub.state = o.state.clone();
+                    record = old_records[k].clone();
                 }
                 sc.subs.push(sub);
+                sc.records.push(record);
             }
             // A face-face joint that rocks onto an edge becomes an edge-face (point) contact once
             // the faces are more than `face_angle_tolerance` apart. The two discretise the joint
@@ -172,23 +173,24 @@ impl<L: ConstitutiveLaw> Model<L> {
                     let normal: Real = olds.iter().map(|s| s.force.normal).sum();
                     let shear: Vector = olds.iter().map(|s| s.force.shear).sum();
                     let new = &mut sc.subs[first as usize..];
+                    let new_records = &mut sc.records[first as usize..];
                     let area: Real = new.iter().map(|s| s.area).sum();
                     if normal > 0.0 && area > 0.0 {
                         let law_ref = &self.joints.laws()[law as usize];
                         let kn = law_ref.stiffness().normal;
                         let n = dc.normal;
                         let shear = shear - n * n.dot(shear);
-                        for s in new {
+                        for (s, r) in new.iter_mut().zip(new_records.iter_mut()) {
                             let w = s.area / area;
                             s.force = JointForce {
                                 normal: normal * w,
                                 shear: shear * w,
                             };
                             let gap = -s.force.normal / (kn * s.area);
-                            s.gap_offset = gap - s.gap;
+                            r.gap_offset = gap - s.gap;
                             s.gap = gap;
                             s.status = JointStatus::Elastic;
-                            s.dashpot = Vector::ZERO;
+                            r.dashpot = Vector::ZERO;
                         }
                     }
                 }
@@ -227,8 +229,8 @@ impl<L: ConstitutiveLaw> Model<L> {
         // since the last evaluation (lost contacts only make the step safer).
         let stiffer = sc.pairs.iter().any(|p| p.area > 1.05 * p.bound_area);
         let (work, dashpot) = dropped_work(
-            (&self.pairs, &self.subs),
-            (&sc.pairs, &sc.subs),
+            (&self.pairs, &self.subs, &self.sub_records),
+            (&sc.pairs, &sc.records),
             &sc.moved,
             &self.blocks,
             self.params.mode,
@@ -238,6 +240,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.energy.damping += dashpot;
         std::mem::swap(&mut self.pairs, &mut sc.pairs);
         std::mem::swap(&mut self.subs, &mut sc.subs);
+        std::mem::swap(&mut self.sub_records, &mut sc.records);
         for (i, moved) in sc.moved.iter().enumerate() {
             if *moved {
                 self.ref_poses[i] = self.blocks[i].state.pose;
@@ -525,8 +528,8 @@ fn outer(a: Vector, b: Vector) -> crate::math::Matrix {
 /// that produced the current poses); the stored energy that vanishes with the sub-contact ends
 /// up in `friction` (dissipated by the loss of contact).
 fn dropped_work<S>(
-    old: (&[ContactPair], &[SubContact<S>]),
-    new: (&[ContactPair], &[SubContact<S>]),
+    old: (&[ContactPair], &[SubContact<S>], &[SubContactRecord]),
+    new: (&[ContactPair], &[SubContactRecord]),
     moved: &[bool],
     blocks: &[crate::block::RigidBlock],
     mode: DisplacementMode,
@@ -552,12 +555,12 @@ fn dropped_work<S>(
             DisplacementMode::Large => (sa.pose.translation, sb.pose.translation),
             DisplacementMode::Small => (p.ref_a, p.ref_b),
         };
-        for s in &old.1[p.range()] {
+        for (s, r) in old.1[p.range()].iter().zip(&old.2[p.range()]) {
             let spring = spring_force(p.normal, &s.force);
-            if spring == Vector::ZERO && s.dashpot == Vector::ZERO {
+            if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
                 continue;
             }
-            if carried.is_some_and(|subs| subs.binary_search_by_key(&s.key, |t| t.key).is_ok()) {
+            if carried.is_some_and(|records| records.binary_search_by_key(&r.key, |t| t.key).is_ok()) {
                 continue;
             }
             let pt = frame.transform_point(s.anchor);
@@ -565,7 +568,7 @@ fn dropped_work<S>(
                 (sb.velocity + sb.angular_velocity.cross(pt - xb)) - (sa.velocity + sa.angular_velocity.cross(pt - xa));
             let du = v_rel * dt;
             work -= 0.5 * spring.dot(du);
-            dashpot -= 0.5 * s.dashpot.dot(du);
+            dashpot -= 0.5 * r.dashpot.dot(du);
         }
     }
     (work, dashpot)

@@ -11,7 +11,9 @@ pub use energy::Energies;
 
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
-use crate::contact::{update_contact, ContactPair, ContactView, DisplacementMode, KernelContext, SubContact};
+use crate::contact::{
+    update_contact, ContactPair, ContactView, DisplacementMode, KernelContext, SubContact, SubContactRecord,
+};
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
@@ -97,6 +99,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     integrator: Box<dyn Integrator>,
     pairs: Vec<ContactPair>,
     subs: Vec<SubContact<L::State>>,
+    /// The sub-contacts' records (key, slip, dashpot force), index for index with `subs`.
+    sub_records: Vec<SubContactRecord>,
     /// Block → contact index (CSR with `block_offsets`): `2 × contact + side`, side 1 when the
     /// block is the contact's `b`.
     block_contacts: Vec<u32>,
@@ -177,6 +181,7 @@ struct ContactPass<'a, L: ConstitutiveLaw> {
     blocks: &'a [RigidBlock],
     laws: &'a [L],
     subs: SubsPtr<SubContact<L::State>>,
+    sub_records: SubsPtr<SubContactRecord>,
     total_subs: usize,
     ctx: KernelContext,
 }
@@ -198,7 +203,18 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             // sub-contact vector is not otherwise borrowed while the pass runs, so every task
             // has exclusive access to its own ranges.
             let own = unsafe { std::slice::from_raw_parts_mut(self.subs.get().add(range.start), range.len()) };
-            update_contact(p, own, &a.state, &b.state, &self.laws[p.law as usize], self.ctx);
+            // SAFETY: as above; the records vector has the same length as the sub-contacts.
+            let own_records =
+                unsafe { std::slice::from_raw_parts_mut(self.sub_records.get().add(range.start), range.len()) };
+            update_contact(
+                p,
+                own,
+                own_records,
+                &a.state,
+                &b.state,
+                &self.laws[p.law as usize],
+                self.ctx,
+            );
             *w = PairWrench {
                 force: p.force,
                 moment_a: p.moment_a,
@@ -300,6 +316,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             integrator: Box::new(CentralDifference::default()),
             pairs: Vec::new(),
             subs: Vec::new(),
+            sub_records: Vec::new(),
             block_contacts: Vec::new(),
             block_offsets: vec![0],
             forces: Vec::new(),
@@ -494,6 +511,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         ContactView {
             pair: p,
             subs: &self.subs[p.range()],
+            records: &self.sub_records[p.range()],
             frame: p.frame(&sa.pose, &sb.pose, self.params.mode),
         }
     }
@@ -720,10 +738,18 @@ impl<L: ConstitutiveLaw> Model<L> {
             stiffness_damping: self.integrator.damping().stiffness_coefficient(),
             mode: self.params.mode,
         };
+        // The records run index for index with the sub-contacts (kept so by detection and
+        // checkpoint load); the pass's range check relies on it.
+        assert_eq!(
+            self.sub_records.len(),
+            self.subs.len(),
+            "sub-contact records out of step"
+        );
         let pass = ContactPass {
             blocks: &self.blocks,
             laws: self.joints.laws(),
             subs: SubsPtr(self.subs.as_mut_ptr()),
+            sub_records: SubsPtr(self.sub_records.as_mut_ptr()),
             total_subs: self.subs.len(),
             ctx,
         };
