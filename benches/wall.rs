@@ -19,7 +19,7 @@ fn wall(blocks: usize) -> Model {
     model
 }
 
-#[divan::bench(args = [1_000, 10_000], sample_count = 20, sample_size = 5)]
+#[divan::bench(args = [1_000, 10_000, 100_000], sample_count = 20, sample_size = 5)]
 fn settle_step(bencher: divan::Bencher, blocks: usize) {
     let mut model = wall(blocks);
     let updates = model.subcontact_count();

@@ -1,19 +1,20 @@
 //! Scaling of a settling running-bond wall with the number of blocks.
 //!
 //! ```text
-//! cargo run --release --example scaling -- --blocks 1000,10000,100000 [--steps 50] [--out DIR]
+//! cargo run --release --example scaling -- --blocks 1000,10000,100000 [--steps 50] [--spacing 0.025] [--out DIR]
 //! ```
 //!
 //! For each size: build the wall (about ten times as long as high), run 20 steps (the first
 //! detects every contact), then time `--steps` steps. Prints blocks, contacts, sub-contacts, time
 //! per step, sub-contact updates per second, the share of time in contact detection, peak memory
-//! per block and the number of threads, and writes `out/scaling/summary.json`.
+//! per block and the number of threads, and writes `out/scaling/summary.json`. `--spacing` sets the
+//! largest sub-contact spacing (m, default 25 mm), for studies of the cost of sub-contact density.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use serde::Serialize;
-use voussoir::build::benchmark_wall;
+use voussoir::build::{benchmark_wall_with_spacing, BENCHMARK_SPACING};
 use voussoir::prelude::*;
 
 #[derive(Serialize)]
@@ -22,6 +23,8 @@ struct Run {
     contacts: usize,
     subcontacts: usize,
     threads: usize,
+    /// Largest sub-contact spacing (m).
+    spacing: f64,
     s_per_step: f64,
     subcontact_updates_per_s: f64,
     detection_share: f64,
@@ -64,6 +67,7 @@ fn main() {
 fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     let mut sizes = vec![1_000usize, 10_000];
     let mut steps = 50u64;
+    let mut spacing = BENCHMARK_SPACING;
     let mut out = PathBuf::from("out/scaling");
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -77,12 +81,16 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
                     .collect::<Result<_, _>>()?
             }
             "--steps" => steps = args.next().ok_or("--steps needs a number")?.parse()?,
+            "--spacing" => spacing = args.next().ok_or("--spacing needs a length in m")?.parse()?,
             "--out" => out = args.next().ok_or("--out needs a folder")?.into(),
             other => return Err(format!("unknown argument {other:?}").into()),
         }
     }
     let threads = rayon::current_num_threads();
-    println!("running-bond wall, bricks 0.2 × 0.1 × 0.05 m, sub-contact spacing 25 mm, {threads} threads");
+    println!(
+        "running-bond wall, bricks 0.2 × 0.1 × 0.05 m, sub-contact spacing {:.1} mm, {threads} threads",
+        spacing * 1e3
+    );
     println!(
         "{:>8} {:>9} {:>11} {:>11} {:>14} {:>10} {:>9} {:>11} {:>12}",
         "blocks",
@@ -98,7 +106,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     let mut runs = Vec::new();
     for n in sizes {
         let started = Instant::now();
-        let mut model = benchmark_wall(n)?;
+        let mut model = benchmark_wall_with_spacing(n, spacing)?;
         model.run_steps(20)?;
         let setup = started.elapsed().as_secs_f64();
         model.reset_timings();
@@ -111,6 +119,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             contacts: model.contacts().len(),
             subcontacts: model.subcontact_count(),
             threads,
+            spacing,
             s_per_step: per_step,
             subcontact_updates_per_s: model.subcontact_count() as f64 / per_step,
             detection_share: share(t.detection, t.total()),
