@@ -2,6 +2,7 @@
 //! law, dashpot), summed into the contact's resultant, moments and energy increments in the same
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
+use super::lanes::{update_group, ContactFrame, LaneSums, LANES};
 use super::{ContactPair, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep};
@@ -23,9 +24,11 @@ pub(crate) struct KernelContext {
 /// on how contacts are spread over threads.
 ///
 /// Everything common to the contact is computed once: the host rotation as a matrix, the
-/// relative velocity field `v_rel(r) = v₀ + Δω × r` with `r` the lever arm from the host
-/// centroid, and the face-face gap `g(r) = g₀ − q·r`; a sub-contact then costs one
-/// matrix-vector product and one cross product for its kinematics and one for its moment.
+/// displacement increment as a field affine in the anchor `a`, `Δu₀ + D a`, and the face-face
+/// gap `g₀ − (Rᵀq)·a`; a sub-contact then costs one matrix-vector product for its kinematics,
+/// and its force enters the contact's moment and work through `Σ F aᵀ` (see [`ForceMoments`]).
+/// Without dashpot forces the sub-contacts go four at a time (`lanes.rs`), with the same
+/// operations per sub-contact.
 #[inline(always)]
 pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
@@ -105,7 +108,28 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let mut normal_force = 0.0;
     // Σ (F_before + F_after)·du for the dashpots (times −½ at the end).
     let mut dashpot_sum = 0.0;
-    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
+    // Without dashpot forces, four sub-contacts at a time; the rest (and everything when there
+    // are dashpots) one at a time, continuing the sums of the groups.
+    let mut done = 0;
+    if !dashpots {
+        let frame = ContactFrame {
+            n,
+            du0,
+            d,
+            face_gap,
+            shear_turn,
+            dt,
+        };
+        let mut sums = LaneSums::default();
+        for (group, group_records) in subs.chunks_exact_mut(LANES).zip(records.chunks_exact_mut(LANES)) {
+            update_group(group, group_records, law, &frame, &mut sums);
+        }
+        done = subs.len() / LANES * LANES;
+        let (force, first, normal) = sums.total();
+        springs = ForceMoments { force, first };
+        normal_force = normal;
+    }
+    for (sub, record) in subs[done..].iter_mut().zip(records[done..].iter_mut()) {
         let a = sub.anchor;
         let face = face_gap.map(|(g0, q)| g0 - q.dot(a));
         // A separated sub-contact that the law says stays open with no force and no change of
@@ -194,7 +218,7 @@ pub(crate) fn spring_force(n: Vector, force: &JointForce) -> Vector {
 /// frame): `F = Σ Fᵢ` and `S = Σ Fᵢ aᵢᵀ`. They give the moment about the host centroid,
 /// `Σ (R aᵢ) × Fᵢ`, and the work over a displacement field affine in the anchor,
 /// `Σ Fᵢ·(du₀ + D aᵢ) = du₀·F + D : S`, without a per-sub-contact cross or dot product.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) struct ForceMoments {
     pub force: Vector,
     pub first: Matrix,

@@ -2,6 +2,7 @@
 //! per-sub-contact kinematics kernel.
 
 mod kernel;
+mod lanes;
 
 use serde::{Deserialize, Serialize};
 
@@ -72,8 +73,9 @@ pub struct ContactPair {
     #[serde(skip)]
     pub(crate) local_other_offset: Real,
     /// Whether the sub-contacts may hold dashpot forces (Rayleigh damping in the last step, or
-    /// history carried over at detection); only saves reading them when not.
-    #[serde(skip, default = "always")]
+    /// history carried over at detection); only saves reading them when not. Checkpointed: it
+    /// selects the sub-contact loop, and with it the order of the sums.
+    #[serde(default = "always")]
     pub(crate) dashpots: bool,
     /// Resultant force on `b` (N).
     pub(crate) force: Vector,
@@ -85,9 +87,9 @@ pub struct ContactPair {
     pub(crate) work: Real,
     pub(crate) dashpot_work: Real,
     /// Force and first moment of the sub-contacts' spring forces as they stand (composed with
-    /// `normal`), for the first half of the next step's joint work. Kept by the step and
-    /// recomputed from the sub-contacts at detection and on checkpoint load.
-    #[serde(skip)]
+    /// `normal`), for the first half of the next step's joint work. Kept by the step,
+    /// recomputed from the sub-contacts at detection, checkpointed (a recomputation could sum
+    /// in another order than the step did).
     pub(crate) springs: ForceMoments,
     /// Centroids at detection (lever arms in small-displacement mode).
     pub(crate) ref_a: Vector,

@@ -193,7 +193,6 @@ where
         for p in &mut model.pairs {
             let (a, b) = (&model.blocks[p.a as usize], &model.blocks[p.b as usize]);
             p.cache_local_faces(Block::shape(a), Block::shape(b));
-            p.refresh_springs(&model.subs);
         }
         model.ref_poses = snap.ref_poses;
         model.dt = snap.dt;
