@@ -109,8 +109,39 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
         err.to_string().contains("joints.laws[0]") && err.to_string().contains("friction"),
         "{err}"
     );
+    // Spring moments that do not belong to the stored forces (they feed the joint work).
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let force = &mut json["pairs"][0]["springs"]["force"][2];
+    let fz = force.as_f64().expect("a number");
+    assert!(fz.abs() > 1.0, "the first contact is loaded: {fz}");
+    *force = serde_json::json!(fz * 1.5);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("bad springs");
+    assert!(err.to_string().contains("pairs[0].springs"), "{err}");
     // A missing file.
     let err = Model::<CoulombSlip>::load_checkpoint(std::path::Path::new("/nonexistent/x.json")).expect_err("missing");
     assert!(matches!(err, Error::Io { .. }), "{err}");
+    Ok(())
+}
+
+/// A change that asks for a full re-detection (here a ten times stiffer joint law, which needs a
+/// shorter step) is not lost when the model is saved before its next step.
+#[test]
+fn pending_redetection_survives_a_checkpoint() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(30)?;
+    let dt_before = model.dt();
+    model.set_joint_law(
+        MaterialId(0),
+        MaterialId(0),
+        CoulombSlip::new(1e11, 4e10, 25.0, 20.0, 2e3, 1e3)?,
+    )?;
+    let mut restored: Model = Model::from_checkpoint_str(&model.to_checkpoint_string()?)?;
+    model.step()?;
+    restored.step()?;
+    assert!(model.dt() < 0.5 * dt_before, "the stiffer law shortens the step");
+    assert_eq!(restored.dt(), model.dt());
+    model.run_steps(20)?;
+    restored.run_steps(20)?;
+    assert_eq!(state_bits(&model), state_bits(&restored));
     Ok(())
 }

@@ -120,8 +120,11 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut Self::State) -> JointStatus;
 
     /// Whether a sub-contact that is open with zero force stays so at total normal displacement
-    /// `normal_displacement` (m), whatever its shear increment: [`ConstitutiveLaw::update`]
-    /// would return [`JointStatus::Open`], leave the forces at zero and `state` unchanged.
+    /// `normal_displacement` (m), whatever the rest of the [`JointStep`] (shear and normal
+    /// increments, normal, time step): [`ConstitutiveLaw::update`] would return
+    /// [`JointStatus::Open`], leave the forces at zero and `state` unchanged. It is asked only
+    /// for face-face sub-contacts in large-displacement mode whose last status is `Open` with
+    /// zero forces (and no dashpot force).
     ///
     /// The contact kernel then skips the sub-contact's kinematics and update (separated parts
     /// of joints are common: a quarter of the sub-contacts of a settled running-bond wall). It

@@ -19,9 +19,10 @@ pub(crate) struct KernelContext {
 }
 
 /// Updates one contact for one step: its plane (large-displacement mode), the forces of its
-/// sub-contacts (`subs` and `records` are the contact's own ranges) and its resultant, moments about both
-/// centroids and energy increments. Sums run in sub-contact order, so the result does not depend
-/// on how contacts are spread over threads.
+/// sub-contacts (`subs` and `records` are the contact's own ranges) and its resultant, moments
+/// about both centroids and energy increments. Sums run in a fixed order — in sub-contact order,
+/// or, four at a time, per lane, the lanes added in order, then the remaining sub-contacts — so
+/// the result does not depend on how contacts are spread over threads.
 ///
 /// Everything common to the contact is computed once: the host rotation as a matrix, the
 /// displacement increment as a field affine in the anchor `a`, `Δu₀ + D a`, and the face-face
@@ -250,6 +251,26 @@ impl ForceMoments {
             m.add(spring_force(n, &s.force), s.anchor);
         }
         m
+    }
+
+    /// Whether `self` and `other` agree to round-off (relative 1e-9 of the largest entry and
+    /// of the force scale `|F|`): the same moments summed in another order.
+    pub fn matches(&self, other: &Self) -> bool {
+        let entries = |m: &Self| {
+            let f = m.first;
+            [m.force, f.x_axis, f.y_axis, f.z_axis]
+        };
+        let scale = entries(self)
+            .iter()
+            .chain(entries(other).iter())
+            .map(|v| v.abs().max_element())
+            .fold(0.0, Real::max);
+        let tolerance = 1e-9 * scale;
+        entries(self).iter().all(|v| v.is_finite())
+            && entries(self)
+                .iter()
+                .zip(entries(other).iter())
+                .all(|(a, b)| (*a - *b).abs().max_element() <= tolerance)
     }
 
     fn plus(&self, other: &Self) -> Self {

@@ -119,6 +119,20 @@ pub enum ContactKind {
     },
 }
 
+impl ContactKind {
+    /// Whether a contact re-detected as `other` is the same joint, whose sub-contacts may carry
+    /// their history over by key: the same pair of faces, or a point contact again. A point
+    /// contact's body-frame normal changes as its block turns, so it is not compared; the keys
+    /// (which name the features) decide which sub-contacts carry on.
+    pub(crate) fn same_joint(&self, other: &ContactKind) -> bool {
+        match (self, other) {
+            (ContactKind::FaceFace { .. }, ContactKind::FaceFace { .. }) => self == other,
+            (ContactKind::Point { .. }, ContactKind::Point { .. }) => true,
+            _ => false,
+        }
+    }
+}
+
 /// A sub-contact as created by detection.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SubcontactSeed {

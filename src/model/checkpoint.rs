@@ -9,11 +9,11 @@ use serde::{Deserialize, Serialize};
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
-use crate::contact::{ContactPair, SubContact, SubContactRecord};
+use crate::contact::{ContactPair, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
 use crate::io::io_error;
-use crate::math::{Pose, Real};
+use crate::math::{Pose, Real, Vector};
 use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
@@ -52,6 +52,10 @@ struct Snapshot<L: ConstitutiveLaw> {
     /// them half in the next step.
     #[serde(default)]
     last_forces: Vec<(Wrench, Wrench)>,
+    /// A full re-detection (and step re-evaluation) requested by a change of laws, parameters,
+    /// fixity or blocks before the save and not yet done.
+    #[serde(default)]
+    pending_detection: bool,
 }
 
 impl<L> Model<L>
@@ -90,6 +94,7 @@ where
             history: self.history.clone(),
             monitor_interval: self.monitor_interval,
             last_forces: self.records.iter().map(|r| (r.reaction, r.damping)).collect(),
+            pending_detection: self.scratch.force_full_detection,
         };
         serde_json::to_string(&snap).map_err(|e| Error::Io {
             path: "(checkpoint)".into(),
@@ -190,9 +195,21 @@ where
         model.pairs = snap.pairs;
         model.subs = snap.subs;
         model.sub_records = snap.sub_records;
-        for p in &mut model.pairs {
+        for (k, p) in model.pairs.iter_mut().enumerate() {
             let (a, b) = (&model.blocks[p.a as usize], &model.blocks[p.b as usize]);
             p.cache_local_faces(Block::shape(a), Block::shape(b));
+            // Dashpot forces still held must be seen (and their work booked) by the next step.
+            p.dashpots |= model.sub_records[p.range()].iter().any(|r| r.dashpot != Vector::ZERO);
+            // The stored spring moments are those of the stored forces, up to summation order.
+            if !p
+                .springs
+                .matches(&ForceMoments::of_springs(p.normal, &model.subs[p.range()]))
+            {
+                return Err(corrupt(
+                    &format!("pairs[{k}].springs"),
+                    "inconsistent with the sub-contact forces",
+                ));
+            }
         }
         model.ref_poses = snap.ref_poses;
         model.dt = snap.dt;
@@ -210,7 +227,7 @@ where
             r.reaction = reaction;
             r.damping = damping;
         }
-        model.scratch.force_full_detection = !model.started;
+        model.scratch.force_full_detection = !model.started || snap.pending_detection;
         model.rebuild_block_index();
         Ok(model)
     }

@@ -126,7 +126,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             let bound_area = old.map_or(0.0, |k| self.pairs[k].bound_area);
             let old_subs = old.map(|k| {
                 let p = &self.pairs[k];
-                (p.kind == dc.kind && p.host_is_a == dc.host_is_a)
+                (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
                     .then(|| (&self.subs[p.range()], &self.sub_records[p.range()]))
             });
             let old_subs = old_subs.flatten();
@@ -542,7 +542,7 @@ fn dropped_work<S>(
             .binary_search_by_key(&(p.a, p.b), |q| (q.a, q.b))
             .ok()
             .map(|k| &new.0[k])
-            .filter(|q| q.kind == p.kind && q.host_is_a == p.host_is_a)
+            .filter(|q| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
             .map(|q| &new.1[q.range()]);
         // A contact between two blocks that did not move is kept as it was, with all its
         // sub-contacts.
