@@ -136,12 +136,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         // A separated sub-contact that the law says stays open with no force and no change of
         // state needs neither kinematics nor an update (nor a dashpot: it had none and gets none).
         if let Some(gap) = face {
-            if sub.status == JointStatus::Open
-                && sub.force.normal == 0.0
-                && sub.force.shear == Vector::ZERO
-                && (!dashpots || record.dashpot == Vector::ZERO)
-                && law.stays_open(sub.area, gap, &sub.state)
-            {
+            if (!dashpots || record.dashpot == Vector::ZERO) && stays_separated(law, sub, gap) {
                 sub.gap = gap;
                 continue;
             }
@@ -207,6 +202,16 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair.normal_force = normal_force;
     pair.work = -0.5 * spring_sum;
     pair.dashpot_work = -0.5 * dashpot_sum;
+}
+
+/// Whether a face-face sub-contact at geometric gap `gap` may skip its kinematics and update:
+/// it is open with zero force and the law says it stays so ([`ConstitutiveLaw::stays_open`]).
+#[inline(always)]
+pub(crate) fn stays_separated<L: ConstitutiveLaw>(law: &L, sub: &SubContact<L::State>, gap: Real) -> bool {
+    sub.status == JointStatus::Open
+        && sub.force.normal == 0.0
+        && sub.force.shear == Vector::ZERO
+        && law.stays_open(sub.area, gap, &sub.state)
 }
 
 /// A sub-contact's spring force on block `b` (N, world): normal plus shear.

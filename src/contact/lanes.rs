@@ -10,6 +10,7 @@
 
 use std::ops::{Add, Mul, Sub};
 
+use super::kernel::stays_separated;
 use super::{SubContact, SubContactRecord};
 use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep};
 use crate::math::{Matrix, Real, Vector};
@@ -200,12 +201,7 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
         let sub = &mut group[l];
         let gap = gap.0[l];
         // A separated sub-contact that stays open: no force, no update (as the scalar loop).
-        if frame.face_gap.is_some()
-            && sub.status == JointStatus::Open
-            && sub.force.normal == 0.0
-            && sub.force.shear == Vector::ZERO
-            && law.stays_open(sub.area, gap, &sub.state)
-        {
+        if frame.face_gap.is_some() && stays_separated(law, sub, gap) {
             sub.gap = gap;
             continue;
         }

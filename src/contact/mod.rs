@@ -106,6 +106,16 @@ fn always() -> bool {
     true
 }
 
+#[cfg(test)]
+mod tests {
+    /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
+    #[test]
+    fn subcontact_is_80_bytes_with_coulomb_state() {
+        use crate::constitutive::CoulombState;
+        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 80);
+    }
+}
+
 impl ContactPair {
     /// The two blocks.
     pub fn blocks(&self) -> (BlockId, BlockId) {
