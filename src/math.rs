@@ -5,6 +5,9 @@
 
 pub use parry3d_f64::math::{Matrix, Pose, Real, Rotation, Vector};
 
+/// A 2-D vector: components in a joint's tangent plane, or coordinates on a contact's anchor plane.
+pub type Vector2 = glam::DVec2;
+
 /// Returns `true` when every component of `v` is finite (neither NaN nor infinite).
 #[inline]
 pub fn is_finite_vector(v: Vector) -> bool {

@@ -53,7 +53,7 @@ fn state_bits(model: &Model) -> Vec<u64> {
     for c in model.contacts() {
         for s in c.subs {
             bits.push(s.normal_force().to_bits());
-            bits.extend(s.shear_force().to_array().map(f64::to_bits));
+            bits.extend(c.shear_force(s).to_array().map(f64::to_bits));
         }
     }
     let e = model.energies();

@@ -13,7 +13,8 @@
 //! then softens to `N·tan φ` once it has slipped `u_soft`.
 
 use serde::{Deserialize, Serialize};
-use voussoir::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
+use voussoir::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus, JointStep, JointStiffness};
+use voussoir::math::Vector2;
 use voussoir::prelude::*;
 
 /// Coulomb slip with linearly softening cohesion. (serde only for checkpoints.)
@@ -82,11 +83,12 @@ impl ConstitutiveLaw for SofteningCoulomb {
         force.normal = -self.normal_stiffness * step.normal_displacement * area;
         if force.normal <= 0.0 {
             force.normal = 0.0;
-            force.shear = Vector::ZERO;
+            force.shear = Vector2::ZERO;
             return JointStatus::Open;
         }
-        // Shear: incremental. `force.shear` arrives holding last step's force, already rotated
-        // into the current joint plane; `shear_increment` is the slip of block b relative to a.
+        // Shear: incremental. `force.shear` arrives holding last step's force as components
+        // along the joint's tangents (which turn with the plane); `shear_increment` is the slip
+        // of block b relative to a, along the same tangents.
         force.shear -= step.shear_increment * (self.shear_stiffness * area);
         let cap = self.cohesion_at(state.plastic_slip) * area + force.normal * self.tan_friction;
         let trial = force.shear.length();
@@ -149,8 +151,8 @@ fn law_alone_traces_the_softening_curve() {
         area,
         normal_displacement: -n / (law.normal_stiffness * area),
         normal_increment: 0.0,
-        shear_increment: Vector::new(du, 0.0, 0.0),
-        normal: Vector::Z,
+        shear_increment: Vector2::new(du, 0.0),
+        axes: JointAxes::from_normal(Vector::Z),
         dt: 1e-4,
     };
     let mut force = JointForce::default();

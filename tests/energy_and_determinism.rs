@@ -306,7 +306,7 @@ fn fingerprint(model: &Model) -> Vec<u64> {
     for c in model.contacts() {
         push(c.pair.resultant());
         for (s, r) in c.iter() {
-            push(s.shear_force());
+            push(c.shear_force(s));
             push(Vector::new(s.normal_force(), r.slip(), s.normal_displacement()));
         }
     }

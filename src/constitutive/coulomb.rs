@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
 use crate::error::{in_range, non_negative, positive, Result};
-use crate::math::{Real, Vector};
+use crate::math::{Real, Vector2};
 
 /// Coulomb slip joint.
 ///
@@ -178,7 +178,7 @@ impl ConstitutiveLaw for CoulombSlip {
                 state.failed = true;
             }
             f.normal = 0.0;
-            f.shear = Vector::ZERO;
+            f.shear = Vector2::ZERO;
             return JointStatus::Open;
         }
         f.shear -= s.shear_increment * (self.shear_stiffness * a);
@@ -240,13 +240,16 @@ impl ConstitutiveLaw for CoulombSlip {
 mod tests {
     use super::*;
 
-    fn step(un: Real, dus: Vector) -> JointStep {
+    use super::super::JointAxes;
+    use crate::math::Vector;
+
+    fn step(un: Real, dus: Vector2) -> JointStep {
         JointStep {
             area: 1.0,
             normal_displacement: un,
             normal_increment: 0.0,
             shear_increment: dus,
-            normal: Vector::Z,
+            axes: JointAxes::from_normal(Vector::Z),
             dt: 1.0,
         }
     }
@@ -258,19 +261,19 @@ mod tests {
         let mut s = CoulombState::default();
         // Compressed by 1e-4 m: N = 1e5 N.
         assert_eq!(
-            law.update(&step(-1e-4, Vector::ZERO), &mut f, &mut s),
+            law.update(&step(-1e-4, Vector2::ZERO), &mut f, &mut s),
             JointStatus::Elastic
         );
         // Push 1 mm in x: trial 1e6 N > c + N tan 30 = 1e5 + 5.77e4.
         assert_eq!(
-            law.update(&step(-1e-4, Vector::new(1e-3, 0.0, 0.0)), &mut f, &mut s),
+            law.update(&step(-1e-4, Vector2::new(1e-3, 0.0)), &mut f, &mut s),
             JointStatus::Sliding
         );
         let cap = 1e5 + 1e5 * 30f64.to_radians().tan();
         assert!((f.shear.x + cap).abs() < 1e-6, "{f:?}");
         assert!(s.failed);
         // Now residual: cap = N tan 20.
-        law.update(&step(-1e-4, Vector::new(1e-3, 0.0, 0.0)), &mut f, &mut s);
+        law.update(&step(-1e-4, Vector2::new(1e-3, 0.0)), &mut f, &mut s);
         assert!((f.shear.x + 1e5 * 20f64.to_radians().tan()).abs() < 1e-6);
     }
 
@@ -282,14 +285,20 @@ mod tests {
         let mut s = CoulombState::default();
         // 4e-5 m opening: tension 4e4 < 5e4, carried.
         assert_eq!(
-            law.update(&step(4e-5, Vector::ZERO), &mut f, &mut s),
+            law.update(&step(4e-5, Vector2::ZERO), &mut f, &mut s),
             JointStatus::Elastic
         );
         assert!((f.normal + 4e4).abs() < 1e-6);
-        assert_eq!(law.update(&step(6e-5, Vector::ZERO), &mut f, &mut s), JointStatus::Open);
+        assert_eq!(
+            law.update(&step(6e-5, Vector2::ZERO), &mut f, &mut s),
+            JointStatus::Open
+        );
         assert!(s.failed && f.normal == 0.0);
         // Once failed, no tension at all.
-        assert_eq!(law.update(&step(1e-6, Vector::ZERO), &mut f, &mut s), JointStatus::Open);
+        assert_eq!(
+            law.update(&step(1e-6, Vector2::ZERO), &mut f, &mut s),
+            JointStatus::Open
+        );
     }
 
     /// `stays_open` promises what `update` does: open, zero forces, state unchanged; and it does
@@ -302,7 +311,7 @@ mod tests {
             CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap(),
         ];
         let gaps = [-1e-3, -1e-9, -0.0, 0.0, 1e-300, 1e-12, 4e-5, 6e-5, 1.0];
-        let shears = [Vector::ZERO, Vector::new(1e-3, -2e-4, 0.0)];
+        let shears = [Vector2::ZERO, Vector2::new(1e-3, -2e-4)];
         let mut promised = [0usize; 3];
         for (l, law) in laws.iter().enumerate() {
             for failed in [false, true] {

@@ -14,7 +14,7 @@ pub use coulomb::{CoulombSlip, CoulombState};
 pub use elastic::LinearElastic;
 
 use crate::error::Result;
-use crate::math::{Real, Vector};
+use crate::math::{plane_basis, Real, Vector, Vector2};
 
 /// Material of a block; joint laws are chosen per pair of materials.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default, Serialize, Deserialize)]
@@ -35,6 +35,59 @@ pub struct JointStiffness {
     pub shear: Real,
 }
 
+/// The axes of a joint (world): its unit normal `n` (from `a` to `b`) and two unit tangents
+/// `t₁`, `t₂ = n × t₁` spanning its plane. Shear forces and displacements are given by their
+/// components along the tangents. In large-displacement mode the tangents turn with the joint
+/// plane from step to step, so the components of a stored shear force stay valid as the plane
+/// turns (see `docs/theory.md`, "Sub-contact kinematics").
+///
+/// ```
+/// use voussoir::constitutive::JointAxes;
+/// use voussoir::math::{Vector, Vector2};
+/// let axes = JointAxes::from_normal(Vector::Z);
+/// let s = Vector::new(3.0, -4.0, 0.0);
+/// let c = axes.components(s);
+/// assert!((axes.shear(c) - s).length() < 1e-15);
+/// assert!((c.length() - 5.0).abs() < 1e-15);
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointAxes {
+    /// Unit normal (from `a` to `b`).
+    pub normal: Vector,
+    /// First tangent `t₁`, a unit vector normal to `normal`.
+    pub tangent: Vector,
+}
+
+impl JointAxes {
+    /// Axes with normal `normal` (a unit vector) and an arbitrary first tangent.
+    pub fn from_normal(normal: Vector) -> Self {
+        Self {
+            normal,
+            tangent: plane_basis(normal).0,
+        }
+    }
+    /// The second tangent `t₂ = n × t₁`.
+    #[inline]
+    pub fn tangent_2(&self) -> Vector {
+        self.normal.cross(self.tangent)
+    }
+    /// The world vector with tangent components `c`: `c.x t₁ + c.y t₂`.
+    #[inline]
+    pub fn shear(&self, c: Vector2) -> Vector {
+        self.tangent * c.x + self.tangent_2() * c.y
+    }
+    /// The tangent components of the world vector `v` (its part along `n` is dropped).
+    #[inline]
+    pub fn components(&self, v: Vector) -> Vector2 {
+        Vector2::new(self.tangent.dot(v), self.tangent_2().dot(v))
+    }
+    /// The world force of `force` on block `b`: `n F_n + F_s`.
+    #[inline]
+    pub fn force(&self, force: &JointForce) -> Vector {
+        self.normal * force.normal + self.shear(force.shear)
+    }
+}
+
 /// What the kinematics of one step give a law at one sub-contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointStep {
@@ -44,10 +97,11 @@ pub struct JointStep {
     pub normal_displacement: Real,
     /// Normal displacement increment of this step (m).
     pub normal_increment: Real,
-    /// Shear displacement increment of block `b` relative to block `a` in the joint plane (m).
-    pub shear_increment: Vector,
-    /// Unit normal of the joint (from `a` to `b`).
-    pub normal: Vector,
+    /// Shear displacement increment of block `b` relative to block `a` in the joint plane (m),
+    /// as components along the tangents of [`JointStep::axes`].
+    pub shear_increment: Vector2,
+    /// The joint's normal and tangents (world), for laws that are not isotropic in the plane.
+    pub axes: JointAxes,
     /// Time step (s).
     pub dt: Real,
 }
@@ -57,9 +111,9 @@ pub struct JointStep {
 pub struct JointForce {
     /// Normal force (N), positive in compression.
     pub normal: Real,
-    /// Shear force on block `b` (N), in the joint plane. On entry it holds the previous value
-    /// already rotated into the current plane.
-    pub shear: Vector,
+    /// Shear force on block `b` (N), as components along the joint's tangents
+    /// ([`JointAxes`]); on entry the previous step's value, whose axes have turned with the plane.
+    pub shear: Vector2,
 }
 
 /// State of a sub-contact after an update, for monitors and output.
@@ -87,7 +141,8 @@ pub enum JointStatus {
 ///
 /// ```
 /// use voussoir::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
-/// use voussoir::math::Vector;
+/// use voussoir::constitutive::JointAxes;
+/// use voussoir::math::{Vector, Vector2};
 ///
 /// #[derive(Debug, Clone)]
 /// struct Frictionless { kn: f64 }
@@ -96,14 +151,14 @@ pub enum JointStatus {
 ///     type State = ();
 ///     fn stiffness(&self) -> JointStiffness { JointStiffness { normal: self.kn, shear: 0.0 } }
 ///     fn update(&self, s: &JointStep, f: &mut JointForce, _: &mut ()) -> JointStatus {
-///         f.shear = Vector::ZERO;
+///         f.shear = Vector2::ZERO;
 ///         f.normal = (-self.kn * s.normal_displacement * s.area).max(0.0);
 ///         if f.normal > 0.0 { JointStatus::Sliding } else { JointStatus::Open }
 ///     }
 /// }
 /// let law = Frictionless { kn: 1e9 };
 /// let step = JointStep { area: 0.01, normal_displacement: -1e-6, normal_increment: -1e-6,
-///     shear_increment: Vector::ZERO, normal: Vector::Z, dt: 1e-5 };
+///     shear_increment: Vector2::ZERO, axes: JointAxes::from_normal(Vector::Z), dt: 1e-5 };
 /// let mut f = JointForce::default();
 /// assert_eq!(law.update(&step, &mut f, &mut ()), JointStatus::Sliding);
 /// assert!((f.normal - 10.0).abs() < 1e-9);
@@ -115,8 +170,8 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     /// Initial (largest) stiffness, used for the critical time step and the Rayleigh dashpots.
     fn stiffness(&self) -> JointStiffness;
 
-    /// Updates `force` (holding last step's forces, the shear already rotated into the current
-    /// plane) and `state` for this step's kinematics; returns the resulting status.
+    /// Updates `force` (holding last step's forces, the shear as components along the joint's
+    /// tangents, which have turned with the plane) and `state` for this step's kinematics; returns the resulting status.
     fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut Self::State) -> JointStatus;
 
     /// Whether a sub-contact that is open with zero force stays so at total normal displacement

@@ -2,12 +2,12 @@
 //! law, dashpot), summed into the contact's resultant, moments and energy increments in the same
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
-use super::lanes::{update_group, ContactFrame, LaneSums, LANES};
-use super::{ContactPair, DisplacementMode, SubContact, SubContactRecord};
+use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LocalSums, LANES};
+use super::{AnchorPlane, ContactPair, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
-use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep};
+use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
 use crate::geometry::ContactKind;
-use crate::math::{Matrix, Real, Vector};
+use crate::math::{Matrix, Real, Vector, Vector2};
 
 /// Read-only data shared by all contacts of a step.
 #[derive(Debug, Clone, Copy)]
@@ -18,16 +18,18 @@ pub(crate) struct KernelContext {
     pub mode: DisplacementMode,
 }
 
-/// Updates one contact for one step: its plane (large-displacement mode), the forces of its
-/// sub-contacts (`subs` and `records` are the contact's own ranges) and its resultant, moments
-/// about both centroids and energy increments. Sums run in a fixed order — in sub-contact order,
-/// or, four at a time, per lane, the lanes added in order, then the remaining sub-contacts — so
-/// the result does not depend on how contacts are spread over threads.
+/// Updates one contact for one step: its plane and axes (large-displacement mode), the forces of
+/// its sub-contacts (`subs` and `records` are the contact's own ranges) and its resultant,
+/// moments about both centroids and energy increments. Sums run in a fixed order — in
+/// sub-contact order, or, four at a time, per lane, the lanes added in order, then the remaining
+/// sub-contacts — so the result does not depend on how contacts are spread over threads.
 ///
-/// Everything common to the contact is computed once: the host rotation as a matrix, the
-/// displacement increment as a field affine in the anchor `a`, `Δu₀ + D a`, and the face-face
-/// gap `g₀ − (Rᵀq)·a`; a sub-contact then costs one matrix-vector product for its kinematics,
-/// and its force enters the contact's moment and work through `Σ F aᵀ` (see [`ForceMoments`]).
+/// Everything common to the contact is computed once: the joint axes `(n, t₁, t₂)` turned with
+/// the plane, and the displacement increment in those axes as a field affine in the anchor's
+/// plane coordinates `(x, y)`, `Δu = Δu_o + x Δu_x + y Δu_y`, and so is the face-face gap. A
+/// sub-contact then costs six multiplications for its kinematics, its shear force needs no
+/// turning (its components follow the turning tangents), and its force enters the contact's
+/// resultant, moment and work through the sums `Σ f`, `Σ f x`, `Σ f y` (see [`ForceMoments`]).
 /// Without dashpot forces the sub-contacts go four at a time (`lanes.rs`), with the same
 /// operations per sub-contact.
 #[inline(always)]
@@ -40,8 +42,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     law: &L,
     ctx: KernelContext,
 ) {
-    // The normal of the previous step, in which the stored spring forces were composed.
-    let previous_normal = pair.normal;
+    // The axes of the previous step, in which the stored spring forces were composed.
+    let previous_axes = pair.axes();
     let host = pair.frame(&sa.pose, &sb.pose, ctx.mode);
     let (xa, xb) = match ctx.mode {
         DisplacementMode::Large => (sa.pose.translation, sb.pose.translation),
@@ -50,7 +52,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let xh = host.translation;
     // Face-face, large displacements: gap(p) = (d − m·p)/(m·h) for the other face's plane
     // m·x = d and the host face's normal h; with p = x_h + r, gap = g₀ − q·r.
-    let mut face_gap = None;
+    let mut face_plane = None;
     if ctx.mode == DisplacementMode::Large {
         match pair.kind {
             ContactKind::FaceFace { .. } => {
@@ -64,22 +66,24 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 };
                 let other_offset = pair.local_other_offset + other_n.dot(other_x);
                 let inv_cos = 1.0 / other_n.dot(host_n);
-                face_gap = Some(((other_offset - other_n.dot(xh)) * inv_cos, other_n * inv_cos));
+                face_plane = Some(((other_offset - other_n.dot(xh)) * inv_cos, other_n * inv_cos));
             }
             ContactKind::Point { normal_local } => {
                 pair.normal = sa.pose.rotation * normal_local;
             }
         }
+        pair.tangent = turned_tangent(previous_axes, pair.normal);
     }
-    let n = pair.normal;
-    let shear_turn = plane_turn(previous_normal, n);
+    let axes = pair.axes();
+    let (n, t1, t2) = (axes.normal, axes.tangent, axes.tangent_2());
     let rotation = Matrix::from_quat(host.rotation);
     // v_rel(p) = v_b + ω_b × (p − x_b) − v_a − ω_a × (p − x_a) = v₀ + (ω_b − ω_a) × r.
     let dw = sb.angular_velocity - sa.angular_velocity;
     let v0 = sb.velocity - sa.velocity + sb.angular_velocity.cross(xh - xb) - sa.angular_velocity.cross(xh - xa);
     let dt = ctx.dt;
     // Displacement increments over the step, affine in the anchor `a` (host body frame):
-    // du = v₀Δt + (ΔωΔt) × (R a) = du₀ + D a, with D = [ΔωΔt]× R.
+    // du = v₀Δt + (ΔωΔt) × (R a) = du₀ + D a, with D = [ΔωΔt]× R; with a = o + x u + y v on the
+    // anchor plane, du = (du₀ + D o) + x D u + y D v, taken in the joint axes.
     let du0 = v0 * dt;
     let dwdt = dw * dt;
     let d = Matrix::from_cols(
@@ -87,8 +91,16 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         dwdt.cross(rotation.y_axis),
         dwdt.cross(rotation.z_axis),
     );
-    // Face gap in the anchor: g₀ − q·(R a) = g₀ − (Rᵀq)·a.
-    let face_gap = face_gap.map(|(g0, q)| (g0, rotation.transpose() * q));
+    let plane = pair.anchors;
+    let (ro, ru, rv) = (rotation * plane.origin, rotation * plane.u, rotation * plane.v);
+    let in_axes = |v: Vector| Vector::new(n.dot(v), t1.dot(v), t2.dot(v));
+    let kinematics = Kinematics {
+        at_origin: in_axes(du0 + dwdt.cross(ro)),
+        per_x: in_axes(dwdt.cross(ru)),
+        per_y: in_axes(dwdt.cross(rv)),
+    };
+    // Face gap at the anchor: g₀ − q·(R a) = (g₀ − q·R o) − x q·R u − y q·R v.
+    let face_gap_coefficients = face_plane.map(|(g0, q)| (g0 - q.dot(ro), q.dot(ru), q.dot(rv)));
     let k = law.stiffness();
     // Dashpot coefficients per unit area (zero without Rayleigh damping).
     let damped = ctx.stiffness_damping > 0.0;
@@ -104,9 +116,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // after Rayleigh damping was switched off).
     let dashpots = damped || pair.dashpots;
 
-    let mut springs = ForceMoments::default();
+    let mut sums = LocalSums::default();
     let mut dashpot_moments = ForceMoments::default();
-    let mut normal_force = 0.0;
     // Σ (F_before + F_after)·du for the dashpots (times −½ at the end).
     let mut dashpot_sum = 0.0;
     // Without dashpot forces, four sub-contacts at a time; the rest (and everything when there
@@ -114,25 +125,21 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let mut done = 0;
     if !dashpots {
         let frame = ContactFrame {
-            n,
-            du0,
-            d,
-            face_gap,
-            shear_turn,
+            axes,
+            kinematics,
+            face_gap: face_gap_coefficients,
             dt,
         };
-        let mut sums = LaneSums::default();
+        let mut lanes = LaneSums::default();
         for (group, group_records) in subs.chunks_exact_mut(LANES).zip(records.chunks_exact_mut(LANES)) {
-            update_group(group, group_records, law, &frame, &mut sums);
+            update_group(group, group_records, law, &frame, &mut lanes);
         }
         done = subs.len() / LANES * LANES;
-        let (force, first, normal) = sums.total();
-        springs = ForceMoments { force, first };
-        normal_force = normal;
+        sums = lanes.total();
     }
     for (sub, record) in subs[done..].iter_mut().zip(records[done..].iter_mut()) {
-        let a = sub.anchor;
-        let face = face_gap.map(|(g0, q)| g0 - q.dot(a));
+        let (x, y) = (sub.plane.x, sub.plane.y);
+        let face = face_gap_coefficients.map(|g| face_gap(g, x, y));
         // A separated sub-contact that the law says stays open with no force and no change of
         // state needs neither kinematics nor an update (nor a dashpot: it had none and gets none).
         if let Some(gap) = face {
@@ -141,44 +148,40 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 continue;
             }
         }
-        let du = du0 + d * a;
-        let du_n = n.dot(du);
-        let du_s = du - n * du_n;
+        let [du_n, du_1, du_2] = increment(&kinematics, x, y);
+        let du_s = Vector2::new(du_1, du_2);
         let gap = face.unwrap_or(sub.gap + du_n);
-        // Last step's shear force turns with the joint plane.
-        if let Some(m) = shear_turn {
-            sub.force.shear -= m * n.dot(sub.force.shear);
-        }
         let step = JointStep {
             area: sub.area,
             normal_displacement: gap,
             normal_increment: du_n,
             shear_increment: du_s,
-            normal: n,
+            axes,
             dt,
         };
         let status = law.update(&step, &mut sub.force, &mut sub.state);
         if status == JointStatus::Sliding {
             record.slip += du_s.length();
         }
-        normal_force += sub.force.normal;
-        springs.add(spring_force(n, &sub.force), a);
+        sums.add(sub.force.normal, sub.force.shear, sub.plane);
         if dashpots {
             let mut dashpot = Vector::ZERO;
             if damped && status != JointStatus::Open {
                 dashpot -= n * (cn * sub.area * du_n);
                 if status != JointStatus::Sliding {
-                    dashpot -= du_s * (cs * sub.area);
+                    dashpot -= axes.shear(du_s) * (cs * sub.area);
                 }
             }
+            let du = n * du_n + t1 * du_1 + t2 * du_2;
             dashpot_sum += (record.dashpot + dashpot).dot(du);
-            dashpot_moments.add(dashpot, a);
+            dashpot_moments.add(dashpot, plane.point(sub.plane));
             record.dashpot = dashpot;
         }
         sub.gap = gap;
         sub.status = status;
     }
     pair.dashpots = damped;
+    let springs = ForceMoments::from_local(&axes, &plane, &sums);
     // Joint work by the trapezoidal rule, Σ (F_before + F_after)·du summed through the moments:
     // Σ F·(du₀ + D a) = du₀·ΣF + D : Σ F aᵀ.
     let spring_sum = pair.springs.work(du0, &d) + springs.work(du0, &d);
@@ -199,9 +202,21 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         pair.moment_b = moment_host;
         pair.moment_a = -(moment_host + (xb - xa).cross(force));
     }
-    pair.normal_force = normal_force;
+    pair.normal_force = sums.force.x;
     pair.work = -0.5 * spring_sum;
     pair.dashpot_work = -0.5 * dashpot_sum;
+}
+
+/// The first tangent of `previous` turned into the plane normal to `normal` by the smallest
+/// rotation taking the old normal to the new one (see [`plane_turn`]), then made normal to
+/// `normal` and of unit length again against round-off.
+#[inline]
+fn turned_tangent(previous: JointAxes, normal: Vector) -> Vector {
+    let Some(m) = plane_turn(previous.normal, normal) else {
+        return previous.tangent;
+    };
+    let t = previous.tangent - m * normal.dot(previous.tangent);
+    (t - normal * normal.dot(t)).normalize()
 }
 
 /// Whether a face-face sub-contact at geometric gap `gap` may skip its kinematics and update:
@@ -210,14 +225,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
 pub(crate) fn stays_separated<L: ConstitutiveLaw>(law: &L, sub: &SubContact<L::State>, gap: Real) -> bool {
     sub.status == JointStatus::Open
         && sub.force.normal == 0.0
-        && sub.force.shear == Vector::ZERO
+        && sub.force.shear == Vector2::ZERO
         && law.stays_open(sub.area, gap, &sub.state)
-}
-
-/// A sub-contact's spring force on block `b` (N, world): normal plus shear.
-#[inline(always)]
-pub(crate) fn spring_force(n: Vector, force: &JointForce) -> Vector {
-    n * force.normal + force.shear
 }
 
 /// Zeroth and first moments of a contact's sub-contact forces over their anchors `a` (host body
@@ -249,13 +258,32 @@ impl ForceMoments {
         self.first.z_axis += f * a.z;
     }
 
-    /// The moments of the spring forces of `subs`, whose forces were composed with normal `n`.
-    pub fn of_springs<S>(n: Vector, subs: &[SubContact<S>]) -> Self {
-        let mut m = Self::default();
+    /// The moments of the spring forces of `subs`, whose forces are components in `axes` and
+    /// whose anchors lie on `plane`.
+    pub fn of_springs<S>(axes: &JointAxes, plane: &AnchorPlane, subs: &[SubContact<S>]) -> Self {
+        let mut sums = LocalSums::default();
         for s in subs {
-            m.add(spring_force(n, &s.force), s.anchor);
+            sums.add(s.force.normal, s.force.shear, s.plane);
         }
-        m
+        Self::from_local(axes, plane, &sums)
+    }
+
+    /// The moments from the sums in the joint axes: with `B = [n t₁ t₂]` and anchors
+    /// `a = o + x u + y v`, `Σ F = B Σ f` and `Σ F aᵀ = (B Σ f) oᵀ + (B Σ f x) uᵀ + (B Σ f y) vᵀ`.
+    #[inline]
+    pub(crate) fn from_local(axes: &JointAxes, plane: &AnchorPlane, sums: &LocalSums) -> Self {
+        let (n, t1, t2) = (axes.normal, axes.tangent, axes.tangent_2());
+        let world = |f: Vector| n * f.x + t1 * f.y + t2 * f.z;
+        let (f, fx, fy) = (world(sums.force), world(sums.per_x), world(sums.per_y));
+        let (o, u, v) = (plane.origin, plane.u, plane.v);
+        Self {
+            force: f,
+            first: Matrix::from_cols(
+                f * o.x + fx * u.x + fy * v.x,
+                f * o.y + fx * u.y + fy * v.y,
+                f * o.z + fx * u.z + fy * v.z,
+            ),
+        }
     }
 
     /// Whether `self` and `other` agree to round-off (relative 1e-9 of the largest entry and

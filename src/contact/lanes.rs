@@ -1,19 +1,19 @@
 //! The sub-contact loop four sub-contacts at a time, for contacts without dashpot forces.
 //!
-//! The kinematics (`Δu = Δu₀ + D a`, `Δu_n`, `Δu_s`, the face gap), the turn of last step's shear
-//! force into the new plane and the force moments `Σ F`, `Σ F aᵀ` are computed lane-wise on four
-//! sub-contacts, which the compiler turns into packed floating-point instructions; the law runs
-//! lane by lane (it is generic and branches). Each lane performs exactly the operations of the
-//! one-at-a-time loop in [`super::kernel`], in the same order, so a sub-contact's forces do not
-//! depend on which loop updated it; the moments are summed per lane and the lanes added in a
-//! fixed order, so the totals do not depend on the number of threads.
+//! The kinematics (the displacement increment in the joint axes, affine in the anchor's plane
+//! coordinates, and the face gap) and the force sums `Σ f`, `Σ f x`, `Σ f y` are computed
+//! lane-wise on four sub-contacts, which the compiler turns into packed floating-point
+//! instructions; the law runs lane by lane (it is generic and branches). The kinematics are one
+//! generic function ([`increment`], [`face_gap`]) for a lane group and for a single sub-contact,
+//! so a sub-contact's forces do not depend on which loop updated it; the sums are kept per lane
+//! and the lanes added in a fixed order, so the totals do not depend on the number of threads.
 
 use std::ops::{Add, Mul, Sub};
 
 use super::kernel::stays_separated;
 use super::{SubContact, SubContactRecord};
-use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep};
-use crate::math::{Matrix, Real, Vector};
+use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
+use crate::math::{Real, Vector, Vector2};
 
 /// Sub-contacts per group.
 pub(crate) const LANES: usize = 4;
@@ -62,109 +62,104 @@ impl Mul for F4 {
     }
 }
 
-/// A vector per lane.
-#[derive(Debug, Clone, Copy, Default)]
-struct V4 {
-    x: F4,
-    y: F4,
-    z: F4,
+/// A number type the kinematics are written for: one sub-contact ([`Real`]) or a lane group.
+pub(crate) trait Lane: Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> {
+    /// The value `x` (in every lane).
+    fn splat(x: Real) -> Self;
 }
 
-impl V4 {
+impl Lane for Real {
     #[inline(always)]
-    fn splat(v: Vector) -> Self {
-        Self {
-            x: F4::splat(v.x),
-            y: F4::splat(v.y),
-            z: F4::splat(v.z),
-        }
-    }
-    #[inline(always)]
-    fn gather(f: impl Fn(usize) -> Vector) -> Self {
-        Self {
-            x: F4::from_fn(|l| f(l).x),
-            y: F4::from_fn(|l| f(l).y),
-            z: F4::from_fn(|l| f(l).z),
-        }
-    }
-    #[inline(always)]
-    fn lane(&self, l: usize) -> Vector {
-        Vector::new(self.x.0[l], self.y.0[l], self.z.0[l])
-    }
-    /// `self · v` for a vector `v` common to the lanes, as glam's `(x + y) + z`.
-    #[inline(always)]
-    fn dot(&self, v: &V4) -> F4 {
-        self.x * v.x + self.y * v.y + self.z * v.z
-    }
-    #[inline(always)]
-    fn scale(&self, s: F4) -> Self {
-        Self {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
-    }
-    #[inline(always)]
-    fn sum(self) -> Vector {
-        Vector::new(self.x.sum(), self.y.sum(), self.z.sum())
+    fn splat(x: Real) -> Self {
+        x
     }
 }
 
-impl Add for V4 {
-    type Output = Self;
+impl Lane for F4 {
     #[inline(always)]
-    fn add(self, o: Self) -> Self {
-        Self {
-            x: self.x + o.x,
-            y: self.y + o.y,
-            z: self.z + o.z,
-        }
+    fn splat(x: Real) -> Self {
+        F4::splat(x)
     }
 }
 
-impl Sub for V4 {
-    type Output = Self;
-    #[inline(always)]
-    fn sub(self, o: Self) -> Self {
-        Self {
-            x: self.x - o.x,
-            y: self.y - o.y,
-            z: self.z - o.z,
-        }
-    }
+/// The displacement increment of a contact's sub-contacts over a step, in the joint axes
+/// `(n, t₁, t₂)`: affine in the anchor's plane coordinates `(x, y)`,
+/// `Δu = Δu_o + x Δu_x + y Δu_y` (see `update_contact`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Kinematics {
+    /// At the plane origin.
+    pub at_origin: Vector,
+    /// Per unit of `x`.
+    pub per_x: Vector,
+    /// Per unit of `y`.
+    pub per_y: Vector,
+}
+
+/// `[Δu_n, Δu_t₁, Δu_t₂]` at plane coordinates `(x, y)`, each as `(o + p_x x) + p_y y`.
+#[inline(always)]
+pub(crate) fn increment<T: Lane>(k: &Kinematics, x: T, y: T) -> [T; 3] {
+    let at = |o: Real, px: Real, py: Real| (T::splat(o) + T::splat(px) * x) + T::splat(py) * y;
+    [
+        at(k.at_origin.x, k.per_x.x, k.per_y.x),
+        at(k.at_origin.y, k.per_x.y, k.per_y.y),
+        at(k.at_origin.z, k.per_x.z, k.per_y.z),
+    ]
+}
+
+/// The face-face gap `(g_o − g_x x) − g_y y` at plane coordinates `(x, y)`.
+#[inline(always)]
+pub(crate) fn face_gap<T: Lane>(g: (Real, Real, Real), x: T, y: T) -> T {
+    (T::splat(g.0) - T::splat(g.1) * x) - T::splat(g.2) * y
 }
 
 /// What the loop needs of the contact, computed once per contact (see `update_contact`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ContactFrame {
-    /// Normal of this step.
-    pub n: Vector,
-    /// `Δu₀` and `D` of `Δu = Δu₀ + D a`.
-    pub du0: Vector,
-    pub d: Matrix,
-    /// Face gap `g₀ − q·a` (face-face, large displacements), else incremental.
-    pub face_gap: Option<(Real, Vector)>,
-    /// Turn of last step's shear force: `s ← s − m (n·s)`.
-    pub shear_turn: Option<Vector>,
+    /// The joint axes of this step.
+    pub axes: JointAxes,
+    pub kinematics: Kinematics,
+    /// Face gap `(g_o, g_x, g_y)` (face-face, large displacements), else incremental.
+    pub face_gap: Option<(Real, Real, Real)>,
     pub dt: Real,
 }
 
-/// Per-lane sums of a contact's spring forces and normal forces.
+/// Force sums of a contact's sub-contacts in the joint axes: `Σ f`, `Σ f x`, `Σ f y` for
+/// `f = (F_n, F_t₁, F_t₂)` at plane coordinates `(x, y)`.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct LocalSums {
+    pub force: Vector,
+    pub per_x: Vector,
+    pub per_y: Vector,
+}
+
+impl LocalSums {
+    /// Adds the spring force of one sub-contact at plane coordinates `c`.
+    #[inline(always)]
+    pub fn add(&mut self, normal: Real, shear: Vector2, c: Vector2) {
+        let f = Vector::new(normal, shear.x, shear.y);
+        self.force += f;
+        self.per_x += f * c.x;
+        self.per_y += f * c.y;
+    }
+}
+
+/// [`LocalSums`] per lane.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct LaneSums {
-    force: V4,
-    first: [V4; 3],
-    normal: F4,
+    force: [F4; 3],
+    per_x: [F4; 3],
+    per_y: [F4; 3],
 }
 
 impl LaneSums {
-    /// The lane sums added in lane order: `(Σ F, Σ F aᵀ, Σ F_n)`.
-    pub fn total(self) -> (Vector, Matrix, Real) {
-        (
-            self.force.sum(),
-            Matrix::from_cols(self.first[0].sum(), self.first[1].sum(), self.first[2].sum()),
-            self.normal.sum(),
-        )
+    /// The lane sums added in lane order.
+    pub fn total(self) -> LocalSums {
+        let v = |s: [F4; 3]| Vector::new(s[0].sum(), s[1].sum(), s[2].sum());
+        LocalSums {
+            force: v(self.force),
+            per_x: v(self.per_x),
+            per_y: v(self.per_y),
+        }
     }
 }
 
@@ -179,24 +174,13 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
     sums: &mut LaneSums,
 ) {
     debug_assert!(group.len() == LANES && records.len() == LANES);
-    let n = frame.n;
-    let nv = V4::splat(n);
-    let a = V4::gather(|l| group[l].anchor);
-    // du = du₀ + D a, as glam's `du₀ + ((D.x a.x + D.y a.y) + D.z a.z)`.
-    let d = &frame.d;
-    let da = V4::splat(d.x_axis).scale(a.x) + V4::splat(d.y_axis).scale(a.y) + V4::splat(d.z_axis).scale(a.z);
-    let du = V4::splat(frame.du0) + da;
-    let du_n = nv.dot(&du);
-    let du_s = du - nv.scale(du_n);
+    let x = F4::from_fn(|l| group[l].plane.x);
+    let y = F4::from_fn(|l| group[l].plane.y);
+    let [du_n, du_1, du_2] = increment(&frame.kinematics, x, y);
     let gap = match frame.face_gap {
-        Some((g0, q)) => F4::splat(g0) - V4::splat(q).dot(&a),
+        Some(g) => face_gap(g, x, y),
         None => F4::from_fn(|l| group[l].gap) + du_n,
     };
-    let mut shear = V4::gather(|l| group[l].force.shear);
-    if let Some(m) = frame.shear_turn {
-        shear = shear - V4::splat(m).scale(nv.dot(&shear));
-    }
-    let (mut fn_, mut fs) = (F4::default(), V4::default());
     for l in 0..LANES {
         let sub = &mut group[l];
         let gap = gap.0[l];
@@ -205,36 +189,31 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
             sub.gap = gap;
             continue;
         }
-        let du_s = du_s.lane(l);
-        let mut force = JointForce {
-            normal: sub.force.normal,
-            shear: shear.lane(l),
-        };
+        let du_s = Vector2::new(du_1.0[l], du_2.0[l]);
         let step = JointStep {
             area: sub.area,
             normal_displacement: gap,
             normal_increment: du_n.0[l],
             shear_increment: du_s,
-            normal: n,
+            axes: frame.axes,
             dt: frame.dt,
         };
-        let status = law.update(&step, &mut force, &mut sub.state);
+        let status = law.update(&step, &mut sub.force, &mut sub.state);
         if status == JointStatus::Sliding {
             records[l].slip += du_s.length();
         }
-        sub.force = force;
         sub.gap = gap;
         sub.status = status;
-        fn_.0[l] = force.normal;
-        fs.x.0[l] = force.shear.x;
-        fs.y.0[l] = force.shear.y;
-        fs.z.0[l] = force.shear.z;
     }
-    // Spring force n F_n + F_s, and its moments, lane-wise.
-    let f = nv.scale(fn_) + fs;
-    sums.normal = sums.normal + fn_;
-    sums.force = sums.force + f;
-    sums.first[0] = sums.first[0] + f.scale(a.x);
-    sums.first[1] = sums.first[1] + f.scale(a.y);
-    sums.first[2] = sums.first[2] + f.scale(a.z);
+    // The forces as the law left them (zero where skipped), read back lane by lane.
+    let f = [
+        F4::from_fn(|l| group[l].force.normal),
+        F4::from_fn(|l| group[l].force.shear.x),
+        F4::from_fn(|l| group[l].force.shear.y),
+    ];
+    for k in 0..3 {
+        sums.force[k] = sums.force[k] + f[k];
+        sums.per_x[k] = sums.per_x[k] + f[k] * x;
+        sums.per_y[k] = sums.per_y[k] + f[k] * y;
+    }
 }

@@ -6,13 +6,13 @@ mod lanes;
 
 use serde::{Deserialize, Serialize};
 
-pub(crate) use kernel::{spring_force, update_contact, ForceMoments, KernelContext};
+pub(crate) use kernel::{update_contact, ForceMoments, KernelContext};
 
 use crate::block::BlockId;
-use crate::constitutive::{JointForce, JointStatus};
+use crate::constitutive::{JointAxes, JointForce, JointStatus};
 use crate::geometry::Polyhedron;
 use crate::geometry::{ContactKind, SubKey};
-use crate::math::{Pose, Real, Rotation, Vector};
+use crate::math::{Pose, Real, Rotation, Vector, Vector2};
 
 /// Typed index of a contact in the model's current contact list (valid until the next
 /// re-detection).
@@ -63,6 +63,12 @@ pub struct ContactPair {
     /// a step it still holds the previous step's normal, in which the stored spring forces were
     /// composed.
     pub(crate) normal: Vector,
+    /// First tangent of the joint (world, normal to `normal`); the second is `normal × tangent`.
+    /// The sub-contacts' shear forces are components along the two. Turned with the normal
+    /// every step in large-displacement mode.
+    pub(crate) tangent: Vector,
+    /// The plane of the anchors in the host block's body frame (see [`AnchorPlane`]).
+    pub(crate) anchors: AnchorPlane,
     /// Face-face: outward normals of face `a` and face `b` in their blocks' body frames, and the
     /// plane offset of the face that is not the host, in its body frame. Cached from the shapes
     /// at detection and on checkpoint load, so that the step loop does not visit the polyhedra.
@@ -110,9 +116,9 @@ fn always() -> bool {
 mod tests {
     /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
     #[test]
-    fn subcontact_is_80_bytes_with_coulomb_state() {
+    fn subcontact_is_64_bytes_with_coulomb_state() {
         use crate::constitutive::CoulombState;
-        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 80);
+        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 64);
     }
 }
 
@@ -128,6 +134,23 @@ impl ContactPair {
     /// Unit normal a → b (world).
     pub fn normal(&self) -> Vector {
         self.normal
+    }
+    /// The joint's normal and tangents (world); sub-contact shear forces are components along
+    /// the tangents.
+    pub fn axes(&self) -> JointAxes {
+        JointAxes {
+            normal: self.normal,
+            tangent: self.tangent,
+        }
+    }
+    /// The plane of the sub-contact anchors in the host block's body frame.
+    pub fn anchor_plane(&self) -> &AnchorPlane {
+        &self.anchors
+    }
+    /// Material point of `sub` (one of this contact's sub-contacts) on the host block, in its
+    /// body frame (m).
+    pub fn anchor<S>(&self, sub: &SubContact<S>) -> Vector {
+        self.anchors.point(sub.plane)
     }
     /// Resultant force on `b` (N, world).
     pub fn resultant(&self) -> Vector {
@@ -175,7 +198,7 @@ impl ContactPair {
 
     /// Recomputes [`ContactPair::springs`] from the contact's own sub-contacts.
     pub(crate) fn refresh_springs<S>(&mut self, subs: &[SubContact<S>]) {
-        self.springs = ForceMoments::of_springs(self.normal, &subs[self.range()]);
+        self.springs = ForceMoments::of_springs(&self.axes(), &self.anchors, &subs[self.range()]);
     }
 
     pub(crate) fn range(&self) -> std::ops::Range<usize> {
@@ -183,16 +206,111 @@ impl ContactPair {
     }
 }
 
+/// The plane of a contact's sub-contact anchors, in the host block's body frame: the anchor with
+/// plane coordinates `c` is `origin + c.x u + c.y v` (`u`, `v` orthonormal). Face-face anchors lie
+/// on the host face, those of a point contact on a segment or at a point, so one plane holds
+/// them all, and a sub-contact stores two coordinates instead of a 3-D point.
+///
+/// ```
+/// use voussoir::contact::AnchorPlane;
+/// use voussoir::math::Vector;
+/// let pts = [Vector::new(0.1, 0.2, 0.3), Vector::new(0.4, 0.2, 0.3), Vector::new(0.1, 0.2, -0.5)];
+/// let plane = AnchorPlane::through(pts);
+/// for p in pts {
+///     assert!((plane.point(plane.coordinates(p)) - p).length() < 1e-15);
+/// }
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AnchorPlane {
+    /// A point of the plane (body frame, m).
+    pub origin: Vector,
+    /// First in-plane unit axis.
+    pub u: Vector,
+    /// Second in-plane unit axis, normal to `u`.
+    pub v: Vector,
+}
+
+impl Default for AnchorPlane {
+    fn default() -> Self {
+        Self {
+            origin: Vector::ZERO,
+            u: Vector::X,
+            v: Vector::Y,
+        }
+    }
+}
+
+impl AnchorPlane {
+    /// A plane through `points` when they are coplanar (collinear points and a single point
+    /// included): origin at the first point, `u` towards the farthest, `v` towards the point
+    /// farthest from that line (any normal to `u` when the points are collinear).
+    pub fn through<I>(points: I) -> Self
+    where
+        I: IntoIterator<Item = Vector>,
+        I::IntoIter: Clone,
+    {
+        let points = points.into_iter();
+        let Some(origin) = points.clone().next() else {
+            return Self::default();
+        };
+        let far = points.clone().map(|p| p - origin).fold(Vector::ZERO, |best, d| {
+            if d.length_squared() > best.length_squared() {
+                d
+            } else {
+                best
+            }
+        });
+        let size = far.length();
+        if size == 0.0 {
+            return Self {
+                origin,
+                ..Self::default()
+            };
+        }
+        let u = far / size;
+        let off = points
+            .map(|p| {
+                let d = p - origin;
+                d - u * u.dot(d)
+            })
+            .fold(Vector::ZERO, |best, w| {
+                if w.length_squared() > best.length_squared() {
+                    w
+                } else {
+                    best
+                }
+            });
+        let v = if off.length() > 1e-9 * size {
+            off.normalize()
+        } else {
+            u.any_orthonormal_vector()
+        };
+        Self { origin, u, v }
+    }
+    /// The point with plane coordinates `c` (body frame, m).
+    #[inline]
+    pub fn point(&self, c: Vector2) -> Vector {
+        self.origin + self.u * c.x + self.v * c.y
+    }
+    /// The plane coordinates of `p` (its projection onto the plane).
+    #[inline]
+    pub fn coordinates(&self, p: Vector) -> Vector2 {
+        let d = p - self.origin;
+        Vector2::new(self.u.dot(d), self.v.dot(d))
+    }
+}
+
 /// A sub-contact: a point of a joint with a tributary area, its spring forces and the law's
-/// state — what the step reads and writes for every sub-contact, and nothing else (80 bytes with
-/// [`crate::constitutive::CoulombSlip`]'s state). Its identity, accumulated slip and dashpot
-/// force sit in a parallel [`SubContactRecord`]; its world position and total force follow from
-/// the anchor and the contact's frame, see [`ContactView::point`] and
-/// [`ContactView::total_force`].
+/// state — what the step reads and writes for every sub-contact, and nothing else (64 bytes with
+/// [`crate::constitutive::CoulombSlip`]'s state). Its position is given by two coordinates on the
+/// contact's [`AnchorPlane`], its shear force by two components along the joint's tangents
+/// ([`JointAxes`]). Its identity, accumulated slip and dashpot force sit in a parallel
+/// [`SubContactRecord`]; its world position and forces follow from the contact, see
+/// [`ContactView::point`], [`ContactView::shear_force`] and [`ContactView::total_force`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SubContact<S> {
-    /// Material point on the host block (body frame).
-    pub(crate) anchor: Vector,
+    /// Coordinates of the material point on the host block, on the contact's anchor plane (m).
+    pub(crate) plane: Vector2,
     pub(crate) area: Real,
     /// Normal displacement `u_n` (m, positive = open).
     pub(crate) gap: Real,
@@ -202,10 +320,10 @@ pub struct SubContact<S> {
 }
 
 impl<S> SubContact<S> {
-    /// Material point on the host block, in its body frame (m); [`ContactView::point`] gives
-    /// its world position.
-    pub fn anchor(&self) -> Vector {
-        self.anchor
+    /// Coordinates of the anchor on the contact's [`AnchorPlane`] (m); [`ContactPair::anchor`]
+    /// gives the body-frame point, [`ContactView::point`] the world point.
+    pub fn plane_coordinates(&self) -> Vector2 {
+        self.plane
     }
     /// Tributary area (m²).
     pub fn area(&self) -> Real {
@@ -223,8 +341,9 @@ impl<S> SubContact<S> {
     pub fn normal_stress(&self) -> Real {
         self.force.normal / self.area
     }
-    /// Shear force on block `b` (N, world, in the joint plane).
-    pub fn shear_force(&self) -> Vector {
+    /// Shear force on block `b` (N) as components along the joint's tangents
+    /// ([`ContactPair::axes`]); [`ContactView::shear_force`] gives the world vector.
+    pub fn shear_components(&self) -> Vector2 {
         self.force.shear
     }
     /// Status after the last update.
@@ -298,7 +417,12 @@ pub struct ContactView<'a, S> {
 impl<S> ContactView<'_, S> {
     /// World position of one of this contact's sub-contacts (m).
     pub fn point(&self, sub: &SubContact<S>) -> Vector {
-        self.frame.transform_point(sub.anchor)
+        self.frame.transform_point(self.pair.anchor(sub))
+    }
+    /// Shear force of one of this contact's sub-contacts on block `b` (N, world, in the joint
+    /// plane).
+    pub fn shear_force(&self, sub: &SubContact<S>) -> Vector {
+        self.pair.axes().shear(sub.force.shear)
     }
     /// World positions of the sub-contacts, in order.
     pub fn points(&self) -> impl ExactSizeIterator<Item = Vector> + '_ {
@@ -313,7 +437,7 @@ impl<S> ContactView<'_, S> {
     /// # Panics
     /// If `index` is not below `subs.len()`.
     pub fn total_force(&self, index: usize) -> Vector {
-        spring_force(self.pair.normal, &self.subs[index].force) + self.records[index].dashpot
+        self.pair.axes().force(&self.subs[index].force) + self.records[index].dashpot
     }
 }
 

@@ -122,7 +122,7 @@ pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> R
         let l = &law[c.pair.law_index()];
         for (s, r) in c.iter() {
             points.extend(c.point(s).to_array());
-            shear.extend(s.shear_force().to_array());
+            shear.extend(c.shear_force(s).to_array());
             normal_force.push(s.normal_force());
             normal_stress.push(s.normal_stress());
             area.push(s.area());

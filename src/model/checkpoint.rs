@@ -18,7 +18,7 @@ use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 
 #[derive(Serialize, Deserialize)]
 #[serde(bound(
@@ -203,7 +203,7 @@ where
             // The stored spring moments are those of the stored forces, up to summation order.
             if !p
                 .springs
-                .matches(&ForceMoments::of_springs(p.normal, &model.subs[p.range()]))
+                .matches(&ForceMoments::of_springs(&p.axes(), &p.anchors, &model.subs[p.range()]))
             {
                 return Err(corrupt(
                     &format!("pairs[{k}].springs"),

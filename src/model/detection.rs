@@ -4,8 +4,8 @@ use rayon::prelude::*;
 
 use super::Model;
 use crate::block::{Block, BlockId};
-use crate::constitutive::{ConstitutiveLaw, JointForce, JointStatus};
-use crate::contact::{spring_force, ContactPair, DisplacementMode, ForceMoments, SubContact, SubContactRecord};
+use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
+use crate::contact::{AnchorPlane, ContactPair, DisplacementMode, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, ContactKind, NarrowPhaseScratch, SubcontactSeed};
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
@@ -130,17 +130,19 @@ impl<L: ConstitutiveLaw> Model<L> {
                     .then(|| (&self.subs[p.range()], &self.sub_records[p.range()]))
             });
             let old_subs = old_subs.flatten();
-            // Carried spring forces were composed in the old contact's normal, which the next
-            // step's energy increment needs as the previous normal.
-            let previous_normal = match (old, old_subs) {
-                (Some(k), Some(_)) => self.pairs[k].normal,
-                _ => dc.normal,
+            // Carried spring forces were composed in the old contact's axes: their shear forces
+            // are components along its tangents, and the next step's energy increment needs its
+            // normal as the previous one. A new contact starts with any tangents.
+            let axes = match (old, old_subs) {
+                (Some(k), Some(_)) => self.pairs[k].axes(),
+                _ => JointAxes::from_normal(dc.normal),
             };
             let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
+            let anchors = AnchorPlane::through(sc.seeds.iter().map(|s| s.anchor));
             let first = sc.subs.len() as u32;
             for seed in &sc.seeds {
                 let mut sub = SubContact {
-                    anchor: seed.anchor,
+                    plane: anchors.coordinates(seed.anchor),
                     area: seed.area,
                     gap: seed.gap,
                     force: JointForce::default(),
@@ -171,15 +173,16 @@ impl<L: ConstitutiveLaw> Model<L> {
                 if matches!(p.kind, ContactKind::FaceFace { .. }) {
                     let olds = &self.subs[p.range()];
                     let normal: Real = olds.iter().map(|s| s.force.normal).sum();
-                    let shear: Vector = olds.iter().map(|s| s.force.shear).sum();
+                    let old_axes = p.axes();
+                    let shear: Vector = olds.iter().map(|s| old_axes.shear(s.force.shear)).sum();
                     let new = &mut sc.subs[first as usize..];
                     let new_records = &mut sc.records[first as usize..];
                     let area: Real = new.iter().map(|s| s.area).sum();
                     if normal > 0.0 && area > 0.0 {
                         let law_ref = &self.joints.laws()[law as usize];
                         let kn = law_ref.stiffness().normal;
-                        let n = dc.normal;
-                        let shear = shear - n * n.dot(shear);
+                        // The new contact has no carried history: its axes are `dc.normal`'s.
+                        let shear = axes.components(shear);
                         for (s, r) in new.iter_mut().zip(new_records.iter_mut()) {
                             let w = s.area / area;
                             s.force = JointForce {
@@ -203,7 +206,9 @@ impl<L: ConstitutiveLaw> Model<L> {
                 law,
                 first,
                 count: sc.seeds.len() as u32,
-                normal: previous_normal,
+                normal: axes.normal,
+                tangent: axes.tangent,
+                anchors,
                 local_normal_a: Vector::ZERO,
                 local_normal_b: Vector::ZERO,
                 local_other_offset: 0.0,
@@ -313,10 +318,12 @@ impl<L: ConstitutiveLaw> Model<L> {
             // Area moments of the sub-contact points about the first one (for digits).
             let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
             let frame = p.frame(&sa.pose, &sb.pose, self.params.mode);
-            let origin = subs.first().map_or(Vector::ZERO, |s| frame.transform_point(s.anchor));
+            let origin = subs
+                .first()
+                .map_or(Vector::ZERO, |s| frame.transform_point(p.anchor(s)));
             let mut moments = AreaMoments::default();
             for s in subs {
-                moments.add(frame.transform_point(s.anchor) - origin, s.area);
+                moments.add(frame.transform_point(p.anchor(s)) - origin, s.area);
             }
             let side = |i: usize| -> Option<Stiffness6> {
                 let (inv_sqrt_m, rot, inv_sqrt_i) = scaling[i]?;
@@ -556,14 +563,14 @@ fn dropped_work<S>(
             DisplacementMode::Small => (p.ref_a, p.ref_b),
         };
         for (s, r) in old.1[p.range()].iter().zip(&old.2[p.range()]) {
-            let spring = spring_force(p.normal, &s.force);
+            let spring = p.axes().force(&s.force);
             if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
                 continue;
             }
             if carried.is_some_and(|records| records.binary_search_by_key(&r.key, |t| t.key).is_ok()) {
                 continue;
             }
-            let pt = frame.transform_point(s.anchor);
+            let pt = frame.transform_point(p.anchor(s));
             let v_rel =
                 (sb.velocity + sb.angular_velocity.cross(pt - xb)) - (sa.velocity + sa.angular_velocity.cross(pt - xa));
             let du = v_rel * dt;
