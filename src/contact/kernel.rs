@@ -3,7 +3,7 @@
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LocalSums, LANES};
-use super::{AnchorPlane, ContactPair, DisplacementMode, SubContact, SubContactRecord};
+use super::{ContactPair, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
 use crate::geometry::ContactKind;
@@ -81,26 +81,28 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let dw = sb.angular_velocity - sa.angular_velocity;
     let v0 = sb.velocity - sa.velocity + sb.angular_velocity.cross(xh - xb) - sa.angular_velocity.cross(xh - xa);
     let dt = ctx.dt;
-    // Displacement increments over the step, affine in the anchor `a` (host body frame):
-    // du = v₀Δt + (ΔωΔt) × (R a) = du₀ + D a, with D = [ΔωΔt]× R; with a = o + x u + y v on the
-    // anchor plane, du = (du₀ + D o) + x D u + y D v, taken in the joint axes.
-    let du0 = v0 * dt;
-    let dwdt = dw * dt;
-    let d = Matrix::from_cols(
-        dwdt.cross(rotation.x_axis),
-        dwdt.cross(rotation.y_axis),
-        dwdt.cross(rotation.z_axis),
-    );
+    // Displacement increments over the step at the anchor a = o + x u + y v (host body frame),
+    // r = R a: du = v₀Δt + (ΔωΔt) × r = w_o + x w_x + y w_y (world), then in the joint axes.
     let plane = pair.anchors;
-    let (ro, ru, rv) = (rotation * plane.origin, rotation * plane.u, rotation * plane.v);
+    let lever = Lever {
+        origin: rotation * plane.origin,
+        u: rotation * plane.u,
+        v: rotation * plane.v,
+    };
+    let dwdt = dw * dt;
+    let increments = Lever {
+        origin: v0 * dt + dwdt.cross(lever.origin),
+        u: dwdt.cross(lever.u),
+        v: dwdt.cross(lever.v),
+    };
     let in_axes = |v: Vector| Vector::new(n.dot(v), t1.dot(v), t2.dot(v));
     let kinematics = Kinematics {
-        at_origin: in_axes(du0 + dwdt.cross(ro)),
-        per_x: in_axes(dwdt.cross(ru)),
-        per_y: in_axes(dwdt.cross(rv)),
+        at_origin: in_axes(increments.origin),
+        per_x: in_axes(increments.u),
+        per_y: in_axes(increments.v),
     };
-    // Face gap at the anchor: g₀ − q·(R a) = (g₀ − q·R o) − x q·R u − y q·R v.
-    let face_gap_coefficients = face_plane.map(|(g0, q)| (g0 - q.dot(ro), q.dot(ru), q.dot(rv)));
+    // Face gap at the anchor: g₀ − q·r = (g₀ − q·R o) − x q·R u − y q·R v.
+    let face_gap_coefficients = face_plane.map(|(g0, q)| (g0 - q.dot(lever.origin), q.dot(lever.u), q.dot(lever.v)));
     let k = law.stiffness();
     // Dashpot coefficients per unit area (zero without Rayleigh damping).
     let damped = ctx.stiffness_damping > 0.0;
@@ -131,10 +133,12 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             dt,
         };
         let mut lanes = LaneSums::default();
-        for (group, group_records) in subs.chunks_exact_mut(LANES).zip(records.chunks_exact_mut(LANES)) {
+        let (groups, _) = subs.as_chunks_mut::<LANES>();
+        let (group_records, _) = records.as_chunks_mut::<LANES>();
+        for (group, group_records) in groups.iter_mut().zip(group_records.iter_mut()) {
             update_group(group, group_records, law, &frame, &mut lanes);
         }
-        done = subs.len() / LANES * LANES;
+        done = groups.len() * LANES;
         sums = lanes.total();
     }
     for (sub, record) in subs[done..].iter_mut().zip(records[done..].iter_mut()) {
@@ -174,17 +178,16 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             }
             let du = n * du_n + t1 * du_1 + t2 * du_2;
             dashpot_sum += (record.dashpot + dashpot).dot(du);
-            dashpot_moments.add(dashpot, plane.point(sub.plane));
+            dashpot_moments.add(dashpot, sub.plane);
             record.dashpot = dashpot;
         }
         sub.gap = gap;
         sub.status = status;
     }
     pair.dashpots = damped;
-    let springs = ForceMoments::from_local(&axes, &plane, &sums);
-    // Joint work by the trapezoidal rule, Σ (F_before + F_after)·du summed through the moments:
-    // Σ F·(du₀ + D a) = du₀·ΣF + D : Σ F aᵀ.
-    let spring_sum = pair.springs.work(du0, &d) + springs.work(du0, &d);
+    let springs = ForceMoments::from_local(&axes, &sums);
+    // Joint work by the trapezoidal rule, Σ (F_before + F_after)·du summed through the moments.
+    let spring_sum = pair.springs.work(&increments) + springs.work(&increments);
     pair.springs = springs;
     let total = if dashpots {
         springs.plus(&dashpot_moments)
@@ -192,7 +195,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         springs
     };
     let force = total.force;
-    let moment_host = total.moment(&rotation);
+    let moment_host = total.moment(&lever);
     // Moments about the centroids: Σ (p − x)×F with p = x_h + r on block b, −F on block a.
     pair.force = force;
     if pair.host_is_a {
@@ -229,70 +232,72 @@ pub(crate) fn stays_separated<L: ConstitutiveLaw>(law: &L, sub: &SubContact<L::S
         && law.stays_open(sub.area, gap, &sub.state)
 }
 
-/// Zeroth and first moments of a contact's sub-contact forces over their anchors `a` (host body
-/// frame): `F = Σ Fᵢ` and `S = Σ Fᵢ aᵢᵀ`. They give the moment about the host centroid,
-/// `Σ (R aᵢ) × Fᵢ`, and the work over a displacement field affine in the anchor,
-/// `Σ Fᵢ·(du₀ + D aᵢ) = du₀·F + D : S`, without a per-sub-contact cross or dot product.
+/// Three world vectors tied to a contact's anchor plane: a value at the plane origin and its
+/// rates along the plane axes — lever arms `R o`, `R u`, `R v` (host rotation `R`), or the
+/// displacement increment `w_o`, `w_x`, `w_y` of the anchor `o + x u + y v`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Lever {
+    pub origin: Vector,
+    pub u: Vector,
+    pub v: Vector,
+}
+
+/// Moments of a contact's sub-contact forces `Fᵢ` (world) over the anchors' plane coordinates
+/// `(xᵢ, yᵢ)`: `F = Σ Fᵢ`, `F_x = Σ Fᵢ xᵢ`, `F_y = Σ Fᵢ yᵢ`. With anchors `o + x u + y v` they give
+/// the moment about the host centroid, `Σ rᵢ × Fᵢ = R o × F + R u × F_x + R v × F_y`, and the work
+/// over a displacement field affine in the plane coordinates,
+/// `Σ Fᵢ·(w_o + xᵢ w_x + yᵢ w_y) = F·w_o + F_x·w_x + F_y·w_y`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub(crate) struct ForceMoments {
     pub force: Vector,
-    pub first: Matrix,
+    pub per_x: Vector,
+    pub per_y: Vector,
 }
 
 impl Default for ForceMoments {
     fn default() -> Self {
         Self {
             force: Vector::ZERO,
-            first: Matrix::ZERO,
+            per_x: Vector::ZERO,
+            per_y: Vector::ZERO,
         }
     }
 }
 
 impl ForceMoments {
-    /// Adds force `f` at anchor `a`.
+    /// Adds force `f` at plane coordinates `c`.
     #[inline(always)]
-    pub fn add(&mut self, f: Vector, a: Vector) {
+    pub fn add(&mut self, f: Vector, c: Vector2) {
         self.force += f;
-        self.first.x_axis += f * a.x;
-        self.first.y_axis += f * a.y;
-        self.first.z_axis += f * a.z;
+        self.per_x += f * c.x;
+        self.per_y += f * c.y;
     }
 
-    /// The moments of the spring forces of `subs`, whose forces are components in `axes` and
-    /// whose anchors lie on `plane`.
-    pub fn of_springs<S>(axes: &JointAxes, plane: &AnchorPlane, subs: &[SubContact<S>]) -> Self {
+    /// The moments of the spring forces of `subs`, whose forces are components in `axes`.
+    pub fn of_springs<S>(axes: &JointAxes, subs: &[SubContact<S>]) -> Self {
         let mut sums = LocalSums::default();
         for s in subs {
             sums.add(s.force.normal, s.force.shear, s.plane);
         }
-        Self::from_local(axes, plane, &sums)
+        Self::from_local(axes, &sums)
     }
 
-    /// The moments from the sums in the joint axes: with `B = [n t₁ t₂]` and anchors
-    /// `a = o + x u + y v`, `Σ F = B Σ f` and `Σ F aᵀ = (B Σ f) oᵀ + (B Σ f x) uᵀ + (B Σ f y) vᵀ`.
+    /// The moments from the sums in the joint axes, `B = [n t₁ t₂]` applied to each.
     #[inline]
-    pub(crate) fn from_local(axes: &JointAxes, plane: &AnchorPlane, sums: &LocalSums) -> Self {
+    pub(crate) fn from_local(axes: &JointAxes, sums: &LocalSums) -> Self {
         let (n, t1, t2) = (axes.normal, axes.tangent, axes.tangent_2());
         let world = |f: Vector| n * f.x + t1 * f.y + t2 * f.z;
-        let (f, fx, fy) = (world(sums.force), world(sums.per_x), world(sums.per_y));
-        let (o, u, v) = (plane.origin, plane.u, plane.v);
         Self {
-            force: f,
-            first: Matrix::from_cols(
-                f * o.x + fx * u.x + fy * v.x,
-                f * o.y + fx * u.y + fy * v.y,
-                f * o.z + fx * u.z + fy * v.z,
-            ),
+            force: world(sums.force),
+            per_x: world(sums.per_x),
+            per_y: world(sums.per_y),
         }
     }
 
-    /// Whether `self` and `other` agree to round-off (relative 1e-9 of the largest entry and
-    /// of the force scale `|F|`): the same moments summed in another order.
+    /// Whether `self` and `other` agree to round-off (relative 1e-9 of the largest entry):
+    /// the same moments summed in another order.
     pub fn matches(&self, other: &Self) -> bool {
-        let entries = |m: &Self| {
-            let f = m.first;
-            [m.force, f.x_axis, f.y_axis, f.z_axis]
-        };
+        let entries = |m: &Self| [m.force, m.per_x, m.per_y];
         let scale = entries(self)
             .iter()
             .chain(entries(other).iter())
@@ -309,26 +314,21 @@ impl ForceMoments {
     fn plus(&self, other: &Self) -> Self {
         Self {
             force: self.force + other.force,
-            first: self.first + other.first,
+            per_x: self.per_x + other.per_x,
+            per_y: self.per_y + other.per_y,
         }
     }
 
-    /// `Σ Fᵢ·(du₀ + D aᵢ)`.
+    /// `Σ Fᵢ·(w_o + xᵢ w_x + yᵢ w_y)`.
     #[inline]
-    fn work(&self, du0: Vector, d: &Matrix) -> Real {
-        du0.dot(self.force)
-            + (d.x_axis.dot(self.first.x_axis) + d.y_axis.dot(self.first.y_axis) + d.z_axis.dot(self.first.z_axis))
+    fn work(&self, w: &Lever) -> Real {
+        (self.force.dot(w.origin) + self.per_x.dot(w.u)) + self.per_y.dot(w.v)
     }
 
-    /// `Σ (R aᵢ) × Fᵢ`, from `T = R Sᵀ` (`T_jk = Σ (R aᵢ)_j F_ik`).
+    /// `Σ rᵢ × Fᵢ` for lever arms `rᵢ = R o + xᵢ R u + yᵢ R v`.
     #[inline]
-    fn moment(&self, rotation: &Matrix) -> Vector {
-        let t = *rotation * self.first.transpose();
-        Vector::new(
-            t.z_axis.y - t.y_axis.z,
-            t.x_axis.z - t.z_axis.x,
-            t.y_axis.x - t.x_axis.y,
-        )
+    fn moment(&self, r: &Lever) -> Vector {
+        (r.origin.cross(self.force) + r.u.cross(self.per_x)) + r.v.cross(self.per_y)
     }
 }
 

@@ -167,13 +167,12 @@ impl LaneSums {
 /// their spring forces to `sums`. The same operations as the one-at-a-time loop, lane-wise.
 #[inline(always)]
 pub(crate) fn update_group<L: ConstitutiveLaw>(
-    group: &mut [SubContact<L::State>],
-    records: &mut [SubContactRecord],
+    group: &mut [SubContact<L::State>; LANES],
+    records: &mut [SubContactRecord; LANES],
     law: &L,
     frame: &ContactFrame,
     sums: &mut LaneSums,
 ) {
-    debug_assert!(group.len() == LANES && records.len() == LANES);
     let x = F4::from_fn(|l| group[l].plane.x);
     let y = F4::from_fn(|l| group[l].plane.y);
     let [du_n, du_1, du_2] = increment(&frame.kinematics, x, y);
@@ -211,9 +210,9 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
         F4::from_fn(|l| group[l].force.shear.x),
         F4::from_fn(|l| group[l].force.shear.y),
     ];
-    for k in 0..3 {
-        sums.force[k] = sums.force[k] + f[k];
-        sums.per_x[k] = sums.per_x[k] + f[k] * x;
-        sums.per_y[k] = sums.per_y[k] + f[k] * y;
+    for (k, f) in f.into_iter().enumerate() {
+        sums.force[k] = sums.force[k] + f;
+        sums.per_x[k] = sums.per_x[k] + f * x;
+        sums.per_y[k] = sums.per_y[k] + f * y;
     }
 }

@@ -198,7 +198,7 @@ impl ContactPair {
 
     /// Recomputes [`ContactPair::springs`] from the contact's own sub-contacts.
     pub(crate) fn refresh_springs<S>(&mut self, subs: &[SubContact<S>]) {
-        self.springs = ForceMoments::of_springs(&self.axes(), &self.anchors, &subs[self.range()]);
+        self.springs = ForceMoments::of_springs(&self.axes(), &subs[self.range()]);
     }
 
     pub(crate) fn range(&self) -> std::ops::Range<usize> {

@@ -203,7 +203,7 @@ where
             // The stored spring moments are those of the stored forces, up to summation order.
             if !p
                 .springs
-                .matches(&ForceMoments::of_springs(&p.axes(), &p.anchors, &model.subs[p.range()]))
+                .matches(&ForceMoments::of_springs(&p.axes(), &model.subs[p.range()]))
             {
                 return Err(corrupt(
                     &format!("pairs[{k}].springs"),
