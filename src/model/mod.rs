@@ -715,7 +715,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         if let Some(i) = diverged {
             return Err(self.divergence_error(i));
         }
-        if self.step % self.monitor_interval == 0 && !self.monitors.is_empty() {
+        if self.step.is_multiple_of(self.monitor_interval) && !self.monitors.is_empty() {
             self.sample();
         }
         Ok(())
