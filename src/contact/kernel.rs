@@ -374,4 +374,34 @@ mod tests {
         assert!(plane_turn(to, to).is_none());
         assert!(plane_turn(to, -to).is_none());
     }
+
+    /// Over many small turns of the plane the tangent stays a unit vector in the plane and is
+    /// carried as the stored shear vector used to be — by the smallest rotation each step — so
+    /// shear components along the tangents describe the same turned force.
+    #[test]
+    fn turned_tangent_follows_the_plane_as_the_shear_force_did() {
+        let mut axes = JointAxes::from_normal(Vector::new(0.2, -0.1, 0.97).normalize());
+        // A shear force as a world vector, turned the old way, and as components.
+        let mut shear = axes.tangent * 3.0 - axes.tangent_2() * 4.0;
+        let components = axes.components(shear);
+        for k in 0..2000 {
+            let t = k as Real * 0.01;
+            let n = Vector::new(0.2 + 0.1 * t.sin(), -0.1 + 0.3 * (0.7 * t).cos(), 0.97).normalize();
+            if let Some(m) = plane_turn(axes.normal, n) {
+                shear -= m * n.dot(shear);
+            }
+            axes = JointAxes {
+                normal: n,
+                tangent: turned_tangent(axes, n),
+            };
+        }
+        assert!((axes.tangent.length() - 1.0).abs() < 1e-14);
+        assert!(axes.tangent.dot(axes.normal).abs() < 1e-14);
+        assert!(
+            (axes.shear(components) - shear).length() < 1e-12,
+            "{} vs {}",
+            axes.shear(components),
+            shear
+        );
+    }
 }

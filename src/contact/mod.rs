@@ -114,6 +114,34 @@ fn always() -> bool {
 
 #[cfg(test)]
 mod tests {
+    use super::AnchorPlane;
+    use crate::math::{Rotation, Vector};
+
+    /// Anchors of every contact case come back from their plane coordinates to round-off: a
+    /// grid on a tilted face, a segment, a single point, and nothing.
+    #[test]
+    fn anchor_plane_reproduces_coplanar_collinear_and_single_anchors() {
+        let tilt = Rotation::from_scaled_axis(Vector::new(0.3, -0.7, 0.4));
+        let origin = Vector::new(0.8, -0.35, 1.2);
+        let grid: Vec<Vector> = (0..9)
+            .flat_map(|i| (0..5).map(move |j| (i, j)))
+            .map(|(i, j)| origin + tilt * Vector::new(0.025 * i as f64 - 0.1, 0.025 * j as f64, 0.0))
+            .collect();
+        let segment: Vec<Vector> = (0..7)
+            .map(|k| origin + tilt * Vector::new(0.01 * k as f64, 0.0, 0.0))
+            .collect();
+        for anchors in [grid, segment, vec![origin]] {
+            let plane = AnchorPlane::through(anchors.iter().copied());
+            assert!((plane.u.length() - 1.0).abs() < 1e-15 && (plane.v.length() - 1.0).abs() < 1e-15);
+            assert!(plane.u.dot(plane.v).abs() < 1e-15);
+            for a in &anchors {
+                let back = plane.point(plane.coordinates(*a));
+                assert!((back - *a).length() < 1e-15, "{a} -> {back}");
+            }
+        }
+        assert_eq!(AnchorPlane::through(std::iter::empty()), AnchorPlane::default());
+    }
+
     /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
     #[test]
     fn subcontact_is_64_bytes_with_coulomb_state() {
