@@ -309,7 +309,8 @@ impl AnchorPlane {
                 }
             });
         let v = if off.length() > 1e-9 * size {
-            off.normalize()
+            // Normal to `u` again: `off` inherits round-off when the points are nearly collinear.
+            (off - u * u.dot(off)).normalize()
         } else {
             u.any_orthonormal_vector()
         };
