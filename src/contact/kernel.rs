@@ -2,10 +2,10 @@
 //! law, dashpot), summed into the contact's resultant, moments and energy increments in the same
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
-use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LocalSums, LANES};
+use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
 use super::{ContactPair, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
-use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
+use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus, JointStep};
 use crate::geometry::ContactKind;
 use crate::math::{Matrix, Real, Vector, Vector2};
 
@@ -118,7 +118,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // after Rayleigh damping was switched off).
     let dashpots = damped || pair.dashpots;
 
-    let mut sums = LocalSums::default();
+    // Spring-force sums in the joint axes.
+    let mut sums = ForceMoments::default();
     let mut dashpot_moments = ForceMoments::default();
     // Σ (F_before + F_after)·du for the dashpots (times −½ at the end).
     let mut dashpot_sum = 0.0;
@@ -167,7 +168,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         if status == JointStatus::Sliding {
             record.slip += du_s.length();
         }
-        sums.add(sub.force.normal, sub.force.shear, sub.plane);
+        sums.add_joint(&sub.force, sub.plane);
         if dashpots {
             let mut dashpot = Vector::ZERO;
             if damped && status != JointStatus::Open {
@@ -185,7 +186,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         sub.status = status;
     }
     pair.dashpots = damped;
-    let springs = ForceMoments::from_local(&axes, &sums);
+    let springs = sums.to_world(&axes);
     // Joint work by the trapezoidal rule, Σ (F_before + F_after)·du summed through the moments.
     let spring_sum = pair.springs.work(&increments) + springs.work(&increments);
     pair.springs = springs;
@@ -242,8 +243,9 @@ pub(crate) struct Lever {
     pub v: Vector,
 }
 
-/// Moments of a contact's sub-contact forces `Fᵢ` (world) over the anchors' plane coordinates
-/// `(xᵢ, yᵢ)`: `F = Σ Fᵢ`, `F_x = Σ Fᵢ xᵢ`, `F_y = Σ Fᵢ yᵢ`. With anchors `o + x u + y v` they give
+/// Moments of a contact's sub-contact forces `Fᵢ` over the anchors' plane coordinates
+/// `(xᵢ, yᵢ)` — world, or in the joint axes while the kernel sums them (see
+/// [`ForceMoments::to_world`]): `F = Σ Fᵢ`, `F_x = Σ Fᵢ xᵢ`, `F_y = Σ Fᵢ yᵢ`. With anchors `o + x u + y v` they give
 /// the moment about the host centroid, `Σ rᵢ × Fᵢ = R o × F + R u × F_x + R v × F_y`, and the work
 /// over a displacement field affine in the plane coordinates,
 /// `Σ Fᵢ·(w_o + xᵢ w_x + yᵢ w_y) = F·w_o + F_x·w_x + F_y·w_y`.
@@ -275,22 +277,30 @@ impl ForceMoments {
 
     /// The moments of the spring forces of `subs`, whose forces are components in `axes`.
     pub fn of_springs<S>(axes: &JointAxes, subs: &[SubContact<S>]) -> Self {
-        let mut sums = LocalSums::default();
+        let mut sums = Self::default();
         for s in subs {
-            sums.add(s.force.normal, s.force.shear, s.plane);
+            sums.add_joint(&s.force, s.plane);
         }
-        Self::from_local(axes, &sums)
+        sums.to_world(axes)
     }
 
-    /// The moments from the sums in the joint axes, `B = [n t₁ t₂]` applied to each.
+    /// Adds a sub-contact's spring force in the joint axes, `(F_n, F_t₁, F_t₂)`, at plane
+    /// coordinates `c` (for moments kept in the joint axes).
+    #[inline(always)]
+    pub fn add_joint(&mut self, f: &JointForce, c: Vector2) {
+        self.add(Vector::new(f.normal, f.shear.x, f.shear.y), c);
+    }
+
+    /// These moments, kept in the joint `axes`, in world coordinates: `B = [n t₁ t₂]` applied
+    /// to each.
     #[inline]
-    pub(crate) fn from_local(axes: &JointAxes, sums: &LocalSums) -> Self {
+    pub(crate) fn to_world(self, axes: &JointAxes) -> Self {
         let (n, t1, t2) = (axes.normal, axes.tangent, axes.tangent_2());
         let world = |f: Vector| n * f.x + t1 * f.y + t2 * f.z;
         Self {
-            force: world(sums.force),
-            per_x: world(sums.per_x),
-            per_y: world(sums.per_y),
+            force: world(self.force),
+            per_x: world(self.per_x),
+            per_y: world(self.per_y),
         }
     }
 

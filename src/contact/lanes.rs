@@ -11,6 +11,7 @@
 use std::ops::{Add, Mul, Sub};
 
 use super::kernel::stays_separated;
+use super::kernel::ForceMoments;
 use super::{SubContact, SubContactRecord};
 use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
 use crate::math::{Real, Vector, Vector2};
@@ -123,27 +124,8 @@ pub(crate) struct ContactFrame {
     pub dt: Real,
 }
 
-/// Force sums of a contact's sub-contacts in the joint axes: `Σ f`, `Σ f x`, `Σ f y` for
-/// `f = (F_n, F_t₁, F_t₂)` at plane coordinates `(x, y)`.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct LocalSums {
-    pub force: Vector,
-    pub per_x: Vector,
-    pub per_y: Vector,
-}
-
-impl LocalSums {
-    /// Adds the spring force of one sub-contact at plane coordinates `c`.
-    #[inline(always)]
-    pub fn add(&mut self, normal: Real, shear: Vector2, c: Vector2) {
-        let f = Vector::new(normal, shear.x, shear.y);
-        self.force += f;
-        self.per_x += f * c.x;
-        self.per_y += f * c.y;
-    }
-}
-
-/// [`LocalSums`] per lane.
+/// A contact's force sums in the joint axes ([`ForceMoments`] of `f = (F_n, F_t₁, F_t₂)`), per
+/// lane.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct LaneSums {
     force: [F4; 3],
@@ -153,9 +135,9 @@ pub(crate) struct LaneSums {
 
 impl LaneSums {
     /// The lane sums added in lane order.
-    pub fn total(self) -> LocalSums {
+    pub fn total(self) -> ForceMoments {
         let v = |s: [F4; 3]| Vector::new(s[0].sum(), s[1].sum(), s[2].sum());
-        LocalSums {
+        ForceMoments {
             force: v(self.force),
             per_x: v(self.per_x),
             per_y: v(self.per_y),
