@@ -117,6 +117,36 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     *force = serde_json::json!(fz * 1.5);
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("bad springs");
     assert!(err.to_string().contains("pairs[0].springs"), "{err}");
+    // Joint axes or anchor plane axes that are not orthonormal.
+    for (field, path) in [("tangent", "pairs[0].tangent"), ("anchors", "pairs[0].anchors")] {
+        let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+        let axis = if field == "tangent" {
+            &mut json["pairs"][0]["tangent"]
+        } else {
+            &mut json["pairs"][0]["anchors"]["v"]
+        };
+        let scaled: Vec<f64> = axis
+            .as_array()
+            .expect("a vector")
+            .iter()
+            .map(|c| 1.01 * c.as_f64().expect("a number"))
+            .collect();
+        *axis = serde_json::json!(scaled);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err(field);
+        assert!(err.to_string().contains(path), "{err}");
+    }
+    // Another version is named as such, whatever else changed between the versions.
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    json["version"] = serde_json::json!(3);
+    json.as_object_mut().expect("an object").remove("sub_records");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 3");
+    assert!(
+        err.to_string().contains("version 3") && err.to_string().contains("reads version 4"),
+        "{err}"
+    );
+    json["format"] = serde_json::json!("something-else");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("format");
+    assert!(err.to_string().contains("something-else"), "{err}");
     // A missing file.
     let err = Model::<CoulombSlip>::load_checkpoint(std::path::Path::new("/nonexistent/x.json")).expect_err("missing");
     assert!(matches!(err, Error::Io { .. }), "{err}");

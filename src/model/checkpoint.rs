@@ -20,6 +20,13 @@ use crate::monitor::{History, Monitor};
 const FORMAT: &str = "voussoir-checkpoint";
 const VERSION: u32 = 4;
 
+/// The fields every version has, read before the rest (other fields are skipped).
+#[derive(Deserialize)]
+struct Header {
+    format: String,
+    version: u32,
+}
+
 #[derive(Serialize, Deserialize)]
 #[serde(bound(
     serialize = "L: Serialize, L::State: Serialize",
@@ -123,6 +130,25 @@ where
     /// # Errors
     /// [`Error::Checkpoint`] for truncated, corrupt or inconsistent text, naming where.
     pub fn from_checkpoint_str(text: &str) -> Result<Self> {
+        // The format and version first, so that a file of another version is named as such
+        // rather than failing on the first field that changed.
+        if let Ok(header) = serde_json::from_str::<Header>(text) {
+            if header.format != FORMAT {
+                return Err(Error::Checkpoint {
+                    path: "format".into(),
+                    message: format!("\"{}\" is not a {FORMAT}", header.format),
+                });
+            }
+            if header.version != VERSION {
+                return Err(Error::Checkpoint {
+                    path: "version".into(),
+                    message: format!(
+                        "{FORMAT} version {}; this build reads version {VERSION}",
+                        header.version
+                    ),
+                });
+            }
+        }
         let de = &mut serde_json::Deserializer::from_str(text);
         let snap: Snapshot<L> = serde_path_to_error::deserialize(de).map_err(|e| Error::Checkpoint {
             path: e.path().to_string(),
@@ -155,6 +181,15 @@ where
                 }
                 crate::geometry::ContactKind::Point { .. } => true,
             };
+            if !orthonormal(p.normal, p.tangent) {
+                return Err(corrupt(&format!("pairs[{k}].tangent"), "joint axes not orthonormal"));
+            }
+            if !orthonormal(p.anchors.u, p.anchors.v) {
+                return Err(corrupt(
+                    &format!("pairs[{k}].anchors"),
+                    "anchor plane axes not orthonormal",
+                ));
+            }
             let sorted = k == 0 || (snap.pairs[k - 1].a, snap.pairs[k - 1].b) < (p.a, p.b);
             let (start, end) = (p.first as usize, p.first as usize + p.count as usize);
             let ok = faces_ok
@@ -175,6 +210,9 @@ where
         }
         if next != snap.subs.len() {
             return Err(corrupt("subs", "sub-contacts not covered by the contacts"));
+        }
+        if let Some(i) = snap.subs.iter().position(|s| !(s.area >= 0.0)) {
+            return Err(corrupt(&format!("subs[{i}].area"), "negative area"));
         }
         if snap.sub_records.len() != snap.subs.len() {
             return Err(corrupt("sub_records", "one record per sub-contact expected"));
@@ -254,4 +292,12 @@ where
         let text = std::fs::read_to_string(path).map_err(|e| io_error(path, &e))?;
         Self::from_checkpoint_str(&text)
     }
+}
+
+/// Whether `a` and `b` are unit vectors normal to each other, to round-off (1e-9).
+fn orthonormal(a: Vector, b: Vector) -> bool {
+    let tolerance = 1e-9;
+    (a.length_squared() - 1.0).abs() <= tolerance
+        && (b.length_squared() - 1.0).abs() <= tolerance
+        && a.dot(b).abs() <= tolerance
 }

@@ -1132,4 +1132,73 @@ mod tests {
             }
         }
     }
+
+    /// Re-detection carries each sub-contact's shear force as the same world vector, also where
+    /// the joint's tangents are not the ones a new contact with that normal would get (they have
+    /// turned with the plane): the carried components are read in the old contact's axes. A
+    /// tilted, near-vertical joint whose first tangent is turned 40° about the normal from the
+    /// fresh one; reading the components in fresh axes would turn every shear force by 40°.
+    #[test]
+    fn redetection_carries_shear_forces_in_turned_axes() {
+        use crate::constitutive::JointAxes;
+        use crate::geometry::SubKey;
+        use crate::math::Pose;
+        let mut model: Model = Model::new(ModelParameters::default()).expect("model");
+        model
+            .set_joint_law(
+                MaterialId(0),
+                MaterialId(0),
+                CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"),
+            )
+            .expect("law");
+        // Two cubes side by side (joint normal along x), the pair tilted generically.
+        let tilt = Pose {
+            translation: Vector::new(0.3, -0.2, 1.0),
+            rotation: crate::math::Rotation::from_scaled_axis(Vector::new(0.15, -0.25, 0.6)),
+        };
+        let cube = |name: &str, x: Real| {
+            RigidBlock::cuboid(name, Vector::new(x, 0.0, 0.0), Vector::new(x + 0.2, 0.2, 0.2), 2500.0)
+                .expect("cube")
+                .transformed(tilt)
+                .with_fixity(crate::block::Fixity::FIXED)
+        };
+        model.add_block(cube("a", 0.0)).expect("a");
+        // Held still too, but not `FIXED` (two fixed blocks get no contact).
+        let b = cube("b", 0.2).with_fixity(crate::block::Fixity::velocity(Vector::ZERO));
+        model.add_block(b).expect("b");
+        model.run_steps(1).expect("detection");
+        assert_eq!(model.pairs.len(), 1, "one joint");
+        let (normal, range) = (model.pairs[0].normal, model.pairs[0].range());
+        assert!(normal.z.abs() < 0.6, "a steep joint: {normal}");
+        // Turn the tangents 40° about the normal and load the springs elastically.
+        let fresh = JointAxes::from_normal(normal);
+        let turned = crate::math::Rotation::from_axis_angle(normal, 40f64.to_radians()) * fresh.tangent;
+        model.pairs[0].tangent = turned;
+        for (i, sub) in model.subs[range].iter_mut().enumerate() {
+            sub.force.normal = 100.0 + i as Real;
+            sub.force.shear = crate::math::Vector2::new(30.0 - i as Real, 5.0 + 2.0 * i as Real);
+            sub.status = JointStatus::Elastic;
+        }
+        let subs = model.subs.clone();
+        model.pairs[0].refresh_springs(&subs);
+        let world_shears = |m: &Model| -> Vec<(SubKey, Vector)> {
+            let view = m.contacts().next().expect("the joint");
+            view.iter().map(|(s, r)| (r.key(), view.shear_force(s))).collect()
+        };
+        let before = world_shears(&model);
+        model.scratch.force_full_detection = true;
+        model.detect().expect("re-detection");
+        let after = world_shears(&model);
+        assert_eq!(before.len(), after.len());
+        let mut worst: Real = 0.0;
+        for ((k0, f0), (k1, f1)) in before.iter().zip(&after) {
+            assert_eq!(k0, k1);
+            worst = worst.max((*f1 - *f0).length() / f0.length());
+        }
+        assert!(worst < 1e-14, "shear forces changed by {worst} (relative)");
+        // What fresh axes would have given: the test can tell.
+        let misread = before[0].1.length() * 2.0 * (20f64.to_radians()).sin();
+        let first = model.subs[model.pairs[0].range()][0].force.shear;
+        assert!((fresh.shear(first) - before[0].1).length() > 0.5 * misread);
+    }
 }
