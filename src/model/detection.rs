@@ -544,11 +544,21 @@ fn dropped_work<S>(
 ) -> (Real, Real) {
     let (mut work, mut dashpot) = (0.0, 0.0);
     for p in old.0 {
-        let carried = new
+        let successor = new
             .0
             .binary_search_by_key(&(p.a, p.b), |q| (q.a, q.b))
             .ok()
-            .map(|k| &new.0[k])
+            .map(|k| &new.0[k]);
+        // A face-face joint turned point contact hands its spring force on (see `detect`): the
+        // point contact's first step books the second half of that force's work (not of the
+        // dashpot forces, which are not handed on).
+        let handed_on = successor.is_some_and(|q| {
+            matches!(
+                (p.kind, q.kind),
+                (ContactKind::FaceFace { .. }, ContactKind::Point { .. })
+            ) && q.springs.force != Vector::ZERO
+        });
+        let carried = successor
             .filter(|q| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
             .map(|q| &new.1[q.range()]);
         // A contact between two blocks that did not move is kept as it was, with all its
@@ -563,7 +573,11 @@ fn dropped_work<S>(
             DisplacementMode::Small => (p.ref_a, p.ref_b),
         };
         for (s, r) in old.1[p.range()].iter().zip(&old.2[p.range()]) {
-            let spring = p.axes().force(&s.force);
+            let spring = if handed_on {
+                Vector::ZERO
+            } else {
+                p.axes().force(&s.force)
+            };
             if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
                 continue;
             }
