@@ -187,8 +187,9 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     }
     pair.dashpots = damped;
     let springs = sums.to_world(&axes);
-    // Joint work by the trapezoidal rule, Σ (F_before + F_after)·du summed through the moments.
-    let spring_sum = pair.springs.work(&increments) + springs.work(&increments);
+    // Joint work by the trapezoidal rule, Σ (F_before + F_after)·du summed through the moments
+    // (the two sets of moments added first: one set of dot products).
+    let spring_sum = pair.springs.plus(&springs).work(&increments);
     pair.springs = springs;
     let total = if dashpots {
         springs.plus(&dashpot_moments)
