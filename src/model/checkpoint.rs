@@ -211,7 +211,7 @@ where
         if next != snap.subs.len() {
             return Err(corrupt("subs", "sub-contacts not covered by the contacts"));
         }
-        if let Some(i) = snap.subs.iter().position(|s| !(s.area >= 0.0)) {
+        if let Some(i) = snap.subs.iter().position(|s| s.area < 0.0) {
             return Err(corrupt(&format!("subs[{i}].area"), "negative area"));
         }
         if snap.sub_records.len() != snap.subs.len() {
