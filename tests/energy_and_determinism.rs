@@ -198,32 +198,27 @@ fn collapse_with_rayleigh_damping_balances_energy() {
 #[test]
 fn face_face_joint_turned_point_contact_books_its_work_once() {
     let mut model = column(Damping::None, 20.0, 4);
-    let point_pairs = |m: &Model| -> Vec<(BlockId, BlockId)> {
+    // The block pairs in contact through a point contact (`point`) or a face-face joint.
+    let pairs = |m: &Model, point: bool| -> Vec<(BlockId, BlockId)> {
         m.contacts()
-            .filter(|c| matches!(c.pair.kind(), voussoir::geometry::ContactKind::Point { .. }))
+            .filter(|c| matches!(c.pair.kind(), voussoir::geometry::ContactKind::Point { .. }) == point)
             .map(|c| c.pair.blocks())
             .collect()
     };
-    let face_pairs = |m: &Model| -> Vec<(BlockId, BlockId)> {
-        m.contacts()
-            .filter(|c| matches!(c.pair.kind(), voussoir::geometry::ContactKind::FaceFace { .. }))
-            .map(|c| c.pair.blocks())
-            .collect()
-    };
-    let mut faces_before = face_pairs(&model);
+    let mut faces_before = pairs(&model, false);
     let mut balance = model.energies().balance_error();
     let (mut at_conversions, mut elsewhere) = (Vec::new(), Vec::new());
     while model.time() < 0.6 {
         model.step().unwrap();
         let change = (model.energies().balance_error() - balance).abs();
         balance = model.energies().balance_error();
-        let converted = point_pairs(&model).iter().any(|p| faces_before.contains(p));
+        let converted = pairs(&model, true).iter().any(|p| faces_before.contains(p));
         if converted {
             at_conversions.push(change);
         } else {
             elsewhere.push(change);
         }
-        faces_before = face_pairs(&model);
+        faces_before = pairs(&model, false);
     }
     let largest = elsewhere.iter().cloned().fold(0.0, f64::max);
     assert!(!at_conversions.is_empty(), "no face-face joint turned point contact");
