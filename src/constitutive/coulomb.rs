@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
+use super::{ConstitutiveLaw, ElasticRegime, JointForce, JointStatus, JointStep, JointStiffness};
 use crate::error::{in_range, non_negative, positive, Result};
 use crate::math::{Real, Vector2};
 
@@ -207,6 +207,17 @@ impl ConstitutiveLaw for CoulombSlip {
         } else {
             self.tensile_strength == 0.0 && normal < -self.tensile_strength * area
         }
+    }
+
+    /// Intact joint in compression below its strength: `c` and `tan φ` (peak values).
+    #[inline]
+    fn elastic_regime(&self) -> Option<ElasticRegime> {
+        Some(ElasticRegime {
+            normal_stiffness: self.normal_stiffness,
+            shear_stiffness: self.shear_stiffness,
+            cohesion: self.cohesion,
+            tan_friction: self.tan_friction,
+        })
     }
 
     fn is_failed(&self, state: &CoulombState) -> bool {

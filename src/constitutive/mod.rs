@@ -116,6 +116,59 @@ pub struct JointForce {
     pub shear: Vector2,
 }
 
+/// A law's linear elastic regime for sub-contacts in the virgin state (`State::default()`), which
+/// the contact kernel evaluates without calling [`ConstitutiveLaw::update`]; see
+/// [`ConstitutiveLaw::elastic_regime`].
+///
+/// The trial forces are `F_n = −k_n·u_n·A` and `F_s = F_s⁻ − Δu_s·(k_s·A)`; they stand when the
+/// joint is in compression (`F_n > 0`) and within its strength, `|F_s|² ≤ L²` with
+/// `L = c·A + F_n·tan φ ≥ 0`, computed in exactly this order ([`ElasticRegime::trial`]).
+///
+/// ```
+/// use voussoir::constitutive::{ConstitutiveLaw, CoulombSlip, ElasticRegime};
+/// use voussoir::math::Vector2;
+/// let law = CoulombSlip::dry(1e9, 4e8, 30.0)?;
+/// let regime = law.elastic_regime().expect("Coulomb slip has one");
+/// // 1 µm of overlap on 0.01 m²: 10 N of compression carries up to 5.77 N of shear.
+/// let stuck = regime.trial(0.01, -1e-6, Vector2::new(-1e-6, 0.0), Vector2::ZERO);
+/// assert!((stuck.expect("elastic").shear.x - 4.0).abs() < 1e-12);
+/// assert!(regime.trial(0.01, -1e-6, Vector2::new(-2e-6, 0.0), Vector2::ZERO).is_none());
+/// assert!(regime.trial(0.01, 1e-6, Vector2::ZERO, Vector2::ZERO).is_none());
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElasticRegime {
+    /// Normal stiffness `k_n` (Pa/m).
+    pub normal_stiffness: Real,
+    /// Shear stiffness `k_s` (Pa/m).
+    pub shear_stiffness: Real,
+    /// Cohesion `c` (Pa).
+    pub cohesion: Real,
+    /// Friction coefficient `tan φ` (may be infinite: no shear limit).
+    pub tan_friction: Real,
+}
+
+impl ElasticRegime {
+    /// The forces after a step with total normal displacement `normal_displacement` (m) and
+    /// shear increment `shear_increment` (tangent components, m) on area `area` (m²) from the
+    /// shear force `shear` (tangent components, N), if they stay in the regime: in compression
+    /// and within the strength. `None` otherwise (then the law's own update decides).
+    #[inline(always)]
+    pub fn trial(
+        &self,
+        area: Real,
+        normal_displacement: Real,
+        shear_increment: Vector2,
+        shear: Vector2,
+    ) -> Option<JointForce> {
+        let normal = -self.normal_stiffness * normal_displacement * area;
+        let shear = shear - shear_increment * (self.shear_stiffness * area);
+        let limit = self.cohesion * area + normal * self.tan_friction;
+        let stands = normal > 0.0 && !(limit < 0.0 || shear.length_squared() > limit * limit);
+        stands.then_some(JointForce { normal, shear })
+    }
+}
+
 /// State of a sub-contact after an update, for monitors and output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum JointStatus {
@@ -187,6 +240,19 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     #[inline]
     fn stays_open(&self, _area: Real, _normal_displacement: Real, _state: &Self::State) -> bool {
         false
+    }
+
+    /// The law's linear elastic regime in the virgin state, if it has one: then, for a
+    /// sub-contact whose state equals `State::default()`, whenever [`ElasticRegime::trial`]
+    /// returns forces, [`ConstitutiveLaw::update`] must set exactly those forces (bit for bit),
+    /// leave the state unchanged and return [`JointStatus::Elastic`].
+    ///
+    /// The contact kernel then updates such sub-contacts (in compression, below their strength:
+    /// most of a masonry structure at rest) in a tight loop without calling `update`, and falls
+    /// back to `update` for the others. The default, `None`, always calls `update`.
+    #[inline]
+    fn elastic_regime(&self) -> Option<ElasticRegime> {
+        None
     }
 
     /// Elastic energy stored in the joint springs (J). The default assumes linear springs with the

@@ -5,7 +5,7 @@
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
 use super::{ContactPair, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
-use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus, JointStep};
+use crate::constitutive::{ConstitutiveLaw, ElasticRegime, JointAxes, JointForce, JointStatus, JointStep};
 use crate::geometry::ContactKind;
 use crate::math::{Matrix, Real, Vector, Vector2};
 
@@ -126,7 +126,11 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // Without dashpot forces, four sub-contacts at a time; the rest (and everything when there
     // are dashpots) one at a time, continuing the sums of the groups.
     let mut done = 0;
-    if !dashpots {
+    let elastic_regime = if dashpots { None } else { law.elastic_regime() };
+    if let (Some(regime), Some(g)) = (elastic_regime, face_gap_coefficients) {
+        sums = update_elastic_first(subs, records, law, &regime, &kinematics, g, axes, dt);
+        done = subs.len();
+    } else if !dashpots {
         let frame = ContactFrame {
             axes,
             kinematics,
@@ -210,6 +214,59 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair.normal_force = sums.force.x;
     pair.work = -0.5 * spring_sum;
     pair.dashpot_work = -0.5 * dashpot_sum;
+}
+
+/// The sub-contacts of a face-face contact without dashpot forces, for a law with an
+/// [`ElasticRegime`]: a virgin sub-contact whose trial forces stand takes them directly; the
+/// others (open, sliding, failed) go through the law as in the one-at-a-time loop. Returns the
+/// spring-force sums in the joint axes, taken in sub-contact order.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn update_elastic_first<L: ConstitutiveLaw>(
+    subs: &mut [SubContact<L::State>],
+    records: &mut [SubContactRecord],
+    law: &L,
+    regime: &ElasticRegime,
+    kinematics: &Kinematics,
+    g: (Real, Real, Real),
+    axes: JointAxes,
+    dt: Real,
+) -> ForceMoments {
+    let virgin = L::State::default();
+    let mut sums = ForceMoments::default();
+    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
+        let (x, y) = (sub.plane.x, sub.plane.y);
+        let gap = face_gap(g, x, y);
+        let [du_n, du_1, du_2] = increment(kinematics, x, y);
+        let du_s = Vector2::new(du_1, du_2);
+        if sub.state == virgin {
+            if let Some(force) = regime.trial(sub.area, gap, du_s, sub.force.shear) {
+                sub.force = force;
+                sub.gap = gap;
+                sub.status = JointStatus::Elastic;
+                sums.add_joint(&force, sub.plane);
+                continue;
+            }
+        }
+        sub.gap = gap;
+        if stays_separated(law, sub, gap) {
+            continue;
+        }
+        let step = JointStep {
+            area: sub.area,
+            normal_displacement: gap,
+            normal_increment: du_n,
+            shear_increment: du_s,
+            axes,
+            dt,
+        };
+        sub.status = law.update(&step, &mut sub.force, &mut sub.state);
+        if sub.status == JointStatus::Sliding {
+            record.slip += du_s.length();
+        }
+        sums.add_joint(&sub.force, sub.plane);
+    }
+    sums
 }
 
 /// The first tangent of `previous` turned into the plane normal to `normal` by the smallest
