@@ -312,6 +312,61 @@ mod tests {
         );
     }
 
+    /// `elastic_regime` promises what `update` does for a virgin sub-contact: wherever the trial
+    /// stands, the same forces bit for bit, `Elastic`, state unchanged; and the trial stands
+    /// exactly where `update` of an intact joint ends `Elastic` in compression. Over a grid of
+    /// displacements around the open and slip limits (both signs of zero included), on dry,
+    /// cohesive and bonded joints, from shear forces at, inside and beyond the strength.
+    #[test]
+    fn elastic_regime_agrees_with_update_bit_for_bit() {
+        let laws = [
+            CoulombSlip::dry(4e9, 1.6e9, 30.0).unwrap(),
+            CoulombSlip::new(4e9, 1.6e9, 35.0, 25.0, 2e5, 0.0).unwrap(),
+            CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap(),
+        ];
+        let gaps = [-1e-3, -2.5e-5, -1e-9, -1e-300, -0.0, 0.0, 1e-12, 4e-5];
+        let increments = [0.0, 1e-9, 3e-6, -2e-5, 1e-4];
+        let (mut stood, mut declined) = (0, 0);
+        for (l, law) in laws.iter().enumerate() {
+            let regime = law.elastic_regime().expect("regime");
+            for &gap in &gaps {
+                for &du in &increments {
+                    for &carried in &[0.0, 7.5e3, -4.1e4, 1.2e5] {
+                        let area = 0.37;
+                        let (shear, increment) = (Vector2::new(carried, -0.3 * carried), Vector2::new(du, 0.6 * du));
+                        let step = JointStep {
+                            area,
+                            ..step(gap, increment)
+                        };
+                        let mut f = JointForce { normal: 1.0, shear };
+                        let mut state = CoulombState::default();
+                        let status = law.update(&step, &mut f, &mut state);
+                        match regime.trial(area, gap, increment, shear) {
+                            Some(trial) => {
+                                stood += 1;
+                                assert_eq!(status, JointStatus::Elastic, "law {l}, gap {gap}, du {du}");
+                                assert_eq!(trial.normal.to_bits(), f.normal.to_bits());
+                                assert_eq!(trial.shear.x.to_bits(), f.shear.x.to_bits());
+                                assert_eq!(trial.shear.y.to_bits(), f.shear.y.to_bits());
+                                assert_eq!(state, CoulombState::default());
+                            }
+                            None => {
+                                declined += 1;
+                                // Only open, sliding, or elastic without compression (a bonded
+                                // joint in tension) is left to `update`.
+                                assert!(
+                                    status != JointStatus::Elastic || f.normal <= 0.0,
+                                    "law {l}, gap {gap}, du {du}: {status:?} {f:?}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(stood > 100 && declined > 100, "{stood} {declined}");
+    }
+
     /// `stays_open` promises what `update` does: open, zero forces, state unchanged; and it does
     /// promise it for separated dry and failed joints, not for intact bonded ones.
     #[test]

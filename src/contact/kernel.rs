@@ -127,8 +127,12 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // are dashpots) one at a time, continuing the sums of the groups.
     let mut done = 0;
     let elastic_regime = if dashpots { None } else { law.elastic_regime() };
-    if let (Some(regime), Some(g)) = (elastic_regime, face_gap_coefficients) {
-        sums = update_elastic_first(subs, records, law, &regime, &kinematics, g, axes, dt);
+    if let Some(regime) = elastic_regime {
+        // Two call sites, so that each is compiled for its kind of gap.
+        sums = match face_gap_coefficients {
+            Some(g) => update_elastic_first(subs, records, law, &regime, &kinematics, Some(g), axes, dt),
+            None => update_elastic_first(subs, records, law, &regime, &kinematics, None, axes, dt),
+        };
         done = subs.len();
     } else if !dashpots {
         let frame = ContactFrame {
@@ -216,9 +220,10 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair.dashpot_work = -0.5 * dashpot_sum;
 }
 
-/// The sub-contacts of a face-face contact without dashpot forces, for a law with an
-/// [`ElasticRegime`]: a virgin sub-contact whose trial forces stand takes them directly; the
-/// others (open, sliding, failed) go through the law as in the one-at-a-time loop. Returns the
+/// The sub-contacts of a contact without dashpot forces, for a law with an [`ElasticRegime`]:
+/// a virgin sub-contact whose trial forces stand takes them directly; the others (open, sliding,
+/// failed) go through the law exactly as in the one-at-a-time loop. `face` holds the face-face
+/// gap coefficients (large displacements), `None` for gaps carried incrementally. Returns the
 /// spring-force sums in the joint axes, taken in sub-contact order.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
@@ -228,7 +233,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     law: &L,
     regime: &ElasticRegime,
     kinematics: &Kinematics,
-    g: (Real, Real, Real),
+    face: Option<(Real, Real, Real)>,
     axes: JointAxes,
     dt: Real,
 ) -> ForceMoments {
@@ -236,8 +241,11 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     let mut sums = ForceMoments::default();
     for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
         let (x, y) = (sub.plane.x, sub.plane.y);
-        let gap = face_gap(g, x, y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
+        let gap = match face {
+            Some(g) => face_gap(g, x, y),
+            None => sub.gap + du_n,
+        };
         let du_s = Vector2::new(du_1, du_2);
         if sub.state == virgin {
             if let Some(force) = regime.trial(sub.area, gap, du_s, sub.force.shear) {
@@ -248,10 +256,11 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                 continue;
             }
         }
-        sub.gap = gap;
-        if stays_separated(law, sub, gap) {
+        if face.is_some() && stays_separated(law, sub, gap) {
+            sub.gap = gap;
             continue;
         }
+        sub.gap = gap;
         let step = JointStep {
             area: sub.area,
             normal_displacement: gap,
