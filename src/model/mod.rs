@@ -1107,10 +1107,10 @@ mod tests {
     fn grouped_and_single_sub_contact_loops_agree() {
         let mut wall = crate::build::benchmark_wall(300).expect("wall");
         wall.run_steps(40).expect("run");
-        let coulomb = wall.joints.laws()[0].clone();
+        let coulomb = wall.joints.laws()[0];
         for counts in [
             compare_loops(&wall, &coulomb),
-            compare_loops(&wall, &WithoutRegime(coulomb.clone())),
+            compare_loops(&wall, &WithoutRegime(coulomb)),
         ] {
             let [compared, sliding, open, _] = counts;
             assert!(
@@ -1154,12 +1154,12 @@ mod tests {
                 column.add_block(cube).expect("cube");
             }
             let mut totals = [0; 4];
-            let coulomb = column.joints.laws()[0].clone();
+            let coulomb = column.joints.laws()[0];
             for _ in 0..8 {
                 column.run_steps(150).expect("run");
                 for counts in [
                     compare_loops(&column, &coulomb),
-                    compare_loops(&column, &WithoutRegime(coulomb.clone())),
+                    compare_loops(&column, &WithoutRegime(coulomb)),
                 ] {
                     totals.iter_mut().zip(counts).for_each(|(t, c)| *t += c);
                 }
