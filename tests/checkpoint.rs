@@ -77,7 +77,7 @@ fn restarted_run_is_bit_identical() -> Result<()> {
         "the test must cross re-detections"
     );
     assert!(
-        model.contacts().flat_map(|c| c.records).any(|r| r.slip() > 0.0),
+        model.contacts().flat_map(|c| c.subs).any(|s| s.slip() > 0.0),
         "the test must include slip"
     );
     assert_eq!(state_bits(&model), state_bits(&restarted));
@@ -137,11 +137,11 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     }
     // Another version is named as such, whatever else changed between the versions.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
-    json["version"] = serde_json::json!(3);
+    json["version"] = serde_json::json!(4);
     json.as_object_mut().expect("an object").remove("sub_records");
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 3");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 4");
     assert!(
-        err.to_string().contains("version 3") && err.to_string().contains("reads version 4"),
+        err.to_string().contains("version 4") && err.to_string().contains("reads version 5"),
         "{err}"
     );
     json["format"] = serde_json::json!("something-else");

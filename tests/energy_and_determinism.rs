@@ -346,9 +346,9 @@ fn fingerprint(model: &Model) -> Vec<u64> {
     }
     for c in model.contacts() {
         push(c.pair.resultant());
-        for (s, r) in c.iter() {
+        for s in c.subs {
             push(c.shear_force(s));
-            push(Vector::new(s.normal_force(), r.slip(), s.normal_displacement()));
+            push(Vector::new(s.normal_force(), s.slip(), s.normal_displacement()));
         }
     }
     let e = model.energies();

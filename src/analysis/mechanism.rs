@@ -163,9 +163,9 @@ fn joint_state<L: ConstitutiveLaw>(model: &Model<L>, j: &JointRef, c: &Mechanism
     let (i, e) = (current(j.intrados), current(j.extrados));
     let depth = e - i;
     let (mut area, mut open, mut force, mut moment, mut slip) = (0.0, 0.0, 0.0, Vector::ZERO, 0.0);
-    for (s, r) in contact.iter() {
+    for s in contact.subs {
         area += s.area();
-        slip += r.slip() * s.area();
+        slip += s.slip() * s.area();
         if s.normal_force() > 0.0 {
             force += s.normal_force();
             moment += contact.point(s) * s.normal_force();

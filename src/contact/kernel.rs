@@ -130,8 +130,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
         sums = match face_gap_coefficients {
-            Some(g) => update_elastic_first(subs, records, law, &regime, &kinematics, Some(g), axes, dt),
-            None => update_elastic_first(subs, records, law, &regime, &kinematics, None, axes, dt),
+            Some(g) => update_elastic_first(subs, law, &regime, &kinematics, Some(g), axes, dt),
+            None => update_elastic_first(subs, law, &regime, &kinematics, None, axes, dt),
         };
         done = subs.len();
     } else if !dashpots {
@@ -143,9 +143,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         };
         let mut lanes = LaneSums::default();
         let (groups, _) = subs.as_chunks_mut::<LANES>();
-        let (group_records, _) = records.as_chunks_mut::<LANES>();
-        for (group, group_records) in groups.iter_mut().zip(group_records.iter_mut()) {
-            update_group(group, group_records, law, &frame, &mut lanes);
+        for group in groups.iter_mut() {
+            update_group(group, law, &frame, &mut lanes);
         }
         done = groups.len() * LANES;
         sums = lanes.total();
@@ -174,7 +173,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         };
         let status = law.update(&step, &mut sub.force, &mut sub.state);
         if status == JointStatus::Sliding {
-            record.slip += du_s.length();
+            sub.slip += du_s.length();
         }
         sums.add_joint(&sub.force, sub.plane);
         if dashpots {
@@ -229,7 +228,6 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
 #[allow(clippy::too_many_arguments)]
 fn update_elastic_first<L: ConstitutiveLaw>(
     subs: &mut [SubContact<L::State>],
-    records: &mut [SubContactRecord],
     law: &L,
     regime: &ElasticRegime,
     kinematics: &Kinematics,
@@ -239,7 +237,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
 ) -> ForceMoments {
     let virgin = L::State::default();
     let mut sums = ForceMoments::default();
-    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
+    for sub in subs.iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
         let gap = match face {
@@ -271,7 +269,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
         };
         sub.status = law.update(&step, &mut sub.force, &mut sub.state);
         if sub.status == JointStatus::Sliding {
-            record.slip += du_s.length();
+            sub.slip += du_s.length();
         }
         sums.add_joint(&sub.force, sub.plane);
     }

@@ -12,7 +12,7 @@ use std::ops::{Add, Mul, Sub};
 
 use super::kernel::stays_separated;
 use super::kernel::ForceMoments;
-use super::{SubContact, SubContactRecord};
+use super::SubContact;
 use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
 use crate::math::{Real, Vector, Vector2};
 
@@ -145,12 +145,11 @@ impl LaneSums {
     }
 }
 
-/// Updates four sub-contacts (and their records) of a contact without dashpot forces, adding
+/// Updates four sub-contacts of a contact without dashpot forces, adding
 /// their spring forces to `sums`. The same operations as the one-at-a-time loop, lane-wise.
 #[inline(always)]
 pub(crate) fn update_group<L: ConstitutiveLaw>(
     group: &mut [SubContact<L::State>; LANES],
-    records: &mut [SubContactRecord; LANES],
     law: &L,
     frame: &ContactFrame,
     sums: &mut LaneSums,
@@ -162,8 +161,7 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
         Some(g) => face_gap(g, x, y),
         None => F4::from_fn(|l| group[l].gap) + du_n,
     };
-    for l in 0..LANES {
-        let sub = &mut group[l];
+    for (l, sub) in group.iter_mut().enumerate() {
         let gap = gap.0[l];
         // A separated sub-contact that stays open: no force, no update (as the scalar loop).
         if frame.face_gap.is_some() && stays_separated(law, sub, gap) {
@@ -181,7 +179,7 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
         };
         let status = law.update(&step, &mut sub.force, &mut sub.state);
         if status == JointStatus::Sliding {
-            records[l].slip += du_s.length();
+            sub.slip += du_s.length();
         }
         sub.gap = gap;
         sub.status = status;

@@ -144,9 +144,9 @@ mod tests {
 
     /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
     #[test]
-    fn subcontact_is_64_bytes_with_coulomb_state() {
+    fn subcontact_is_72_bytes_with_coulomb_state() {
         use crate::constitutive::CoulombState;
-        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 64);
+        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 72);
     }
 }
 
@@ -329,11 +329,11 @@ impl AnchorPlane {
     }
 }
 
-/// A sub-contact: a point of a joint with a tributary area, its spring forces and the law's
-/// state — what the step reads and writes for every sub-contact, and nothing else (64 bytes with
-/// [`crate::constitutive::CoulombSlip`]'s state). Its position is given by two coordinates on the
-/// contact's [`AnchorPlane`], its shear force by two components along the joint's tangents
-/// ([`JointAxes`]). Its identity, accumulated slip and dashpot force sit in a parallel
+/// A sub-contact: a point of a joint with a tributary area, its spring forces, its accumulated
+/// slip and the law's state — what the step reads and writes for every sub-contact, and nothing
+/// else (72 bytes with [`crate::constitutive::CoulombSlip`]'s state). Its position is given by
+/// two coordinates on the contact's [`AnchorPlane`], its shear force by two components along the
+/// joint's tangents ([`JointAxes`]). Its identity, dashpot force and gap offset sit in a parallel
 /// [`SubContactRecord`]; its world position and forces follow from the contact, see
 /// [`ContactView::point`], [`ContactView::shear_force`] and [`ContactView::total_force`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -344,6 +344,8 @@ pub struct SubContact<S> {
     /// Normal displacement `u_n` (m, positive = open).
     pub(crate) gap: Real,
     pub(crate) force: JointForce,
+    /// Accumulated slip while sliding (m).
+    pub(crate) slip: Real,
     pub(crate) status: JointStatus,
     pub(crate) state: S,
 }
@@ -375,6 +377,11 @@ impl<S> SubContact<S> {
     pub fn shear_components(&self) -> Vector2 {
         self.force.shear
     }
+    /// Slip accumulated while sliding (m): the sum of the shear displacement increments of the
+    /// steps that ended sliding.
+    pub fn slip(&self) -> Real {
+        self.slip
+    }
     /// Status after the last update.
     pub fn status(&self) -> JointStatus {
         self.status
@@ -385,15 +392,13 @@ impl<S> SubContact<S> {
     }
 }
 
-/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity, accumulated
-/// slip, dashpot force and gap offset. Stored in a parallel array (same index as the
-/// sub-contact), so that the step streams only the [`SubContact`]s and touches a record only
-/// while the sub-contact slides or carries a dashpot force.
+/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity, dashpot force
+/// and gap offset. Stored in a parallel array (same index as the sub-contact), so that the step
+/// streams only the [`SubContact`]s and touches a record only while the sub-contact carries a
+/// dashpot force.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SubContactRecord {
     pub(crate) key: SubKey,
-    /// Accumulated slip while sliding (m).
-    pub(crate) slip: Real,
     /// Stiffness-proportional (Rayleigh) dashpot force on `b` (world) of the last step; zero
     /// without Rayleigh damping.
     #[serde(default)]
@@ -409,7 +414,6 @@ impl SubContactRecord {
     pub(crate) fn new(key: SubKey) -> Self {
         Self {
             key,
-            slip: 0.0,
             dashpot: Vector::ZERO,
             gap_offset: 0.0,
         }
@@ -417,10 +421,6 @@ impl SubContactRecord {
     /// Stable identity within the pair.
     pub fn key(&self) -> SubKey {
         self.key
-    }
-    /// Accumulated slip (m).
-    pub fn slip(&self) -> Real {
-        self.slip
     }
     /// Stiffness-proportional dashpot force on block `b` (N, world); zero without Rayleigh
     /// damping.

@@ -120,14 +120,14 @@ pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> R
     let (mut state, mut contact) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for (ci, c) in model.contacts().enumerate() {
         let l = &law[c.pair.law_index()];
-        for (s, r) in c.iter() {
+        for s in c.subs {
             points.extend(c.point(s).to_array());
             shear.extend(c.shear_force(s).to_array());
             normal_force.push(s.normal_force());
             normal_stress.push(s.normal_stress());
             area.push(s.area());
             gap.push(s.normal_displacement());
-            slip.push(r.slip());
+            slip.push(s.slip());
             state.push(if l.is_failed(s.law_state()) && s.status() != JointStatus::Sliding {
                 3u8
             } else {

@@ -18,7 +18,7 @@ use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 4;
+const VERSION: u32 = 5;
 
 /// The fields every version has, read before the rest (other fields are skipped).
 #[derive(Deserialize)]

@@ -146,6 +146,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     area: seed.area,
                     gap: seed.gap,
                     force: JointForce::default(),
+                    slip: 0.0,
                     status: JointStatus::Open,
                     state: L::State::default(),
                 };
@@ -153,6 +154,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
                     let o = &old_subs[k];
                     sub.force = o.force;
+                    sub.slip = o.slip;
                     sub.gap = seed.gap + old_records[k].gap_offset;
                     sub.status = o.status;
                     sub.state = o.state.clone();
