@@ -225,7 +225,6 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
 /// gap coefficients (large displacements), `None` for gaps carried incrementally. Returns the
 /// spring-force sums in the joint axes, taken in sub-contact order.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn update_elastic_first<L: ConstitutiveLaw>(
     subs: &mut [SubContact<L::State>],
     law: &L,
