@@ -163,18 +163,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let [du_n, du_1, du_2] = increment(&kinematics, x, y);
         let du_s = Vector2::new(du_1, du_2);
         let gap = face.unwrap_or(sub.gap + du_n);
-        let step = JointStep {
-            area: sub.area,
-            normal_displacement: gap,
-            normal_increment: du_n,
-            shear_increment: du_s,
-            axes,
-            dt,
-        };
-        let status = law.update(&step, &mut sub.force, &mut sub.state);
-        if status == JointStatus::Sliding {
-            sub.slip += du_s.length();
-        }
+        let status = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
         sums.add_joint(&sub.force, sub.plane);
         if dashpots {
             let mut dashpot = Vector::ZERO;
@@ -189,8 +178,6 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             dashpot_moments.add(dashpot, sub.plane);
             record.dashpot = dashpot;
         }
-        sub.gap = gap;
-        sub.status = status;
     }
     pair.dashpots = damped;
     let springs = sums.to_world(&axes);
@@ -257,19 +244,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             sub.gap = gap;
             continue;
         }
-        sub.gap = gap;
-        let step = JointStep {
-            area: sub.area,
-            normal_displacement: gap,
-            normal_increment: du_n,
-            shear_increment: du_s,
-            axes,
-            dt,
-        };
-        sub.status = law.update(&step, &mut sub.force, &mut sub.state);
-        if sub.status == JointStatus::Sliding {
-            sub.slip += du_s.length();
-        }
+        update_with_law(law, sub, gap, du_n, du_s, axes, dt);
         sums.add_joint(&sub.force, sub.plane);
     }
     sums
@@ -285,6 +260,36 @@ fn turned_tangent(previous: JointAxes, normal: Vector) -> Vector {
     };
     let t = previous.tangent - m * normal.dot(previous.tangent);
     (t - normal * normal.dot(t)).normalize()
+}
+
+/// Calls the law on one sub-contact with this step's gap and increments, and stores what it
+/// returns: forces and state (by the law), gap, status, and the slip while sliding. Every
+/// sub-contact loop goes through here, so a sub-contact's update does not depend on the loop.
+#[inline(always)]
+pub(crate) fn update_with_law<L: ConstitutiveLaw>(
+    law: &L,
+    sub: &mut SubContact<L::State>,
+    gap: Real,
+    du_n: Real,
+    du_s: Vector2,
+    axes: JointAxes,
+    dt: Real,
+) -> JointStatus {
+    let step = JointStep {
+        area: sub.area,
+        normal_displacement: gap,
+        normal_increment: du_n,
+        shear_increment: du_s,
+        axes,
+        dt,
+    };
+    let status = law.update(&step, &mut sub.force, &mut sub.state);
+    if status == JointStatus::Sliding {
+        sub.slip += du_s.length();
+    }
+    sub.gap = gap;
+    sub.status = status;
+    status
 }
 
 /// Whether a face-face sub-contact at geometric gap `gap` may skip its kinematics and update:

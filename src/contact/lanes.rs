@@ -10,10 +10,10 @@
 
 use std::ops::{Add, Mul, Sub};
 
-use super::kernel::stays_separated;
 use super::kernel::ForceMoments;
+use super::kernel::{stays_separated, update_with_law};
 use super::SubContact;
-use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
+use crate::constitutive::{ConstitutiveLaw, JointAxes};
 use crate::math::{Real, Vector, Vector2};
 
 /// Sub-contacts per group.
@@ -169,20 +169,7 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
             continue;
         }
         let du_s = Vector2::new(du_1.0[l], du_2.0[l]);
-        let step = JointStep {
-            area: sub.area,
-            normal_displacement: gap,
-            normal_increment: du_n.0[l],
-            shear_increment: du_s,
-            axes: frame.axes,
-            dt: frame.dt,
-        };
-        let status = law.update(&step, &mut sub.force, &mut sub.state);
-        if status == JointStatus::Sliding {
-            sub.slip += du_s.length();
-        }
-        sub.gap = gap;
-        sub.status = status;
+        update_with_law(law, sub, gap, du_n.0[l], du_s, frame.axes, frame.dt);
     }
     // The forces as the law left them (zero where skipped), read back lane by lane.
     let f = [
