@@ -32,9 +32,15 @@ pub fn rotation_from_vector(v: Vector) -> Rotation {
     if theta2 >= 1e-6 {
         return Rotation::from_scaled_axis(v);
     }
+    // Reciprocals of the series' denominators: multiplications rather than divisions.
+    const SIXTH: Real = 1.0 / 6.0;
+    const TWENTIETH: Real = 1.0 / 20.0;
+    const FORTY_SECOND: Real = 1.0 / 42.0;
+    const TWELFTH: Real = 1.0 / 12.0;
+    const THIRTIETH: Real = 1.0 / 30.0;
     let x2 = 0.25 * theta2; // (θ/2)²
-    let half_sinc = 0.5 * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0)));
-    let cos = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0));
+    let half_sinc = 0.5 * (1.0 - x2 * SIXTH * (1.0 - x2 * TWENTIETH * (1.0 - x2 * FORTY_SECOND)));
+    let cos = 1.0 - x2 * 0.5 * (1.0 - x2 * TWELFTH * (1.0 - x2 * THIRTIETH));
     let xyz = v * half_sinc;
     Rotation::from_xyzw(xyz.x, xyz.y, xyz.z, cos)
 }

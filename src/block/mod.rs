@@ -89,8 +89,12 @@ impl Fixity {
     }
 
     /// `true` when no degree of freedom is constrained.
+    #[inline]
     pub fn is_free(&self) -> bool {
-        self.translation.iter().chain(&self.rotation).all(|d| *d == Dof::Free)
+        self.translation
+            .iter()
+            .chain(&self.rotation)
+            .all(|d| matches!(d, Dof::Free))
     }
 
     /// `true` when every degree of freedom is held at zero velocity.

@@ -37,8 +37,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
     subs: &mut [SubContact<L::State>],
     records: &mut [SubContactRecord],
-    sa: &BlockState,
-    sb: &BlockState,
+    (sa, rotation_a): (&BlockState, &Matrix),
+    (sb, rotation_b): (&BlockState, &Matrix),
     law: &L,
     ctx: KernelContext,
 ) {
@@ -56,8 +56,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     if ctx.mode == DisplacementMode::Large {
         match pair.kind {
             ContactKind::FaceFace { .. } => {
-                let na = sa.pose.rotation * pair.local_normal_a;
-                let nb = sb.pose.rotation * pair.local_normal_b;
+                let na = *rotation_a * pair.local_normal_a;
+                let nb = *rotation_b * pair.local_normal_b;
                 pair.normal = (na - nb).normalize();
                 let (host_n, other_n, other_x) = if pair.host_is_a {
                     (na, nb, sb.pose.translation)
@@ -69,14 +69,18 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 face_plane = Some(((other_offset - other_n.dot(xh)) * inv_cos, other_n * inv_cos));
             }
             ContactKind::Point { normal_local } => {
-                pair.normal = sa.pose.rotation * normal_local;
+                pair.normal = *rotation_a * normal_local;
             }
         }
         pair.tangent = turned_tangent(previous_axes, pair.normal);
     }
     let axes = pair.axes();
     let (n, t1, t2) = (axes.normal, axes.tangent, axes.tangent_2());
-    let rotation = Matrix::from_quat(host.rotation);
+    let rotation = match ctx.mode {
+        DisplacementMode::Large if pair.host_is_a => *rotation_a,
+        DisplacementMode::Large => *rotation_b,
+        DisplacementMode::Small => Matrix::from_quat(host.rotation),
+    };
     // v_rel(p) = v_b + ω_b × (p − x_b) − v_a − ω_a × (p − x_a) = v₀ + (ω_b − ω_a) × r.
     let dw = sb.angular_velocity - sa.angular_velocity;
     let v0 = sb.velocity - sa.velocity + sb.angular_velocity.cross(xh - xb) - sa.angular_velocity.cross(xh - xa);

@@ -2,14 +2,14 @@
 
 use rayon::prelude::*;
 
-use super::Model;
+use super::{Model, BLOCK_CHUNK};
 use crate::block::{Block, BlockId};
 use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::contact::{AnchorPlane, ContactPair, DisplacementMode, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, ContactKind, NarrowPhaseScratch, SubcontactSeed};
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
-use crate::math::{Real, Rotation, Vector};
+use crate::math::{Matrix, Real, Rotation, Vector};
 
 /// Buffers reused from one detection to the next.
 #[derive(Debug, Clone)]
@@ -42,18 +42,26 @@ impl<S> Default for DetectionScratch<S> {
 }
 
 impl<L: ConstitutiveLaw> Model<L> {
-    /// Largest motion of a material point of any block since its last detection, compared
-    /// with the trigger distance.
-    pub(super) fn needs_detection(&self) -> bool {
-        if self.scratch.force_full_detection {
-            return true;
-        }
+    /// The step's first pass over the blocks: their rotation matrices, which the contact pass
+    /// reads instead of turning every contact's normals by quaternions, and (`check`) whether
+    /// any material point of a block moved more than the re-detection trigger since the block's
+    /// last detection.
+    pub(super) fn prepare_blocks(&mut self, check: bool) -> bool {
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
-        self.blocks
-            .par_iter()
-            .with_min_len(1024)
-            .zip(self.ref_poses.par_iter())
-            .any(|(b, r)| moved_beyond(b, r, trigger))
+        self.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        self.rotations
+            .par_chunks_mut(BLOCK_CHUNK)
+            .zip(self.blocks.par_chunks(BLOCK_CHUNK))
+            .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
+            .map(|((rotations, blocks), refs)| {
+                let mut moved = false;
+                for ((rotation, b), r) in rotations.iter_mut().zip(blocks).zip(refs) {
+                    *rotation = Matrix::from_quat(b.state.pose.rotation);
+                    moved |= check && moved_beyond(b, r, trigger);
+                }
+                moved
+            })
+            .reduce(|| false, |a, b| a || b)
     }
 
     /// Re-detects contacts: pairs where a block moved beyond the trigger get a fresh narrow phase

@@ -17,7 +17,7 @@ use crate::contact::{
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
-use crate::math::{is_finite_vector, Pose, Real, Vector};
+use crate::math::{is_finite_vector, Matrix, Pose, Real, Vector};
 use crate::monitor::{History, Monitor, MonitorId};
 
 use detection::DetectionScratch;
@@ -113,6 +113,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     pair_sums: Vec<PairSums>,
     block_sums: Vec<BlockSums>,
     ref_poses: Vec<Pose>,
+    /// Rotation matrices of the blocks at the start of the step (see `prepare_blocks`).
+    rotations: Vec<Matrix>,
     bounds: Vec<StiffnessBound>,
     dt: Real,
     critical: Option<CriticalStep>,
@@ -179,6 +181,8 @@ struct PairWrench {
 /// What the contact pass shares between its tasks.
 struct ContactPass<'a, L: ConstitutiveLaw> {
     blocks: &'a [RigidBlock],
+    /// The blocks' rotation matrices, index for index.
+    rotations: &'a [Matrix],
     laws: &'a [L],
     subs: SubsPtr<SubContact<L::State>>,
     sub_records: SubsPtr<SubContactRecord>,
@@ -193,6 +197,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     fn run(&self, chunk: &mut [ContactPair], wrenches: &mut [PairWrench], sums: &mut PairSums) {
         for (p, w) in chunk.iter_mut().zip(wrenches) {
             let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
+            let (ra, rb) = (&self.rotations[p.a as usize], &self.rotations[p.b as usize]);
             let range = p.range();
             assert!(
                 range.start <= range.end && range.end <= self.total_subs,
@@ -210,8 +215,8 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 p,
                 own,
                 own_records,
-                &a.state,
-                &b.state,
+                (&a.state, ra),
+                (&b.state, rb),
                 &self.laws[p.law as usize],
                 self.ctx,
             );
@@ -262,7 +267,10 @@ struct BlockSums {
     diverged: Option<usize>,
 }
 
-/// Whether a block's state is non-finite or faster than `√max_speed2`.
+/// Whether a block's state is non-finite or faster than `√max_speed2`. A non-finite velocity
+/// fails the speed test (NaN or infinite); a non-finite position or rotation makes the sum of
+/// their components non-finite (as would components beyond 10³⁰⁷, a run away all the same).
+#[inline]
 fn diverged(b: &RigidBlock, max_speed2: Real) -> bool {
     let s = &b.state;
     let r = b.radius;
@@ -270,7 +278,9 @@ fn diverged(b: &RigidBlock, max_speed2: Real) -> bool {
         .velocity
         .length_squared()
         .max(s.angular_velocity.length_squared() * r * r);
-    speed2.is_nan() || speed2 > max_speed2 || !is_finite_state(s)
+    let (t, q) = (s.pose.translation, s.pose.rotation);
+    let pose_sum = ((t.x + t.y) + t.z) + ((q.x + q.y) + (q.z + q.w));
+    !(speed2 <= max_speed2) || !pose_sum.is_finite()
 }
 
 fn is_finite_state(s: &crate::block::BlockState) -> bool {
@@ -325,6 +335,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             pair_sums: Vec::new(),
             block_sums: Vec::new(),
             ref_poses: Vec::new(),
+            rotations: Vec::new(),
             bounds: Vec::new(),
             dt: 0.0,
             critical: None,
@@ -688,10 +699,12 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway.
     pub fn step(&mut self) -> Result<()> {
         let started = std::time::Instant::now();
+        let large = self.params.mode == DisplacementMode::Large;
+        let moved = self.prepare_blocks(large && self.started && !self.scratch.force_full_detection);
         if !self.started {
             self.start()?;
-        } else if self.params.mode == DisplacementMode::Large {
-            if self.scratch.force_full_detection || self.needs_detection() {
+        } else if large {
+            if self.scratch.force_full_detection || moved {
                 self.detect()?;
             }
         } else if self.scratch.force_full_detection {
@@ -747,6 +760,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         );
         let pass = ContactPass {
             blocks: &self.blocks,
+            rotations: &self.rotations,
             laws: self.joints.laws(),
             subs: SubsPtr(self.subs.as_mut_ptr()),
             sub_records: SubsPtr(self.sub_records.as_mut_ptr()),
@@ -1033,10 +1047,12 @@ mod tests {
         let mut counts = [0; 4];
         for k in 0..model.pairs.len() {
             let r = model.pairs[k].range();
-            let (sa, sb) = (
-                &model.blocks[model.pairs[k].a as usize].state,
-                &model.blocks[model.pairs[k].b as usize].state,
+            let (a, b) = (model.pairs[k].a as usize, model.pairs[k].b as usize);
+            let (ra, rb) = (
+                Matrix::from_quat(model.blocks[a].state.pose.rotation),
+                Matrix::from_quat(model.blocks[b].state.pose.rotation),
             );
+            let (sa, sb) = ((&model.blocks[a].state, &ra), (&model.blocks[b].state, &rb));
             let point = matches!(model.pairs[k].kind, crate::geometry::ContactKind::Point { .. });
             // The grouped loop runs without dashpot forces; the single loop when the contact may
             // hold some (none are held here, so it books zero dashpot forces).
