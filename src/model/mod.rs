@@ -280,7 +280,7 @@ fn diverged(b: &RigidBlock, max_speed2: Real) -> bool {
         .max(s.angular_velocity.length_squared() * r * r);
     let (t, q) = (s.pose.translation, s.pose.rotation);
     let pose_sum = ((t.x + t.y) + t.z) + ((q.x + q.y) + (q.z + q.w));
-    !(speed2 <= max_speed2) || !pose_sum.is_finite()
+    speed2.is_nan() || speed2 > max_speed2 || !pose_sum.is_finite()
 }
 
 fn is_finite_state(s: &crate::block::BlockState) -> bool {
