@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::{Damping, Integrator, StepRecord};
-use crate::block::{Block, Dof, RigidBlock, Wrench};
+use crate::block::{Block, Dof, Fixity, RigidBlock, Wrench};
 use crate::math::{rotation_from_vector, Matrix, Real, Vector};
 
 /// Explicit central difference: velocities at half steps, positions at full steps.
@@ -106,7 +106,8 @@ fn sign(x: Real) -> Real {
 #[inline(always)]
 fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Damping) -> StepRecord {
     let mass = block.mass_properties().mass;
-    let fixity = *block.fixity();
+    // A free block's fixity is the constant (its own sits on a cache line the step need not read).
+    let fixity = if block.is_free() { Fixity::FREE } else { *block.fixity() };
     let (alpha, a) = match damping {
         Damping::Local { alpha } => (alpha, 0.0),
         Damping::Rayleigh { mass, .. } => (0.0, mass),

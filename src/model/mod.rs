@@ -821,7 +821,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                         }
                     }
                     *w = total;
-                    if b.fixity().is_free() {
+                    if b.is_free() {
                         sums.max_unbalanced = sums.max_unbalanced.max(total.force.length());
                     }
                     // Energy, first half (see `account_energy`): gravity and loads, and the
