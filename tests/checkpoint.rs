@@ -137,11 +137,11 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     }
     // Another version is named as such, whatever else changed between the versions.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
-    json["version"] = serde_json::json!(4);
+    json["version"] = serde_json::json!(5);
     json.as_object_mut().expect("an object").remove("sub_records");
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 4");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 5");
     assert!(
-        err.to_string().contains("version 4") && err.to_string().contains("reads version 5"),
+        err.to_string().contains("version 5") && err.to_string().contains("reads version 6"),
         "{err}"
     );
     json["format"] = serde_json::json!("something-else");

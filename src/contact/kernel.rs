@@ -3,7 +3,7 @@
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
-use super::{ContactPair, DisplacementMode, SubContact, SubContactRecord};
+use super::{ContactPair, ContactReference, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::constitutive::{ConstitutiveLaw, ElasticRegime, JointAxes, JointForce, JointStatus, JointStep};
 use crate::geometry::ContactKind;
@@ -32,9 +32,11 @@ pub(crate) struct KernelContext {
 /// resultant, moment and work through the sums `Σ f`, `Σ f x`, `Σ f y` (see [`ForceMoments`]).
 /// Without dashpot forces the sub-contacts go four at a time (`lanes.rs`), with the same
 /// operations per sub-contact.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
+    reference: &ContactReference,
     subs: &mut [SubContact<L::State>],
     records: &mut [SubContactRecord],
     (sa, rotation_a): (&BlockState, &Matrix),
@@ -44,11 +46,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
 ) {
     // The axes of the previous step, in which the stored spring forces were composed.
     let previous_axes = pair.axes();
-    let host = pair.frame(&sa.pose, &sb.pose, ctx.mode);
-    let (xa, xb) = match ctx.mode {
-        DisplacementMode::Large => (sa.pose.translation, sb.pose.translation),
-        DisplacementMode::Small => (pair.ref_a, pair.ref_b),
-    };
+    let host = pair.frame(reference, &sa.pose, &sb.pose, ctx.mode);
+    let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, ctx.mode);
     let xh = host.translation;
     // Face-face, large displacements: gap(p) = (d − m·p)/(m·h) for the other face's plane
     // m·x = d and the host face's normal h; with p = x_h + r, gap = g₀ − q·r.

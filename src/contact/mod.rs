@@ -47,8 +47,9 @@ pub trait Contact {
 
 /// One contact between blocks `a < b`, with a contiguous range of sub-contacts.
 ///
-/// Layout: the fields a large-displacement step reads and writes come first and together; the
-/// reference geometry of small-displacement mode and the detection bookkeeping come last.
+/// Layout: what a step reads and writes; the reference geometry of small-displacement mode and
+/// the detection bookkeeping sit in a parallel internal list, which a large-displacement
+/// step does not read.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[repr(C)]
 pub struct ContactPair {
@@ -97,6 +98,17 @@ pub struct ContactPair {
     /// recomputed from the sub-contacts at detection, checkpointed (a recomputation could sum
     /// in another order than the step did).
     pub(crate) springs: ForceMoments,
+}
+
+fn always() -> bool {
+    true
+}
+
+/// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
+/// its geometry at detection, which small-displacement mode steps with, and the areas the
+/// critical-step bookkeeping compares.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct ContactReference {
     /// Centroids at detection (lever arms in small-displacement mode).
     pub(crate) ref_a: Vector,
     pub(crate) ref_b: Vector,
@@ -108,8 +120,16 @@ pub struct ContactPair {
     pub(crate) bound_area: Real,
 }
 
-fn always() -> bool {
-    true
+impl ContactReference {
+    /// The centroids of `a` and `b` the step's lever arms start from: their current positions,
+    /// or those at detection in small-displacement mode.
+    #[inline]
+    pub(crate) fn centroids(&self, pose_a: &Pose, pose_b: &Pose, mode: DisplacementMode) -> (Vector, Vector) {
+        match mode {
+            DisplacementMode::Large => (pose_a.translation, pose_b.translation),
+            DisplacementMode::Small => (self.ref_a, self.ref_b),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -207,8 +227,16 @@ impl ContactPair {
     }
 
     /// The pose mapping sub-contact anchors to world points, given the current poses of `a`
-    /// and `b`: the host's pose, or its pose at detection in small-displacement mode.
-    pub(crate) fn frame(&self, pose_a: &Pose, pose_b: &Pose, mode: DisplacementMode) -> Pose {
+    /// and `b`: the host's pose, or its pose at detection (`reference`) in small-displacement
+    /// mode.
+    #[inline]
+    pub(crate) fn frame(
+        &self,
+        reference: &ContactReference,
+        pose_a: &Pose,
+        pose_b: &Pose,
+        mode: DisplacementMode,
+    ) -> Pose {
         match mode {
             DisplacementMode::Large => {
                 if self.host_is_a {
@@ -218,8 +246,12 @@ impl ContactPair {
                 }
             }
             DisplacementMode::Small => Pose::from_parts(
-                if self.host_is_a { self.ref_a } else { self.ref_b },
-                self.ref_host_rotation,
+                if self.host_is_a {
+                    reference.ref_a
+                } else {
+                    reference.ref_b
+                },
+                reference.ref_host_rotation,
             ),
         }
     }

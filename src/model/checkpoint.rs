@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
-use crate::contact::{ContactPair, ForceMoments, SubContact, SubContactRecord};
+use crate::contact::{ContactPair, ContactReference, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
 use crate::io::io_error;
@@ -18,7 +18,7 @@ use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 5;
+const VERSION: u32 = 6;
 
 /// The fields every version has, read before the rest (other fields are skipped).
 #[derive(Deserialize)]
@@ -40,6 +40,8 @@ struct Snapshot<L: ConstitutiveLaw> {
     blocks: Vec<RigidBlock>,
     joints: JointTable<L>,
     pairs: Vec<ContactPair>,
+    /// The contacts' reference geometry and areas, index for index.
+    references: Vec<ContactReference>,
     subs: Vec<SubContact<L::State>>,
     /// The sub-contacts' records, index for index.
     sub_records: Vec<SubContactRecord>,
@@ -86,6 +88,7 @@ where
             blocks: self.blocks.clone(),
             joints: self.joints.clone(),
             pairs: self.pairs.clone(),
+            references: self.references.clone(),
             subs: self.subs.clone(),
             sub_records: self.sub_records.clone(),
             ref_poses: self.ref_poses.clone(),
@@ -170,6 +173,9 @@ where
         if snap.ref_poses.len() != n {
             return Err(corrupt("ref_poses", "one pose per block expected"));
         }
+        if snap.references.len() != snap.pairs.len() {
+            return Err(corrupt("references", "one reference per contact expected"));
+        }
         let mut next = 0usize;
         for (k, p) in snap.pairs.iter().enumerate() {
             let faces_ok = match p.kind {
@@ -231,6 +237,7 @@ where
         model.joints = snap.joints;
         model.integrator = Box::new(CentralDifference::new(snap.damping));
         model.pairs = snap.pairs;
+        model.references = snap.references;
         model.subs = snap.subs;
         model.sub_records = snap.sub_records;
         for (k, p) in model.pairs.iter_mut().enumerate() {

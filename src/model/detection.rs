@@ -5,7 +5,9 @@ use rayon::prelude::*;
 use super::{Model, BLOCK_CHUNK};
 use crate::block::{Block, BlockId};
 use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
-use crate::contact::{AnchorPlane, ContactPair, DisplacementMode, ForceMoments, SubContact, SubContactRecord};
+use crate::contact::{
+    AnchorPlane, ContactPair, ContactReference, DisplacementMode, ForceMoments, SubContact, SubContactRecord,
+};
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, ContactKind, NarrowPhaseScratch, SubcontactSeed};
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
@@ -15,12 +17,17 @@ use crate::math::{Matrix, Real, Rotation, Vector};
 #[derive(Debug, Clone)]
 pub(crate) struct DetectionScratch<S> {
     pub force_full_detection: bool,
+    /// Set by the fused block pass ([`Model::advance_blocks`]) after it moved the blocks and
+    /// took their rotation matrices and movement check for the next step: whether any block
+    /// moved beyond the re-detection trigger. Taken (reset) by the next step.
+    pub prepared: Option<bool>,
     broad: BroadPhase,
     narrow: NarrowPhaseScratch,
     candidates: Vec<(u32, u32)>,
     seeds: Vec<SubcontactSeed>,
     moved: Vec<bool>,
     pairs: Vec<ContactPair>,
+    references: Vec<ContactReference>,
     subs: Vec<SubContact<S>>,
     records: Vec<SubContactRecord>,
 }
@@ -29,12 +36,14 @@ impl<S> Default for DetectionScratch<S> {
     fn default() -> Self {
         Self {
             force_full_detection: true,
+            prepared: None,
             broad: BroadPhase::default(),
             narrow: NarrowPhaseScratch::default(),
             candidates: Vec::new(),
             seeds: Vec::new(),
             moved: Vec::new(),
             pairs: Vec::new(),
+            references: Vec::new(),
             subs: Vec::new(),
             records: Vec::new(),
         }
@@ -45,7 +54,8 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The step's first pass over the blocks: their rotation matrices, which the contact pass
     /// reads instead of turning every contact's normals by quaternions, and (`check`) whether
     /// any material point of a block moved more than the re-detection trigger since the block's
-    /// last detection.
+    /// last detection. (After a step of a blockwise integrator the block pass has done this
+    /// already, see [`DetectionScratch::prepared`].)
     pub(super) fn prepare_blocks(&mut self, check: bool) -> bool {
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
         self.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
@@ -53,14 +63,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(self.blocks.par_chunks(BLOCK_CHUNK))
             .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
-            .map(|((rotations, blocks), refs)| {
-                let mut moved = false;
-                for ((rotation, b), r) in rotations.iter_mut().zip(blocks).zip(refs) {
-                    *rotation = Matrix::from_quat(b.state.pose.rotation);
-                    moved |= check && moved_beyond(b, r, trigger);
-                }
-                moved
-            })
+            .map(|((rotations, blocks), refs)| prepare_chunk(rotations, blocks, refs, check.then_some(trigger)))
             .reduce(|| false, |a, b| a || b)
     }
 
@@ -84,6 +87,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             &mut sc.candidates,
         );
         sc.pairs.clear();
+        sc.references.clear();
         sc.subs.clear();
         sc.records.clear();
         for &(i, j) in &sc.candidates {
@@ -100,6 +104,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     sc.subs.extend_from_slice(&self.subs[p.range()]);
                     sc.records.extend_from_slice(&self.sub_records[p.range()]);
                     sc.pairs.push(kept);
+                    sc.references.push(self.references[k].clone());
                 }
                 continue;
             }
@@ -131,7 +136,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     block_b: BlockId(j),
                 })?;
             let host = if dc.host_is_a { bi } else { bj };
-            let bound_area = old.map_or(0.0, |k| self.pairs[k].bound_area);
+            let bound_area = old.map_or(0.0, |k| self.references[k].bound_area);
             let old_subs = old.map(|k| {
                 let p = &self.pairs[k];
                 (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
@@ -223,9 +228,6 @@ impl<L: ConstitutiveLaw> Model<L> {
                 local_normal_b: Vector::ZERO,
                 local_other_offset: 0.0,
                 dashpots: true,
-                ref_a: bi.state.pose.translation,
-                ref_b: bj.state.pose.translation,
-                ref_host_rotation: host.state.pose.rotation,
                 force: Vector::ZERO,
                 moment_a: Vector::ZERO,
                 moment_b: Vector::ZERO,
@@ -233,18 +235,28 @@ impl<L: ConstitutiveLaw> Model<L> {
                 work: 0.0,
                 dashpot_work: 0.0,
                 springs: ForceMoments::default(),
-                area: sc.seeds.iter().map(|s| s.area).sum(),
-                bound_area,
             };
             pair.cache_local_faces(bi.shape(), bj.shape());
             pair.refresh_springs(&sc.subs);
             sc.pairs.push(pair);
+            sc.references.push(ContactReference {
+                ref_a: bi.state.pose.translation,
+                ref_b: bj.state.pose.translation,
+                ref_host_rotation: host.state.pose.rotation,
+                area: sc.seeds.iter().map(|s| s.area).sum(),
+                bound_area,
+            });
         }
         // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
         // since the last evaluation (lost contacts only make the step safer).
-        let stiffer = sc.pairs.iter().any(|p| p.area > 1.05 * p.bound_area);
+        let stiffer = sc.references.iter().any(|r| r.area > 1.05 * r.bound_area);
         let (work, dashpot) = dropped_work(
-            (&self.pairs, &self.subs, &self.sub_records),
+            OldContacts {
+                pairs: &self.pairs,
+                references: &self.references,
+                subs: &self.subs,
+                records: &self.sub_records,
+            },
             (&sc.pairs, &sc.records),
             &sc.moved,
             &self.blocks,
@@ -254,6 +266,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.energy.joint_work += work;
         self.energy.damping += dashpot;
         std::mem::swap(&mut self.pairs, &mut sc.pairs);
+        std::mem::swap(&mut self.references, &mut sc.references);
         std::mem::swap(&mut self.subs, &mut sc.subs);
         std::mem::swap(&mut self.sub_records, &mut sc.records);
         for (i, moved) in sc.moved.iter().enumerate() {
@@ -321,13 +334,13 @@ impl<L: ConstitutiveLaw> Model<L> {
         let mut own = vec![Stiffness6::default(); n];
         let mut coupling = vec![0.0; n];
         let mut in_contact = vec![false; n];
-        for p in self.pairs.iter_mut() {
+        for (p, reference) in self.pairs.iter().zip(self.references.iter_mut()) {
             let subs = &self.subs[p.range()];
-            p.bound_area = p.area;
+            reference.bound_area = reference.area;
             let k = self.joints.laws()[p.law as usize].stiffness();
             // Area moments of the sub-contact points about the first one (for digits).
             let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
-            let frame = p.frame(&sa.pose, &sb.pose, self.params.mode);
+            let frame = p.frame(reference, &sa.pose, &sb.pose, self.params.mode);
             let origin = subs
                 .first()
                 .map_or(Vector::ZERO, |s| frame.transform_point(p.anchor(s)));
@@ -423,6 +436,25 @@ fn all_constrained(b: &crate::block::RigidBlock) -> bool {
         .iter()
         .chain(&f.rotation)
         .all(|d| d.prescribed().is_some())
+}
+
+/// The rotation matrices of a chunk of blocks and, given the re-detection `trigger`, whether
+/// any of them moved beyond it since its reference pose in `refs`.
+#[inline]
+pub(super) fn prepare_chunk(
+    rotations: &mut [Matrix],
+    blocks: &[crate::block::RigidBlock],
+    refs: &[crate::math::Pose],
+    trigger: Option<Real>,
+) -> bool {
+    let mut moved = false;
+    for ((rotation, b), r) in rotations.iter_mut().zip(blocks).zip(refs) {
+        *rotation = Matrix::from_quat(b.state.pose.rotation);
+        if let Some(trigger) = trigger {
+            moved |= moved_beyond(b, r, trigger);
+        }
+    }
+    moved
 }
 
 /// Whether the largest displacement of a point of the block since pose `r`, bounded by the
@@ -535,6 +567,14 @@ fn outer(a: Vector, b: Vector) -> crate::math::Matrix {
     crate::math::Matrix::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
+/// The contact lists before a re-detection, for [`dropped_work`].
+struct OldContacts<'a, S> {
+    pairs: &'a [ContactPair],
+    references: &'a [ContactReference],
+    subs: &'a [SubContact<S>],
+    records: &'a [SubContactRecord],
+}
+
 /// The work still owed by sub-contacts that re-detection drops while they carry a force:
 /// `(joint work, dashpot dissipation)` (J).
 ///
@@ -545,7 +585,7 @@ fn outer(a: Vector, b: Vector) -> crate::math::Matrix {
 /// that produced the current poses); the stored energy that vanishes with the sub-contact ends
 /// up in `friction` (dissipated by the loss of contact).
 fn dropped_work<S>(
-    old: (&[ContactPair], &[SubContact<S>], &[SubContactRecord]),
+    old: OldContacts<'_, S>,
     new: (&[ContactPair], &[SubContactRecord]),
     moved: &[bool],
     blocks: &[crate::block::RigidBlock],
@@ -553,7 +593,7 @@ fn dropped_work<S>(
     dt: Real,
 ) -> (Real, Real) {
     let (mut work, mut dashpot) = (0.0, 0.0);
-    for p in old.0 {
+    for (p, reference) in old.pairs.iter().zip(old.references) {
         let successor = new
             .0
             .binary_search_by_key(&(p.a, p.b), |q| (q.a, q.b))
@@ -577,12 +617,9 @@ fn dropped_work<S>(
             continue;
         }
         let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
-        let frame = p.frame(&sa.pose, &sb.pose, mode);
-        let (xa, xb) = match mode {
-            DisplacementMode::Large => (sa.pose.translation, sb.pose.translation),
-            DisplacementMode::Small => (p.ref_a, p.ref_b),
-        };
-        for (s, r) in old.1[p.range()].iter().zip(&old.2[p.range()]) {
+        let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
+        let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
+        for (s, r) in old.subs[p.range()].iter().zip(&old.records[p.range()]) {
             let spring = if handed_on {
                 Vector::ZERO
             } else {

@@ -3,6 +3,7 @@
 mod checkpoint;
 mod detection;
 mod energy;
+mod motion;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -12,7 +13,8 @@ pub use energy::Energies;
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
 use crate::contact::{
-    update_contact, ContactPair, ContactView, DisplacementMode, KernelContext, SubContact, SubContactRecord,
+    update_contact, ContactPair, ContactReference, ContactView, DisplacementMode, KernelContext, SubContact,
+    SubContactRecord,
 };
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
@@ -98,6 +100,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     joints: JointTable<L>,
     integrator: Box<dyn Integrator>,
     pairs: Vec<ContactPair>,
+    /// The contacts' reference geometry and areas, index for index with `pairs`.
+    references: Vec<ContactReference>,
     subs: Vec<SubContact<L::State>>,
     /// The sub-contacts' records (key, slip, dashpot force), index for index with `subs`.
     sub_records: Vec<SubContactRecord>,
@@ -134,11 +138,14 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
 /// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Timings {
-    /// Broad and narrow phase, sub-contact history transfer and the critical step.
+    /// Broad and narrow phase, sub-contact history transfer and the critical step (and the
+    /// blocks' rotation matrices and movement check, when the last step's block pass did not
+    /// take them).
     pub detection: Real,
-    /// Joint kinematics, laws and force assembly.
+    /// Joint kinematics, laws and contact resultants.
     pub contacts: Real,
-    /// Central difference, energies and checks.
+    /// The block pass: gathering each block's forces, the integrator, energies and checks (with
+    /// a blockwise integrator also the next step's rotation matrices and movement check).
     pub integration: Real,
     /// Steps timed.
     pub steps: u64,
@@ -183,6 +190,8 @@ struct ContactPass<'a, L: ConstitutiveLaw> {
     blocks: &'a [RigidBlock],
     /// The blocks' rotation matrices, index for index.
     rotations: &'a [Matrix],
+    /// The contacts' references, index for index with the contacts.
+    references: &'a [ContactReference],
     laws: &'a [L],
     subs: SubsPtr<SubContact<L::State>>,
     sub_records: SubsPtr<SubContactRecord>,
@@ -194,8 +203,9 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     /// Updates one chunk of contacts and their sub-contacts, copies their resultants to
     /// `wrenches` and adds their totals to `sums`.
     #[inline(always)]
-    fn run(&self, chunk: &mut [ContactPair], wrenches: &mut [PairWrench], sums: &mut PairSums) {
-        for (p, w) in chunk.iter_mut().zip(wrenches) {
+    fn run(&self, first: usize, chunk: &mut [ContactPair], wrenches: &mut [PairWrench], sums: &mut PairSums) {
+        let references = &self.references[first..first + chunk.len()];
+        for ((p, reference), w) in chunk.iter_mut().zip(references).zip(wrenches) {
             let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let (ra, rb) = (&self.rotations[p.a as usize], &self.rotations[p.b as usize]);
             let range = p.range();
@@ -213,6 +223,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 unsafe { std::slice::from_raw_parts_mut(self.sub_records.get().add(range.start), range.len()) };
             update_contact(
                 p,
+                reference,
                 own,
                 own_records,
                 (&a.state, ra),
@@ -240,8 +251,14 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     /// The processor must support AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&self, chunk: &mut [ContactPair], wrenches: &mut [PairWrench], sums: &mut PairSums) {
-        self.run(chunk, wrenches, sums);
+    unsafe fn run_avx2(
+        &self,
+        first: usize,
+        chunk: &mut [ContactPair],
+        wrenches: &mut [PairWrench],
+        sums: &mut PairSums,
+    ) {
+        self.run(first, chunk, wrenches, sums);
     }
 }
 
@@ -265,6 +282,8 @@ struct BlockSums {
     kinetic: Real,
     /// First block of the chunk that diverged.
     diverged: Option<usize>,
+    /// Whether a block of the chunk moved beyond the re-detection trigger (fused pass only).
+    moved: bool,
 }
 
 /// Whether a block's state is non-finite or faster than `√max_speed2`. A non-finite velocity
@@ -325,6 +344,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             joints: JointTable::new(),
             integrator: Box::new(CentralDifference::default()),
             pairs: Vec::new(),
+            references: Vec::new(),
             subs: Vec::new(),
             sub_records: Vec::new(),
             block_contacts: Vec::new(),
@@ -505,7 +525,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// The current contacts, each with its sub-contacts.
     pub fn contacts(&self) -> impl ExactSizeIterator<Item = ContactView<'_, L::State>> + '_ {
-        self.pairs.iter().map(move |p| self.view(p))
+        (0..self.pairs.len()).map(move |k| self.view(k))
     }
 
     /// The contact between two blocks, if any.
@@ -514,16 +534,17 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.pairs
             .binary_search_by_key(&key, |p| (p.a, p.b))
             .ok()
-            .map(|i| self.view(&self.pairs[i]))
+            .map(|k| self.view(k))
     }
 
-    fn view<'a>(&'a self, p: &'a ContactPair) -> ContactView<'a, L::State> {
+    fn view(&self, k: usize) -> ContactView<'_, L::State> {
+        let p = &self.pairs[k];
         let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
         ContactView {
             pair: p,
             subs: &self.subs[p.range()],
             records: &self.sub_records[p.range()],
-            frame: p.frame(&sa.pose, &sb.pose, self.params.mode),
+            frame: p.frame(&self.references[k], &sa.pose, &sb.pose, self.params.mode),
         }
     }
 
@@ -700,7 +721,10 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn step(&mut self) -> Result<()> {
         let started = std::time::Instant::now();
         let large = self.params.mode == DisplacementMode::Large;
-        let moved = self.prepare_blocks(large && self.started && !self.scratch.force_full_detection);
+        let moved = match self.scratch.prepared.take() {
+            Some(moved) if self.started && !self.scratch.force_full_detection => moved,
+            _ => self.prepare_blocks(large && self.started && !self.scratch.force_full_detection),
+        };
         if !self.started {
             self.start()?;
         } else if large {
@@ -715,9 +739,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let detected = std::time::Instant::now();
         self.compute_forces();
         let forces = std::time::Instant::now();
-        self.integrator
-            .advance(&mut self.blocks, &self.forces, self.dt, &mut self.records);
-        let diverged = self.account_energy();
+        let diverged = self.advance_blocks();
         let t = &mut self.timings;
         t.detection += (detected - started).as_secs_f64();
         t.contacts += (forces - detected).as_secs_f64();
@@ -761,6 +783,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let pass = ContactPass {
             blocks: &self.blocks,
             rotations: &self.rotations,
+            references: &self.references,
             laws: self.joints.laws(),
             subs: SubsPtr(self.subs.as_mut_ptr()),
             sub_records: SubsPtr(self.sub_records.as_mut_ptr()),
@@ -778,138 +801,17 @@ impl<L: ConstitutiveLaw> Model<L> {
             .par_chunks_mut(CONTACT_CHUNK)
             .zip(self.wrenches.par_chunks_mut(CONTACT_CHUNK))
             .zip(self.pair_sums.par_iter_mut())
-            .for_each(|((chunk, wrenches), sums)| {
+            .enumerate()
+            .for_each(|(k, ((chunk, wrenches), sums))| {
+                let first = k * CONTACT_CHUNK;
                 #[cfg(target_arch = "x86_64")]
                 if avx2 {
                     // SAFETY: the processor has AVX2 (checked by `dispatch::has_avx2`).
-                    unsafe { pass.run_avx2(chunk, wrenches, sums) };
+                    unsafe { pass.run_avx2(first, chunk, wrenches, sums) };
                     return;
                 }
-                pass.run(chunk, wrenches, sums);
+                pass.run(first, chunk, wrenches, sums);
             });
-        let blocks = &self.blocks;
-        // One pass per block: gather its contacts (block → contact index), add gravity and
-        // loads; and the energy terms booked before the integrator moves the blocks.
-        let gravity = self.params.gravity;
-        let dt = self.dt;
-        let first = if self.step == 0 { 0.5 } else { 1.0 };
-        let wrenches = &self.wrenches;
-        let (contacts, offsets) = (&self.block_contacts, &self.block_offsets);
-        let records = &self.records;
-        self.block_sums.clear();
-        self.block_sums
-            .resize(self.blocks.len().div_ceil(BLOCK_CHUNK), BlockSums::default());
-        self.forces
-            .par_chunks_mut(BLOCK_CHUNK)
-            .zip(self.block_sums.par_iter_mut())
-            .enumerate()
-            .for_each(|(k, (chunk, sums))| {
-                for (j, w) in chunk.iter_mut().enumerate() {
-                    let i = k * BLOCK_CHUNK + j;
-                    let b = &blocks[i];
-                    let m = b.mass_properties().mass;
-                    let mut total = b.load;
-                    total.force += gravity * m;
-                    for &e in &contacts[offsets[i] as usize..offsets[i + 1] as usize] {
-                        let w = &wrenches[(e >> 1) as usize];
-                        if e & 1 == 1 {
-                            total.force += w.force;
-                            total.moment += w.moment_b;
-                        } else {
-                            total.force -= w.force;
-                            total.moment += w.moment_a;
-                        }
-                    }
-                    *w = total;
-                    if b.is_free() {
-                        sums.max_unbalanced = sums.max_unbalanced.max(total.force.length());
-                    }
-                    // Energy, first half (see `account_energy`): gravity and loads, and the
-                    // `F_{n−1}` halves of the reactions and damping forces, while the velocities
-                    // are still `v_{n−½}` and the step records still hold step `n − 1`.
-                    let r = &records[i];
-                    let (v, om) = (b.state.velocity, b.state.angular_velocity);
-                    sums.gravity_work += first * m * gravity.dot(v) * dt;
-                    sums.load_work += first * (b.load.force.dot(v) + b.load.moment.dot(om)) * dt;
-                    sums.boundary_work += 0.5 * (r.reaction.force.dot(v) + r.reaction.moment.dot(om)) * dt;
-                    sums.damping -= 0.5 * (r.damping.force.dot(v) + r.damping.moment.dot(om)) * dt;
-                }
-            });
-        let mut max_unbalanced: Real = 0.0;
-        let e = &mut self.energy;
-        for s in &self.block_sums {
-            max_unbalanced = max_unbalanced.max(s.max_unbalanced);
-            e.gravity_work += s.gravity_work;
-            e.load_work += s.load_work;
-            e.boundary_work += s.boundary_work;
-            e.damping += s.damping;
-        }
-        let force_magnitudes: Real = self.pair_sums.iter().map(|s| s.force_magnitude).sum();
-        let mean_contact = if self.pairs.is_empty() {
-            0.0
-        } else {
-            force_magnitudes / self.pairs.len() as Real
-        };
-        self.unbalanced_ratio = if mean_contact > 0.0 {
-            max_unbalanced / mean_contact
-        } else {
-            Real::INFINITY
-        };
-    }
-
-    /// Energy bookkeeping, second half, after the integrator; returns the first block whose
-    /// state is no longer finite or faster than `max_speed`.
-    ///
-    /// Every force `F` is booked with the trapezoidal rule over the displacement of the step that
-    /// just ended, `½(F_{n−1} + F_n)·v_{n−½}·Δt` (a force that did not exist before the first
-    /// step counts as zero), which together with the kinetic energy `½·m·v_{n−½}·v_{n+½}` makes
-    /// the balance an exact identity of central difference for translation. The first half was
-    /// booked in [`Model::compute_forces`]; here: the `F_n` halves of the reactions and damping
-    /// forces, the kinetic energy `½·m·v_{n−½}·v_{n+½} + ½·ω_{n−½}·L_{n+½}`, and the joint terms.
-    fn account_energy(&mut self) -> Option<usize> {
-        let dt = self.dt;
-        let max2 = self.params.max_speed * self.params.max_speed;
-        let records = &self.records;
-        self.block_sums
-            .par_iter_mut()
-            .zip(self.blocks.par_chunks(BLOCK_CHUNK))
-            .enumerate()
-            .for_each(|(k, (sums, chunk))| {
-                sums.kinetic = 0.0;
-                sums.boundary_work = 0.0;
-                sums.damping = 0.0;
-                sums.diverged = None;
-                for (j, b) in chunk.iter().enumerate() {
-                    let i = k * BLOCK_CHUNK + j;
-                    let r = &records[i];
-                    let m = b.mass_properties().mass;
-                    let (v1, w1) = (b.state.velocity, b.state.angular_velocity);
-                    // The velocities before the step, from the mean the integrator reports.
-                    let v0 = 2.0 * r.mean_velocity - v1;
-                    let w0 = 2.0 * r.mean_angular_velocity - w1;
-                    sums.kinetic += 0.5 * m * v0.dot(v1) + 0.5 * w0.dot(b.state.angular_momentum);
-                    sums.boundary_work += 0.5 * (r.reaction.force.dot(v0) + r.reaction.moment.dot(w0)) * dt;
-                    sums.damping -= 0.5 * (r.damping.force.dot(v0) + r.damping.moment.dot(w0)) * dt;
-                    if sums.diverged.is_none() && diverged(b, max2) {
-                        sums.diverged = Some(i);
-                    }
-                }
-            });
-        let e = &mut self.energy;
-        let mut kinetic = 0.0;
-        let mut first_diverged = None;
-        for s in &self.block_sums {
-            kinetic += s.kinetic;
-            e.boundary_work += s.boundary_work;
-            e.damping += s.damping;
-            first_diverged = first_diverged.or(s.diverged);
-        }
-        e.kinetic = kinetic;
-        for s in &self.pair_sums {
-            e.joint_work += s.work;
-            e.damping += s.dashpot_work;
-        }
-        first_diverged
     }
 
     fn divergence_error(&self, i: usize) -> Error {
@@ -1063,6 +965,7 @@ mod tests {
                 pairs[k].dashpots = dashpots;
                 update_contact(
                     &mut pairs[k],
+                    &model.references[k],
                     &mut subs[r.clone()],
                     &mut records[r.clone()],
                     sa,
