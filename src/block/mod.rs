@@ -328,8 +328,15 @@ impl RigidBlock {
             + 0.5 * self.state.angular_velocity.dot(self.state.angular_momentum)
     }
 
-    /// `I_world · w` with the current rotation.
-    pub(crate) fn world_inertia_times(&self, w: Vector) -> Vector {
+    /// The kinematic state, for an [`Integrator`](crate::Integrator) of one's own to advance
+    /// (a model hands its blocks out mutably only to its integrator). Keep
+    /// `angular_momentum = I_world·angular_velocity` ([`RigidBlock::world_inertia_times`]).
+    pub fn state_mut(&mut self) -> &mut BlockState {
+        &mut self.state
+    }
+
+    /// `I_world · w` with the current rotation (kg·m²/s for `w` in rad/s).
+    pub fn world_inertia_times(&self, w: Vector) -> Vector {
         let r = self.state.pose.rotation;
         r * (self.mass.principal_inertia * (r.inverse() * w))
     }

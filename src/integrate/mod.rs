@@ -31,6 +31,49 @@ pub struct StepRecord {
 /// `forces[i]` is the total force and moment on block `i` (gravity, applied loads and contacts;
 /// damping is the integrator's business). Implementations must give the same result whatever the
 /// number of threads.
+///
+/// # Example
+///
+/// An explicit integrator of one's own, here a wrapper that caps the translational speed after
+/// central difference; it advances each block on its own, so it says so and the model calls it
+/// chunk by chunk from its block pass.
+///
+/// ```
+/// use voussoir::integrate::StepRecord;
+/// use voussoir::prelude::*;
+///
+/// #[derive(Debug, Clone, Copy)]
+/// struct Capped(CentralDifference, Real);
+///
+/// impl Integrator for Capped {
+///     fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]) {
+///         self.0.advance(blocks, forces, dt, records);
+///         for b in blocks.iter_mut() {
+///             let v = b.state().velocity;
+///             if v.length() > self.1 {
+///                 b.state_mut().velocity = v * (self.1 / v.length());
+///             }
+///         }
+///     }
+///     fn is_blockwise(&self) -> bool {
+///         true
+///     }
+///     fn damping(&self) -> Damping {
+///         self.0.damping()
+///     }
+///     fn boxed_clone(&self) -> Box<dyn Integrator> {
+///         Box::new(*self)
+///     }
+/// }
+///
+/// let mut model: Model = Model::new(ModelParameters::default())?;
+/// let brick = RigidBlock::cuboid("brick", Vector::ZERO, Vector::new(0.2, 0.1, 0.05), 2000.0)?;
+/// model.add_block(brick)?;
+/// model.set_integrator(Capped(CentralDifference::new(Damping::None), 0.01))?;
+/// model.run_steps(100)?;
+/// assert!((model.blocks()[0].state().velocity.length() - 0.01).abs() < 1e-12);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
 pub trait Integrator: Send + Sync + std::fmt::Debug {
     /// Advances velocities to `t + dt/2` and poses to `t + dt`, filling `records`.
     fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]);
