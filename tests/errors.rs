@@ -733,3 +733,77 @@ fn io_and_checkpoint_errors() {
     };
     assert!(path.contains("step"), "{path}");
 }
+
+/// A fixed step just below the stable limit while a cube slides onto another: as the joint
+/// grows, a re-detection finds it stiffer and fails with `TimeStepTooLarge`, and so does every
+/// later step (the run does not go on with the unstable step) until the step is changed.
+#[test]
+fn fixed_time_step_too_large_once_a_joint_grows_stays_an_error() {
+    let stack = |time_step| {
+        let mut model = slab_and_cube(ModelParameters {
+            time_step,
+            ..ModelParameters::default()
+        });
+        // Overlapping the lower cube by 120 mm and sliding back over it at 0.8 m/s.
+        let sliding = RigidBlock::cuboid(
+            "sliding",
+            Vector::new(0.08, 0.0, 0.2),
+            Vector::new(0.28, 0.2, 0.4),
+            2500.0,
+        )
+        .unwrap()
+        .with_velocity(Vector::new(-0.8, 0.0, 0.0), Vector::ZERO);
+        model.add_block(sliding).unwrap();
+        model
+    };
+    // The limit at the start, from a step far too large.
+    let Err(Error::TimeStepTooLarge { limit, .. }) = stack(TimeStep::Fixed(1.0)).step() else {
+        panic!("a 1 s step must be refused")
+    };
+    let dt = 0.995 * limit;
+    let mut model = stack(TimeStep::Fixed(dt));
+    let mut steps = 0;
+    let e = loop {
+        match model.step() {
+            Ok(()) => steps += 1,
+            Err(e) => break e,
+        }
+        assert!(steps < 2000, "no error within {steps} steps");
+    };
+    assert!(steps > 1, "failed at step {steps}: {e:?}");
+    let Error::TimeStepTooLarge { limit: grown, .. } = e else {
+        panic!("expected TimeStepTooLarge, got {e:?}")
+    };
+    assert!(grown < dt, "{grown} {limit}");
+    for _ in 0..3 {
+        assert!(matches!(model.step(), Err(Error::TimeStepTooLarge { .. })));
+    }
+    let mut params = *model.parameters();
+    params.time_step = TimeStep::Fixed(0.5 * grown);
+    model.set_parameters(params).unwrap();
+    model.run_steps(10).unwrap();
+}
+
+/// A block's state edited through `RigidBlock::state_mut` is checked when it is added: a
+/// rotation that is not a unit quaternion or a non-finite angular momentum is refused naming
+/// the block.
+#[test]
+fn edited_block_states_are_checked_on_add() {
+    let cube = || RigidBlock::cuboid("edited", Vector::ZERO, Vector::splat(0.2), 2500.0).unwrap();
+    let mut model: Model = Model::new(ModelParameters::default()).unwrap();
+
+    let mut stretched = cube();
+    stretched.state_mut().pose.rotation = Rotation::from_xyzw(0.0, 0.0, 0.0, 1.01);
+    let e = model.add_block(stretched).unwrap_err();
+    assert!(
+        matches!(&e, Error::InvalidParameter { value, .. } if (*value - 1.01).abs() < 1e-12),
+        "{e:?}"
+    );
+    assert_names(&e.to_string(), &["edited", "rotation", "unit quaternion"]);
+
+    let mut spinning = cube();
+    spinning.state_mut().angular_momentum = Vector::new(Real::NAN, 0.0, 0.0);
+    let e = model.add_block(spinning).unwrap_err();
+    assert!(matches!(&e, Error::NonFinite { .. }), "{e:?}");
+    assert_names(&e.to_string(), &["angular momentum", "edited"]);
+}

@@ -348,6 +348,7 @@ impl RigidBlock {
             ("velocity", s.velocity),
             ("angular velocity", s.angular_velocity),
             ("position", s.pose.translation),
+            ("angular momentum", s.angular_momentum),
             ("load force", self.load.force),
             ("load moment", self.load.moment),
         ] {
@@ -356,6 +357,19 @@ impl RigidBlock {
                     what: format!("{what} of block {:?}", self.name),
                 });
             }
+        }
+        if !s.pose.rotation.is_finite() {
+            return Err(Error::NonFinite {
+                what: format!("rotation of block {:?}", self.name),
+            });
+        }
+        let norm = s.pose.rotation.length();
+        if (norm - 1.0).abs() > 1e-9 {
+            return Err(Error::InvalidParameter {
+                name: format!("rotation quaternion norm of block {:?}", self.name),
+                value: norm,
+                expected: "must be a unit quaternion (norm 1 within 1e-9)",
+            });
         }
         Ok(())
     }

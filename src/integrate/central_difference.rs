@@ -27,27 +27,34 @@ impl CentralDifference {
     }
 }
 
-/// Blocks per rayon task: a chunk of the model's fused block pass (512 blocks) is one task, run
-/// on the calling thread.
-const BLOCKS_PER_TASK: usize = 1024;
+/// Blocks per rayon task.
+const BLOCKS_PER_TASK: usize = 256;
+/// Up to this many blocks are advanced on the calling thread: a chunk of the model's block pass
+/// (512 blocks), which runs on a thread of its own already.
+const SERIAL_BLOCKS: usize = 512;
 
 impl Integrator for CentralDifference {
     fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]) {
         let damping = self.damping;
         let avx2 = crate::dispatch::has_avx2();
-        blocks
-            .par_chunks_mut(BLOCKS_PER_TASK)
-            .zip(forces.par_chunks(BLOCKS_PER_TASK))
-            .zip(records.par_chunks_mut(BLOCKS_PER_TASK))
-            .for_each(|((blocks, loads), records)| {
-                #[cfg(target_arch = "x86_64")]
-                if avx2 {
-                    // SAFETY: the processor has AVX2 (checked by `dispatch::has_avx2`).
-                    unsafe { advance_chunk_avx2(blocks, loads, records, dt, damping) };
-                    return;
-                }
-                advance_chunk(blocks, loads, records, dt, damping);
-            });
+        let run = |blocks: &mut [RigidBlock], loads: &[Wrench], records: &mut [StepRecord]| {
+            #[cfg(target_arch = "x86_64")]
+            if avx2 {
+                // SAFETY: the processor has AVX2 (checked by `dispatch::has_avx2`).
+                unsafe { advance_chunk_avx2(blocks, loads, records, dt, damping) };
+                return;
+            }
+            advance_chunk(blocks, loads, records, dt, damping);
+        };
+        if blocks.len() <= SERIAL_BLOCKS {
+            run(blocks, forces, records);
+        } else {
+            blocks
+                .par_chunks_mut(BLOCKS_PER_TASK)
+                .zip(forces.par_chunks(BLOCKS_PER_TASK))
+                .zip(records.par_chunks_mut(BLOCKS_PER_TASK))
+                .for_each(|((blocks, loads), records)| run(blocks, loads, records));
+        }
     }
 
     /// Each block is advanced on its own.

@@ -26,17 +26,20 @@ pub struct StepRecord {
     pub mean_angular_velocity: Vector,
 }
 
-/// One step of the equations of motion for all blocks.
+/// One step of the equations of motion for all blocks (or, for a
+/// [blockwise](Integrator::is_blockwise) integrator, for a chunk of them).
 ///
-/// `forces[i]` is the total force and moment on block `i` (gravity, applied loads and contacts;
-/// damping is the integrator's business). Implementations must give the same result whatever the
+/// `forces[i]` is the total force and moment on `blocks[i]` (gravity, applied loads and contacts;
+/// damping is the integrator's business); `records[i]` receives what happened to it, which the
+/// model's energy balance reads. Implementations must give the same result whatever the
 /// number of threads.
 ///
 /// # Example
 ///
 /// An explicit integrator of one's own, here a wrapper that caps the translational speed after
 /// central difference; it advances each block on its own, so it says so and the model calls it
-/// chunk by chunk from its block pass.
+/// chunk by chunk from its block pass. The record's mean velocity follows the capped velocity
+/// (the energy the cap removes is not booked as damping: the balance shows it as an error).
 ///
 /// ```
 /// use voussoir::integrate::StepRecord;
@@ -48,10 +51,13 @@ pub struct StepRecord {
 /// impl Integrator for Capped {
 ///     fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]) {
 ///         self.0.advance(blocks, forces, dt, records);
-///         for b in blocks.iter_mut() {
+///         for (b, r) in blocks.iter_mut().zip(records.iter_mut()) {
 ///             let v = b.state().velocity;
 ///             if v.length() > self.1 {
-///                 b.state_mut().velocity = v * (self.1 / v.length());
+///                 let capped = v * (self.1 / v.length());
+///                 let before = 2.0 * r.mean_velocity - v;
+///                 r.mean_velocity = 0.5 * (before + capped);
+///                 b.state_mut().velocity = capped;
 ///             }
 ///         }
 ///     }
@@ -83,7 +89,8 @@ pub trait Integrator: Send + Sync + std::fmt::Debug {
     ///
     /// The model then calls `advance` on consecutive chunks of blocks from its own parallel pass
     /// over the blocks, between gathering the chunk's forces and booking its energy, while the
-    /// chunk is in cache (one sweep through the blocks per step instead of three). Results are
+    /// chunk is in cache (one sweep through the blocks per step instead of four). `blocks`,
+    /// `forces` and `records` are then the chunk's, indexed from its first block. Results are
     /// the same either way. Default `false`: one call with all the blocks.
     fn is_blockwise(&self) -> bool {
         false

@@ -50,6 +50,16 @@ impl<S> Default for DetectionScratch<S> {
     }
 }
 
+impl<S> DetectionScratch<S> {
+    /// Asks the next step for a full detection (after a change of blocks, laws, parameters or
+    /// fixity) and drops the block pass's rotation matrices and movement check, which that
+    /// change may have made stale.
+    pub fn request_full_detection(&mut self) {
+        self.force_full_detection = true;
+        self.prepared = None;
+    }
+}
+
 impl<L: ConstitutiveLaw> Model<L> {
     /// The step's first pass over the blocks: their rotation matrices, which the contact pass
     /// reads instead of turning every contact's normals by quaternions, and (`check`) whether
@@ -277,9 +287,11 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.detections += 1;
         self.rebuild_block_index();
         // A forced full detection follows a change of laws, parameters or fixity: the step is
-        // re-evaluated then too. The flag stays set if that fails, so the error repeats rather
-        // than the run going on with an unstable step.
+        // re-evaluated then too, as after a re-detection that found stiffer contacts. The flag
+        // is set (or stays set) if that fails, so the error repeats rather than the run going on
+        // with an unstable step.
         if stiffer || full || self.critical.is_none() {
+            self.scratch.force_full_detection = true;
             self.refresh_time_step()?;
         }
         self.scratch.force_full_detection = false;

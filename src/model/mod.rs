@@ -376,7 +376,9 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Adds a block and returns its id.
     ///
     /// # Errors
-    /// [`Error::NonFinite`] for a NaN or infinite velocity, position, load or prescribed velocity.
+    /// [`Error::NonFinite`] for a NaN or infinite velocity, position, rotation, load or
+    /// prescribed velocity; [`Error::InvalidParameter`] for a rotation that is not a unit
+    /// quaternion.
     pub fn add_block(&mut self, mut block: RigidBlock) -> Result<BlockId> {
         block.validate()?;
         block.radius = block.shape().radius();
@@ -386,7 +388,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.forces.push(Wrench::default());
         self.records.push(StepRecord::default());
         self.bounds.push(StiffnessBound::default());
-        self.scratch.force_full_detection = true;
+        self.scratch.request_full_detection();
         Ok(id)
     }
 
@@ -396,7 +398,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The law's validation error.
     pub fn set_joint_law(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
         self.joints.insert(a, b, law)?;
-        self.scratch.force_full_detection = true;
+        self.scratch.request_full_detection();
         Ok(())
     }
 
@@ -428,7 +430,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn set_parameters(&mut self, params: ModelParameters) -> Result<()> {
         params.validate()?;
         self.params = params;
-        self.scratch.force_full_detection = true;
+        self.scratch.request_full_detection();
         Ok(())
     }
 
@@ -464,7 +466,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             return Err(e);
         }
         // A released block may touch blocks it had no contact with while both were fixed.
-        self.scratch.force_full_detection = true;
+        self.scratch.request_full_detection();
         if let Err(e) = self.refresh_time_step() {
             let b = self.block_mut(id)?;
             *b = b.clone().with_fixity(old);
@@ -722,6 +724,8 @@ impl<L: ConstitutiveLaw> Model<L> {
         let started = std::time::Instant::now();
         let large = self.params.mode == DisplacementMode::Large;
         let moved = match self.scratch.prepared.take() {
+            // Valid unless something changed since the last block pass: every change of blocks,
+            // laws, parameters or fixity requests a full detection (and drops `prepared`).
             Some(moved) if self.started && !self.scratch.force_full_detection => moved,
             _ => self.prepare_blocks(large && self.started && !self.scratch.force_full_detection),
         };
@@ -759,7 +763,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     fn start(&mut self) -> Result<()> {
         self.params.validate()?;
         self.integrator.damping().validate()?;
-        self.scratch.force_full_detection = true;
+        self.scratch.request_full_detection();
         self.detect()?;
         self.energy.initial_kinetic = self.blocks.iter().map(|b| b.kinetic_energy()).sum();
         self.energy.kinetic = self.energy.initial_kinetic;
@@ -780,6 +784,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             self.subs.len(),
             "sub-contact records out of step"
         );
+        assert_eq!(self.rotations.len(), self.blocks.len(), "rotation matrices out of step");
         let pass = ContactPass {
             blocks: &self.blocks,
             rotations: &self.rotations,
@@ -1143,7 +1148,7 @@ mod tests {
             view.iter().map(|(s, r)| (r.key(), view.shear_force(s))).collect()
         };
         let before = world_shears(&model);
-        model.scratch.force_full_detection = true;
+        model.scratch.request_full_detection();
         model.detect().expect("re-detection");
         let after = world_shears(&model);
         assert_eq!(before.len(), after.len());
