@@ -156,10 +156,7 @@ impl Monitor {
                 component.of(model.contact_wrench(id).map(|w| w.force).unwrap_or_default())
             }
             Monitor::JointForce { a, b, component } => {
-                let f = model
-                    .contact_between(a, b)
-                    .map(|c| c.pair.resultant())
-                    .unwrap_or_default();
+                let f = model.contact_between(a, b).map(|c| c.resultant()).unwrap_or_default();
                 // The stored resultant acts on the higher-numbered block.
                 component.of(if b.0 > a.0 { f } else { -f })
             }

@@ -69,6 +69,14 @@ fn restarted_run_is_bit_identical() -> Result<()> {
     let path = dir.join("wall.json");
     model.save_checkpoint(&path)?;
     let mut restarted: Model = Model::load_checkpoint(&path)?;
+    // The contacts' resultants and the blocks' contact wrenches read the same before a step.
+    let resultants = |m: &Model| m.contacts().map(|c| c.wrench).collect::<Vec<_>>();
+    assert_eq!(resultants(&model), resultants(&restarted));
+    assert!(resultants(&model).iter().any(|w| w.force != Vector::ZERO));
+    for i in 0..model.blocks().len() {
+        let id = BlockId(i as u32);
+        assert_eq!(model.contact_wrench(id)?, restarted.contact_wrench(id)?);
+    }
     let detections = model.detection_count();
     model.run_steps(3000)?;
     restarted.run_steps(3000)?;
@@ -137,13 +145,18 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     }
     // Another version is named as such, whatever else changed between the versions.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
-    json["version"] = serde_json::json!(5);
-    json.as_object_mut().expect("an object").remove("sub_records");
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 5");
+    json["version"] = serde_json::json!(6);
+    json.as_object_mut().expect("an object").remove("wrenches");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 5") && err.to_string().contains("reads version 6"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 7"),
         "{err}"
     );
+    // One wrench per contact.
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    json["wrenches"].as_array_mut().expect("wrenches").pop();
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("wrenches");
+    assert!(err.to_string().contains("wrenches"), "{err}");
     json["format"] = serde_json::json!("something-else");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("format");
     assert!(err.to_string().contains("something-else"), "{err}");

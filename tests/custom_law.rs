@@ -370,7 +370,7 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
         samples.push(Sample {
             travel: model.block(pusher).unwrap().state().pose.translation.x - p0,
             slide: state.pose.translation.x - x0,
-            resistance: -joint.pair.resultant().x,
+            resistance: -joint.resultant().x,
             normal: joint.pair.normal_force(),
             mean_kappa: sum / subs.len() as f64,
             min_kappa,

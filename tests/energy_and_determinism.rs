@@ -345,7 +345,7 @@ fn fingerprint(model: &Model) -> Vec<u64> {
         push(s.angular_momentum);
     }
     for c in model.contacts() {
-        push(c.pair.resultant());
+        push(c.resultant());
         for s in c.subs {
             push(c.shear_force(s));
             push(Vector::new(s.normal_force(), s.slip(), s.normal_displacement()));

@@ -53,7 +53,7 @@ fn a_stuck_joint_keeps_its_shear_force_through_redetection() -> Result<()> {
         let joint = model
             .contact_between(base, block)
             .expect("the block stays on the conveyor");
-        worst_force_error = worst_force_error.max((joint.pair.resultant().x + push).abs());
+        worst_force_error = worst_force_error.max((joint.resultant().x + push).abs());
         worst_slip = worst_slip.max((relative_x(&model)? - x0).abs());
     }
     let detections = model.detection_count() - detections0;

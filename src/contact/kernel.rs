@@ -3,11 +3,22 @@
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
-use super::{ContactPair, ContactReference, DisplacementMode, SubContact, SubContactRecord};
+use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::constitutive::{ConstitutiveLaw, ElasticRegime, JointAxes, JointForce, JointStatus, JointStep};
 use crate::geometry::ContactKind;
 use crate::math::{Matrix, Real, Vector, Vector2};
+
+/// What a contact's update returns besides what it stores in the contact: its wrench on the two
+/// blocks and its energy increments over the step.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct ContactStep {
+    pub wrench: ContactWrench,
+    /// Work done on the joint springs (J), trapezoidal rule.
+    pub work: Real,
+    /// Work of the dashpot forces (J, negative: dissipated).
+    pub dashpot_work: Real,
+}
 
 /// Read-only data shared by all contacts of a step.
 #[derive(Debug, Clone, Copy)]
@@ -19,8 +30,8 @@ pub(crate) struct KernelContext {
 }
 
 /// Updates one contact for one step: its plane and axes (large-displacement mode), the forces of
-/// its sub-contacts (`subs` and `records` are the contact's own ranges) and its resultant,
-/// moments about both centroids and energy increments. Sums run in a fixed order — in
+/// its sub-contacts (`subs` and `records` are the contact's own ranges), and returns its
+/// resultant, moments about both centroids and energy increments. Sums run in a fixed order — in
 /// sub-contact order, or, four at a time, per lane, the lanes added in order, then the remaining
 /// sub-contacts — so the result does not depend on how contacts are spread over threads.
 ///
@@ -43,7 +54,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     (sb, rotation_b): (&BlockState, &Matrix),
     law: &L,
     ctx: KernelContext,
-) {
+) -> ContactStep {
     // The axes of the previous step, in which the stored spring forces were composed.
     let previous_axes = pair.axes();
     let host = pair.frame(reference, &sa.pose, &sb.pose, ctx.mode);
@@ -196,17 +207,21 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let force = total.force;
     let moment_host = total.moment(&lever);
     // Moments about the centroids: Σ (p − x)×F with p = x_h + r on block b, −F on block a.
-    pair.force = force;
-    if pair.host_is_a {
-        pair.moment_a = -moment_host;
-        pair.moment_b = moment_host + (xa - xb).cross(force);
+    let (moment_a, moment_b) = if pair.host_is_a {
+        (-moment_host, moment_host + (xa - xb).cross(force))
     } else {
-        pair.moment_b = moment_host;
-        pair.moment_a = -(moment_host + (xb - xa).cross(force));
-    }
+        (-(moment_host + (xb - xa).cross(force)), moment_host)
+    };
     pair.normal_force = sums.force.x;
-    pair.work = -0.5 * spring_sum;
-    pair.dashpot_work = -0.5 * dashpot_sum;
+    ContactStep {
+        wrench: ContactWrench {
+            force,
+            moment_a,
+            moment_b,
+        },
+        work: -0.5 * spring_sum,
+        dashpot_work: -0.5 * dashpot_sum,
+    }
 }
 
 /// The sub-contacts of a contact without dashpot forces, for a law with an [`ElasticRegime`]:

@@ -84,15 +84,8 @@ pub struct ContactPair {
     /// selects the sub-contact loop, and with it the order of the sums.
     #[serde(default = "always")]
     pub(crate) dashpots: bool,
-    /// Resultant force on `b` (N).
-    pub(crate) force: Vector,
-    /// Moments of the sub-contact forces about the centroids of `a` and `b` (N·m).
-    pub(crate) moment_a: Vector,
-    pub(crate) moment_b: Vector,
     /// Sum of normal forces (N, compression positive).
     pub(crate) normal_force: Real,
-    pub(crate) work: Real,
-    pub(crate) dashpot_work: Real,
     /// Force and first moment of the sub-contacts' spring forces as they stand (composed with
     /// `normal`), for the first half of the next step's joint work. Kept by the step,
     /// recomputed from the sub-contacts at detection, checkpointed (a recomputation could sum
@@ -199,10 +192,6 @@ impl ContactPair {
     /// body frame (m).
     pub fn anchor<S>(&self, sub: &SubContact<S>) -> Vector {
         self.anchors.point(sub.plane)
-    }
-    /// Resultant force on `b` (N, world).
-    pub fn resultant(&self) -> Vector {
-        self.force
     }
     /// Sum of the sub-contact normal forces (N, compression positive).
     pub fn normal_force(&self) -> Real {
@@ -473,9 +462,29 @@ pub struct ContactView<'a, S> {
     /// Maps sub-contact anchors to world points: the host block's pose (its pose at detection in
     /// small-displacement mode).
     pub frame: Pose,
+    /// Resultant force of the sub-contacts' spring and dashpot forces on `b` and their moments
+    /// about the centroids of `a` and `b`, as of the last step (zero for a contact that
+    /// detection has just found).
+    pub wrench: ContactWrench,
+}
+
+/// What one contact applies to its two blocks: the resultant force on `b` (`−force` on `a`) and
+/// the moments about the blocks' centroids (N, N·m, world).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ContactWrench {
+    /// Resultant force on `b` (N).
+    pub force: Vector,
+    /// Moment of the contact forces on `a` about `a`'s centroid (N·m).
+    pub moment_a: Vector,
+    /// Moment of the contact forces on `b` about `b`'s centroid (N·m).
+    pub moment_b: Vector,
 }
 
 impl<S> ContactView<'_, S> {
+    /// Resultant force on `b` (N, world), spring and dashpot forces, as of the last step.
+    pub fn resultant(&self) -> Vector {
+        self.wrench.force
+    }
     /// World position of one of this contact's sub-contacts (m).
     pub fn point(&self, sub: &SubContact<S>) -> Vector {
         self.frame.transform_point(self.pair.anchor(sub))
@@ -514,6 +523,6 @@ impl<S> Contact for ContactView<'_, S> {
         self.subs
     }
     fn resultant(&self) -> Vector {
-        self.pair.force
+        ContactView::resultant(self)
     }
 }

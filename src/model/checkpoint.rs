@@ -9,16 +9,16 @@ use serde::{Deserialize, Serialize};
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
-use crate::contact::{ContactPair, ContactReference, ForceMoments, SubContact, SubContactRecord};
+use crate::contact::{ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
 use crate::io::io_error;
-use crate::math::{Pose, Real, Vector};
+use crate::math::{is_finite_vector, Pose, Real, Vector};
 use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 6;
+const VERSION: u32 = 7;
 
 /// The fields every version has, read before the rest (other fields are skipped).
 #[derive(Deserialize)]
@@ -42,6 +42,9 @@ struct Snapshot<L: ConstitutiveLaw> {
     pairs: Vec<ContactPair>,
     /// The contacts' reference geometry and areas, index for index.
     references: Vec<ContactReference>,
+    /// The contacts' wrenches as of the last step, index for index (what `contact_wrench` and
+    /// the contacts' resultants report before the next step).
+    wrenches: Vec<ContactWrench>,
     subs: Vec<SubContact<L::State>>,
     /// The sub-contacts' records, index for index.
     sub_records: Vec<SubContactRecord>,
@@ -89,6 +92,7 @@ where
             joints: self.joints.clone(),
             pairs: self.pairs.clone(),
             references: self.references.clone(),
+            wrenches: self.wrenches.clone(),
             subs: self.subs.clone(),
             sub_records: self.sub_records.clone(),
             ref_poses: self.ref_poses.clone(),
@@ -176,6 +180,16 @@ where
         if snap.references.len() != snap.pairs.len() {
             return Err(corrupt("references", "one reference per contact expected"));
         }
+        if snap.wrenches.len() != snap.pairs.len() {
+            return Err(corrupt("wrenches", "one wrench per contact expected"));
+        }
+        if let Some(k) = snap
+            .wrenches
+            .iter()
+            .position(|w| !(is_finite_vector(w.force) && is_finite_vector(w.moment_a) && is_finite_vector(w.moment_b)))
+        {
+            return Err(corrupt(&format!("wrenches[{k}]"), "non-finite force or moment"));
+        }
         let mut next = 0usize;
         for (k, p) in snap.pairs.iter().enumerate() {
             let faces_ok = match p.kind {
@@ -238,6 +252,7 @@ where
         model.integrator = Box::new(CentralDifference::new(snap.damping));
         model.pairs = snap.pairs;
         model.references = snap.references;
+        model.wrenches = snap.wrenches;
         model.subs = snap.subs;
         model.sub_records = snap.sub_records;
         for (k, p) in model.pairs.iter_mut().enumerate() {

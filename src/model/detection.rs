@@ -6,7 +6,8 @@ use super::{Model, BLOCK_CHUNK};
 use crate::block::{Block, BlockId};
 use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::contact::{
-    AnchorPlane, ContactPair, ContactReference, DisplacementMode, ForceMoments, SubContact, SubContactRecord,
+    AnchorPlane, ContactPair, ContactReference, ContactWrench, DisplacementMode, ForceMoments, SubContact,
+    SubContactRecord,
 };
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, ContactKind, NarrowPhaseScratch, SubcontactSeed};
@@ -28,6 +29,7 @@ pub(crate) struct DetectionScratch<S> {
     moved: Vec<bool>,
     pairs: Vec<ContactPair>,
     references: Vec<ContactReference>,
+    wrenches: Vec<ContactWrench>,
     subs: Vec<SubContact<S>>,
     records: Vec<SubContactRecord>,
 }
@@ -44,6 +46,7 @@ impl<S> Default for DetectionScratch<S> {
             moved: Vec::new(),
             pairs: Vec::new(),
             references: Vec::new(),
+            wrenches: Vec::new(),
             subs: Vec::new(),
             records: Vec::new(),
         }
@@ -98,6 +101,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         );
         sc.pairs.clear();
         sc.references.clear();
+        sc.wrenches.clear();
         sc.subs.clear();
         sc.records.clear();
         for &(i, j) in &sc.candidates {
@@ -115,6 +119,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     sc.records.extend_from_slice(&self.sub_records[p.range()]);
                     sc.pairs.push(kept);
                     sc.references.push(self.references[k].clone());
+                    sc.wrenches.push(self.wrenches.get(k).copied().unwrap_or_default());
                 }
                 continue;
             }
@@ -238,17 +243,13 @@ impl<L: ConstitutiveLaw> Model<L> {
                 local_normal_b: Vector::ZERO,
                 local_other_offset: 0.0,
                 dashpots: true,
-                force: Vector::ZERO,
-                moment_a: Vector::ZERO,
-                moment_b: Vector::ZERO,
                 normal_force: 0.0,
-                work: 0.0,
-                dashpot_work: 0.0,
                 springs: ForceMoments::default(),
             };
             pair.cache_local_faces(bi.shape(), bj.shape());
             pair.refresh_springs(&sc.subs);
             sc.pairs.push(pair);
+            sc.wrenches.push(ContactWrench::default());
             sc.references.push(ContactReference {
                 ref_a: bi.state.pose.translation,
                 ref_b: bj.state.pose.translation,
@@ -277,6 +278,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.energy.damping += dashpot;
         std::mem::swap(&mut self.pairs, &mut sc.pairs);
         std::mem::swap(&mut self.references, &mut sc.references);
+        std::mem::swap(&mut self.wrenches, &mut sc.wrenches);
         std::mem::swap(&mut self.subs, &mut sc.subs);
         std::mem::swap(&mut self.sub_records, &mut sc.records);
         for (i, moved) in sc.moved.iter().enumerate() {

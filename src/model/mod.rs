@@ -13,8 +13,8 @@ pub use energy::Energies;
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
 use crate::contact::{
-    update_contact, ContactPair, ContactReference, ContactView, DisplacementMode, KernelContext, SubContact,
-    SubContactRecord,
+    update_contact, ContactPair, ContactReference, ContactView, ContactWrench, DisplacementMode, KernelContext,
+    SubContact, SubContactRecord,
 };
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
@@ -111,9 +111,11 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     block_offsets: Vec<u32>,
     forces: Vec<Wrench>,
     records: Vec<StepRecord>,
-    /// The contacts' resultants, copied from the pairs by the contact pass into a compact array
-    /// that the per-block gather reads (a tenth of the bytes of the pairs).
-    wrenches: Vec<PairWrench>,
+    /// The contacts' resultants and moments, index for index with `pairs`: written by the
+    /// contact pass, read by the per-block gather and the accessors (kept out of `ContactPair`,
+    /// whose stream they would lengthen by 72 bytes per contact). Detection carries a kept
+    /// contact's wrench and starts a new one at zero; checkpointed.
+    wrenches: Vec<ContactWrench>,
     pair_sums: Vec<PairSums>,
     block_sums: Vec<BlockSums>,
     ref_poses: Vec<Pose>,
@@ -177,14 +179,6 @@ const BLOCK_CHUNK: usize = 512;
 /// Contacts per chunk of the contact pass (as [`BLOCK_CHUNK`]).
 const CONTACT_CHUNK: usize = 64;
 
-/// A contact's force on `b` and its moments about both centroids.
-#[derive(Debug, Clone, Copy, Default)]
-struct PairWrench {
-    force: Vector,
-    moment_a: Vector,
-    moment_b: Vector,
-}
-
 /// What the contact pass shares between its tasks.
 struct ContactPass<'a, L: ConstitutiveLaw> {
     blocks: &'a [RigidBlock],
@@ -203,7 +197,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     /// Updates one chunk of contacts and their sub-contacts, copies their resultants to
     /// `wrenches` and adds their totals to `sums`.
     #[inline(always)]
-    fn run(&self, first: usize, chunk: &mut [ContactPair], wrenches: &mut [PairWrench], sums: &mut PairSums) {
+    fn run(&self, first: usize, chunk: &mut [ContactPair], wrenches: &mut [ContactWrench], sums: &mut PairSums) {
         let references = &self.references[first..first + chunk.len()];
         for ((p, reference), w) in chunk.iter_mut().zip(references).zip(wrenches) {
             let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
@@ -221,7 +215,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             // SAFETY: as above; the records vector has the same length as the sub-contacts.
             let own_records =
                 unsafe { std::slice::from_raw_parts_mut(self.sub_records.get().add(range.start), range.len()) };
-            update_contact(
+            let step = update_contact(
                 p,
                 reference,
                 own,
@@ -231,14 +225,10 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 &self.laws[p.law as usize],
                 self.ctx,
             );
-            *w = PairWrench {
-                force: p.force,
-                moment_a: p.moment_a,
-                moment_b: p.moment_b,
-            };
-            sums.force_magnitude += p.force.length();
-            sums.work += p.work;
-            sums.dashpot_work += p.dashpot_work;
+            *w = step.wrench;
+            sums.force_magnitude += step.wrench.force.length();
+            sums.work += step.work;
+            sums.dashpot_work += step.dashpot_work;
         }
     }
 
@@ -255,7 +245,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
         &self,
         first: usize,
         chunk: &mut [ContactPair],
-        wrenches: &mut [PairWrench],
+        wrenches: &mut [ContactWrench],
         sums: &mut PairSums,
     ) {
         self.run(first, chunk, wrenches, sums);
@@ -547,6 +537,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             subs: &self.subs[p.range()],
             records: &self.sub_records[p.range()],
             frame: p.frame(&self.references[k], &sa.pose, &sb.pose, self.params.mode),
+            wrench: self.wrenches[k],
         }
     }
 
@@ -648,7 +639,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     fn contact_wrench_of(&self, i: usize) -> Wrench {
         let mut w = Wrench::default();
         for &e in &self.block_contacts[self.block_offsets[i] as usize..self.block_offsets[i + 1] as usize] {
-            let p = &self.pairs[(e >> 1) as usize];
+            let p = &self.wrenches[(e >> 1) as usize];
             if e & 1 == 1 {
                 w.force += p.force;
                 w.moment += p.moment_b;
@@ -801,7 +792,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.pair_sums.clear();
         self.pair_sums
             .resize(self.pairs.len().div_ceil(CONTACT_CHUNK), PairSums::default());
-        self.wrenches.resize(self.pairs.len(), PairWrench::default());
+        assert_eq!(self.wrenches.len(), self.pairs.len(), "contact wrenches out of step");
         self.pairs
             .par_chunks_mut(CONTACT_CHUNK)
             .zip(self.wrenches.par_chunks_mut(CONTACT_CHUNK))
@@ -963,12 +954,25 @@ mod tests {
             let point = matches!(model.pairs[k].kind, crate::geometry::ContactKind::Point { .. });
             // The grouped loop runs without dashpot forces; the single loop when the contact may
             // hold some (none are held here, so it books zero dashpot forces).
-            for (dashpots, pairs, subs, records) in [
-                (false, &mut grouped_pairs, &mut grouped_subs, &mut grouped_records),
-                (true, &mut single_pairs, &mut single_subs, &mut single_records),
+            let (mut grouped_wrench, mut single_wrench) = (ContactWrench::default(), ContactWrench::default());
+            for (dashpots, pairs, subs, records, wrench) in [
+                (
+                    false,
+                    &mut grouped_pairs,
+                    &mut grouped_subs,
+                    &mut grouped_records,
+                    &mut grouped_wrench,
+                ),
+                (
+                    true,
+                    &mut single_pairs,
+                    &mut single_subs,
+                    &mut single_records,
+                    &mut single_wrench,
+                ),
             ] {
                 pairs[k].dashpots = dashpots;
-                update_contact(
+                *wrench = update_contact(
                     &mut pairs[k],
                     &model.references[k],
                     &mut subs[r.clone()],
@@ -977,7 +981,8 @@ mod tests {
                     sb,
                     law,
                     ctx,
-                );
+                )
+                .wrench;
             }
             for i in r {
                 assert_eq!(grouped_subs[i], single_subs[i], "contact {k}, sub-contact {i}");
@@ -989,9 +994,10 @@ mod tests {
             }
             let (g, s) = (&grouped_pairs[k], &single_pairs[k]);
             let scale = s.normal_force.abs().max(1e-9);
-            assert!((g.force - s.force).length() <= 1e-12 * scale, "contact {k}");
+            let (gw, sw) = (grouped_wrench, single_wrench);
+            assert!((gw.force - sw.force).length() <= 1e-12 * scale, "contact {k}");
             assert!((g.normal_force - s.normal_force).abs() <= 1e-12 * scale, "contact {k}");
-            let arm = (g.moment_a - s.moment_a).length() + (g.moment_b - s.moment_b).length();
+            let arm = (gw.moment_a - sw.moment_a).length() + (gw.moment_b - sw.moment_b).length();
             assert!(arm <= 1e-12 * scale, "contact {k}: {arm}");
         }
         counts

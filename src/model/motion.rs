@@ -12,17 +12,17 @@
 use rayon::prelude::*;
 
 use super::detection::prepare_chunk;
-use super::{diverged, BlockSums, Model, PairWrench, BLOCK_CHUNK};
+use super::{diverged, BlockSums, Model, BLOCK_CHUNK};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::ConstitutiveLaw;
-use crate::contact::DisplacementMode;
+use crate::contact::{ContactWrench, DisplacementMode};
 use crate::integrate::{Integrator, StepRecord};
 use crate::math::{Matrix, Real, Vector};
 
 /// What the per-block stages read besides the block itself.
 #[derive(Clone, Copy)]
 struct BlockPass<'a> {
-    wrenches: &'a [PairWrench],
+    wrenches: &'a [ContactWrench],
     /// Block → contact index: `contacts[offsets[i]..offsets[i + 1]]`, each entry `2·contact + side`.
     contacts: &'a [u32],
     offsets: &'a [u32],

@@ -325,9 +325,7 @@ pub fn run(
         };
         last_v = velocity;
         last_sample_t = t;
-        let force = model
-            .contact_between(seat, impactor)
-            .map_or(0.0, |c| c.pair.resultant().y);
+        let force = model.contact_between(seat, impactor).map_or(0.0, |c| c.resultant().y);
         let e = model.energies();
         let sample = ImpactSample {
             time: t,

@@ -252,7 +252,7 @@ pub fn run(
         // reaction, i.e. the upward force on the plate.
         let load = model
             .contact_between(plate, loaded)
-            .map(|c| c.pair.resultant().y)
+            .map(|c| c.resultant().y)
             .unwrap_or(0.0);
         window.push_back((displacement, load));
         window_sum += load;
