@@ -38,6 +38,23 @@ struct BlockPass<'a> {
     trigger: Option<Real>,
 }
 
+/// `total` plus the wrenches of a block's contacts, in index order: `entries` are the block's
+/// slice of the block → contact index (`2·contact + side`, side 1 when the block is `b`).
+#[inline]
+pub(super) fn add_contact_wrenches(mut total: Wrench, entries: &[u32], wrenches: &[ContactWrench]) -> Wrench {
+    for &e in entries {
+        let w = &wrenches[(e >> 1) as usize];
+        if e & 1 == 1 {
+            total.force += w.force;
+            total.moment += w.moment_b;
+        } else {
+            total.force -= w.force;
+            total.moment += w.moment_a;
+        }
+    }
+    total
+}
+
 impl BlockPass<'_> {
     /// Gathers the forces of the chunk of blocks starting at block `first_block` and books the
     /// energy terms due before the move: gravity and loads, and the `F_{n−1}` halves of the
@@ -57,16 +74,8 @@ impl BlockPass<'_> {
             let m = b.mass_properties().mass;
             let mut total = b.load;
             total.force += self.gravity * m;
-            for &e in &self.contacts[self.offsets[i] as usize..self.offsets[i + 1] as usize] {
-                let w = &self.wrenches[(e >> 1) as usize];
-                if e & 1 == 1 {
-                    total.force += w.force;
-                    total.moment += w.moment_b;
-                } else {
-                    total.force -= w.force;
-                    total.moment += w.moment_a;
-                }
-            }
+            let entries = &self.contacts[self.offsets[i] as usize..self.offsets[i + 1] as usize];
+            let total = add_contact_wrenches(total, entries, self.wrenches);
             *w = total;
             if b.is_free() {
                 sums.max_unbalanced = sums.max_unbalanced.max(total.force.length());
@@ -209,8 +218,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::block::{Fixity, RigidBlock};
-    use crate::constitutive::{CoulombSlip, MaterialId};
+    use crate::block::RigidBlock;
     use crate::integrate::{CentralDifference, Damping};
     use crate::model::ModelParameters;
 
@@ -230,38 +238,8 @@ mod tests {
         }
     }
 
-    /// A column of four cubes on a fixed base, each overhanging the one below by 40 mm: it
-    /// leans and topples, so blocks move beyond the re-detection trigger and contacts change.
     fn toppling_column() -> Model {
-        let mut column: Model = Model::new(ModelParameters::default()).expect("model");
-        column
-            .set_joint_law(
-                MaterialId(0),
-                MaterialId(0),
-                CoulombSlip::dry(1e8, 4e7, 30.0).expect("law"),
-            )
-            .expect("law");
-        let base = RigidBlock::cuboid(
-            "base",
-            Vector::new(-1.0, -1.0, -0.2),
-            Vector::new(1.0, 1.0, 0.0),
-            2500.0,
-        )
-        .expect("base")
-        .with_fixity(Fixity::FIXED);
-        column.add_block(base).expect("base");
-        for level in 0..4 {
-            let (x, z) = (0.04 * level as Real, 0.1 * level as Real);
-            let cube = RigidBlock::cuboid(
-                "cube",
-                Vector::new(x - 0.05, -0.05, z),
-                Vector::new(x + 0.05, 0.05, z + 0.1),
-                2500.0,
-            )
-            .expect("cube");
-            column.add_block(cube).expect("cube");
-        }
-        column
+        crate::model::tests::toppling_column(ModelParameters::default())
     }
 
     /// What the comparisons below compare: every block state, the energies, the detection,
