@@ -2,24 +2,30 @@
 //! `BENCHMARKS.md` §4).
 //!
 //! ```text
-//! cargo run --release --example arch_impact                       # all six setups, in parallel
-//! cargo run --release --example arch_impact -- --setup M60H20 --kn 8e9 --damping 0.02
-//! cargo run --release --example arch_impact -- --study            # kn and damping sensitivity (M60)
+//! cargo run --release --example arch_impact                       # six setups × five drop heights
+//! cargo run --release --example arch_impact -- --guide seat       # the steel-seat, guided-DOF variant
+//! cargo run --release --example arch_impact -- --width 0.2        # the width sensitivity case
+//! cargo run --release --example arch_impact -- --study            # + paper Fig. 14 (kn, damping; M60)
+//! cargo run --release --example arch_impact -- --compare-release  # + full-height drops (central runs)
 //! ```
 //!
 //! Flags: `--setup NAME[,NAME]`, `--kn PA_PER_M`, `--damping RATIO`, `--width M`, `--duration S`,
-//! `--out DIR`, `--study`, `--no-paraview`. Writes `summary.json`, one history CSV per setup,
-//! `displacement_time.svg`, `max_disp_vs_experiment.svg`, a ParaView series per setup (and
-//! `sensitivity.svg` with `--study`) under `out/arch_impact/`.
+//! `--guide frame|seat`, `--base sloped|flat`, `--release above|full`, `--offsets MM[,MM]`
+//! (drop-height perturbations, default `-0.5,-0.25,0,0.25,0.5`), `--out DIR`, `--study`,
+//! `--compare-release`, `--no-paraview`. Writes `summary.json`, one history CSV per setup (with
+//! the energy terms), `displacement_time.svg`, `max_disp_vs_experiment.svg`, a ParaView series per
+//! setup (and `sensitivity.svg` with `--study`) under `out/arch_impact/`.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use rayon::prelude::*;
 use serde::Serialize;
-use voussoir::io::plot::{Curve, LinePlot, Reference};
+use voussoir::io::plot::{Curve, LegendPosition, LinePlot, Reference};
 use voussoir::io::{progress, vtk, write_json};
-use voussoir::scenarios::arch_impact::{run, setups, ImpactCase, ImpactResult};
+use voussoir::scenarios::arch_impact::{
+    run, setups, ImpactCase, ImpactResult, ImpactSetup, ImpactorBase, ImpactorGuide, Release,
+};
 
 struct Options {
     out: PathBuf,
@@ -28,9 +34,18 @@ struct Options {
     damping: Option<f64>,
     width: Option<f64>,
     duration: Option<f64>,
+    guide: ImpactorGuide,
+    base: ImpactorBase,
+    release: Release,
+    offsets_mm: Vec<f64>,
     study: bool,
+    compare_release: bool,
     paraview: bool,
 }
+
+const HELP: &str = "arch_impact [--setup M60H20,..] [--kn 4e9] [--damping 0.01] [--width 0.15] [--duration 1.0] \
+[--guide frame|seat] [--base sloped|flat] [--release above|full] [--offsets -0.5,-0.25,0,0.25,0.5] \
+[--out DIR] [--study] [--compare-release] [--no-paraview]";
 
 fn parse() -> Result<Options, String> {
     let mut o = Options {
@@ -40,13 +55,23 @@ fn parse() -> Result<Options, String> {
         damping: None,
         width: None,
         duration: None,
+        guide: ImpactorGuide::Frame,
+        base: ImpactorBase::Sloped,
+        release: Release::JustAbove,
+        offsets_mm: vec![-0.5, -0.25, 0.0, 0.25, 0.5],
         study: false,
+        compare_release: false,
         paraview: true,
     };
     let mut args = std::env::args().skip(1);
     let number = |name: &str, v: Option<String>| -> Result<f64, String> {
         let v = v.ok_or(format!("{name} needs a value"))?;
-        v.parse().map_err(|_| format!("{name}: not a number: {v:?}"))
+        let x: f64 = v.parse().map_err(|_| format!("{name}: not a number: {v:?}"))?;
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(format!("{name}: not finite: {v:?}"))
+        }
     };
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -64,10 +89,42 @@ fn parse() -> Result<Options, String> {
             "--damping" => o.damping = Some(number("--damping", args.next())?),
             "--width" => o.width = Some(number("--width", args.next())?),
             "--duration" => o.duration = Some(number("--duration", args.next())?),
+            "--guide" => {
+                o.guide = match args.next().as_deref() {
+                    Some("frame") => ImpactorGuide::Frame,
+                    Some("seat") => ImpactorGuide::SeatConstrained,
+                    other => return Err(format!("--guide: frame or seat, not {other:?}")),
+                }
+            }
+            "--base" => {
+                o.base = match args.next().as_deref() {
+                    Some("sloped") => ImpactorBase::Sloped,
+                    Some("flat") => ImpactorBase::Flat,
+                    other => return Err(format!("--base: sloped or flat, not {other:?}")),
+                }
+            }
+            "--release" => {
+                o.release = match args.next().as_deref() {
+                    Some("above") => Release::JustAbove,
+                    Some("full") => Release::FullHeight,
+                    other => return Err(format!("--release: above or full, not {other:?}")),
+                }
+            }
+            "--offsets" => {
+                let list = args.next().ok_or("--offsets needs a list of millimetres")?;
+                o.offsets_mm = list
+                    .split(',')
+                    .map(|v| number("--offsets", Some(v.to_owned())))
+                    .collect::<Result<_, _>>()?;
+                if o.offsets_mm.is_empty() {
+                    return Err("--offsets: empty list".into());
+                }
+            }
             "--study" => o.study = true,
+            "--compare-release" => o.compare_release = true,
             "--no-paraview" => o.paraview = false,
             "-h" | "--help" => {
-                println!("arch_impact [--setup M60H20,..] [--kn 4e9] [--damping 0.01] [--width 0.15] [--duration 1.0] [--out DIR] [--study] [--no-paraview]");
+                println!("{HELP}");
                 std::process::exit(0);
             }
             other => return Err(format!("unknown argument {other:?} (try --help)")),
@@ -76,9 +133,18 @@ fn parse() -> Result<Options, String> {
     Ok(o)
 }
 
-fn cases(o: &Options) -> Result<Vec<ImpactCase>, String> {
+/// A group of runs that differ only by the drop-height perturbation.
+#[derive(Clone)]
+struct Group {
+    label: String,
+    /// `main` (one per setup), `study` or `release`.
+    kind: &'static str,
+    base: ImpactCase,
+}
+
+fn groups(o: &Options) -> Result<Vec<Group>, String> {
     let all = setups();
-    let chosen: Vec<_> = match &o.setups {
+    let chosen: Vec<ImpactSetup> = match &o.setups {
         None => all.clone(),
         Some(names) => names
             .iter()
@@ -90,8 +156,11 @@ fn cases(o: &Options) -> Result<Vec<ImpactCase>, String> {
             })
             .collect::<Result<_, _>>()?,
     };
-    let configure = |s: &voussoir::scenarios::arch_impact::ImpactSetup| {
+    let configure = |s: &ImpactSetup| {
         let mut c = ImpactCase::baseline(s.clone());
+        c.guide = o.guide;
+        c.base = o.base;
+        c.release = o.release;
         if let Some(kn) = o.kn {
             c.ks = kn * c.ks / c.kn;
             c.kn = kn;
@@ -107,28 +176,83 @@ fn cases(o: &Options) -> Result<Vec<ImpactCase>, String> {
         }
         c
     };
-    let mut cases: Vec<ImpactCase> = chosen.iter().map(configure).collect();
+    let mut out: Vec<Group> = chosen
+        .iter()
+        .map(|s| Group {
+            label: s.name.clone(),
+            kind: "main",
+            base: configure(s),
+        })
+        .collect();
     if o.study {
+        // Paper Fig. 14: kn 2, 4, 8 GPa/m at 1 %; damping 0.5, 1, 2 % at 4 GPa/m. The 4 GPa/m, 1 %
+        // point is the main run.
         for s in all.iter().filter(|s| s.name.starts_with("M60")) {
             let base = configure(s);
             for kn in [2e9, 8e9] {
-                cases.push(ImpactCase {
+                out.push(Group {
                     label: format!("{} kn {} GPa/m", s.name, kn / 1e9),
-                    ks: kn * base.ks / base.kn,
-                    kn,
-                    ..base.clone()
+                    kind: "study",
+                    base: ImpactCase {
+                        ks: kn * base.ks / base.kn,
+                        kn,
+                        ..base.clone()
+                    },
                 });
             }
             for d in [0.005, 0.02] {
-                cases.push(ImpactCase {
+                out.push(Group {
                     label: format!("{} damping {} %", s.name, d * 100.0),
-                    damping_ratio: d,
-                    ..base.clone()
+                    kind: "study",
+                    base: ImpactCase {
+                        damping_ratio: d,
+                        ..base.clone()
+                    },
+                });
+            }
+            if !chosen.iter().any(|c| c.name == s.name) {
+                out.push(Group {
+                    label: s.name.clone(),
+                    kind: "study",
+                    base,
                 });
             }
         }
     }
-    Ok(cases)
+    if o.compare_release {
+        let other = match o.release {
+            Release::JustAbove => Release::FullHeight,
+            Release::FullHeight => Release::JustAbove,
+        };
+        for s in &chosen {
+            out.push(Group {
+                label: format!("{} release {}", s.name, release_name(other)),
+                kind: "release",
+                base: ImpactCase {
+                    release: other,
+                    ..configure(s)
+                },
+            });
+        }
+    }
+    for g in &mut out {
+        g.base.label = g.label.clone();
+    }
+    Ok(out)
+}
+
+fn release_name(r: Release) -> &'static str {
+    match r {
+        Release::JustAbove => "just above",
+        Release::FullHeight => "full height",
+    }
+}
+
+fn guide_name(g: ImpactorGuide) -> &'static str {
+    match g {
+        ImpactorGuide::Frame => "free impactor between fixed frame blocks (contacts only)",
+        ImpactorGuide::SeatConstrained => "steel seat on voussoir 5, impactor guided by constrained DOFs",
+    }
 }
 
 #[derive(Serialize)]
@@ -140,62 +264,161 @@ struct Experiment {
 }
 
 #[derive(Serialize)]
-struct SetupSummary {
+struct RunSummary {
+    height_offset_m: f64,
+    first_peak_disp_m: f64,
+    max_disp_m: f64,
+    max_velocity_m_per_s: f64,
+    collapsed: bool,
+    max_energy_excess_j: f64,
+    max_energy_error_j: f64,
+    wall_s: f64,
+}
+
+#[derive(Serialize)]
+struct EnergySummary {
+    /// At the end of the run, changes since release (J).
+    input_j: f64,
+    kinetic_j: f64,
+    elastic_j: f64,
+    friction_j: f64,
+    damping_j: f64,
+    gravity_work_j: f64,
+    final_excess_j: f64,
+    max_excess_j: f64,
+    max_abs_error_j: f64,
+}
+
+#[derive(Serialize)]
+struct GroupSummary {
     name: String,
     label: String,
+    kind: &'static str,
+    guide: ImpactorGuide,
+    base: ImpactorBase,
+    release: Release,
     mass_kg: f64,
     height_m: f64,
     v0_m_per_s: f64,
+    contact_speed_m_per_s: f64,
     impact_energy_j: f64,
     kn_pa_per_m: f64,
     damping_ratio: f64,
     width_m: f64,
     first_peak_disp_m: f64,
     max_disp_m: f64,
+    spread_max_disp_m: [f64; 2],
+    spread_first_peak_disp_m: [f64; 2],
+    max_rise_m: f64,
+    max_rise_time_s: f64,
     max_velocity_m_per_s: f64,
     max_accel_m_per_s2: f64,
     max_impact_force_n: f64,
+    max_impactor_drift_m: [f64; 2],
+    max_impactor_rotation_rad: f64,
     collapsed: bool,
+    collapsed_runs: usize,
+    runs_count: usize,
     collapse_time_s: Option<f64>,
-    max_energy_excess_j: f64,
+    energy: EnergySummary,
     steps: u64,
     dt_s: f64,
-    steps_per_s: f64,
     wall_s: f64,
+    runs: Vec<RunSummary>,
     experiment: Experiment,
 }
 
-fn summarise(r: &ImpactResult) -> SetupSummary {
-    let c = &r.case;
-    let s = &c.setup;
-    SetupSummary {
-        name: s.name.clone(),
-        label: c.label.clone(),
-        mass_kg: s.mass,
-        height_m: s.height,
-        v0_m_per_s: r.v0,
-        impact_energy_j: r.kinetic_energy,
-        kn_pa_per_m: c.kn,
-        damping_ratio: c.damping_ratio,
-        width_m: c.width,
-        first_peak_disp_m: r.first_peak_disp,
-        max_disp_m: r.max_disp,
-        max_velocity_m_per_s: r.max_velocity,
-        max_accel_m_per_s2: r.max_accel,
-        max_impact_force_n: r.max_impact_force,
-        collapsed: r.collapsed,
-        collapse_time_s: r.collapse_time,
-        max_energy_excess_j: r.max_energy_excess,
-        steps: r.steps,
-        dt_s: r.dt,
-        steps_per_s: r.steps as f64 / r.wall_s,
-        wall_s: r.wall_s,
-        experiment: Experiment {
-            collapsed: s.collapsed,
-            max_disp_m: s.max_disp,
-            max_velocity_m_per_s: s.max_velocity,
-            max_accel_m_per_s2: s.max_accel,
-        },
+/// The results of one group, central run first.
+struct Outcome<'a> {
+    group: &'a Group,
+    central: &'a ImpactResult,
+    runs: Vec<&'a ImpactResult>,
+}
+
+impl Outcome<'_> {
+    fn spread(&self, f: impl Fn(&ImpactResult) -> f64) -> [f64; 2] {
+        let v: Vec<f64> = self.runs.iter().map(|r| f(r)).collect();
+        [
+            v.iter().copied().fold(f64::INFINITY, f64::min),
+            v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        ]
+    }
+
+    fn collapsed_runs(&self) -> usize {
+        self.runs.iter().filter(|r| r.collapsed).count()
+    }
+
+    fn summary(&self) -> GroupSummary {
+        let r = self.central;
+        let c = &r.case;
+        let s = &c.setup;
+        let last = r.samples.last().copied();
+        let e = |f: fn(&voussoir::scenarios::arch_impact::ImpactSample) -> f64| last.map_or(0.0, |x| f(&x));
+        GroupSummary {
+            name: s.name.clone(),
+            label: self.group.label.clone(),
+            kind: self.group.kind,
+            guide: c.guide,
+            base: c.base,
+            release: c.release,
+            mass_kg: s.mass,
+            height_m: c.drop_height(),
+            v0_m_per_s: r.v0,
+            contact_speed_m_per_s: r.contact_speed,
+            impact_energy_j: r.kinetic_energy,
+            kn_pa_per_m: c.kn,
+            damping_ratio: c.damping_ratio,
+            width_m: c.width,
+            first_peak_disp_m: r.first_peak_disp,
+            max_disp_m: r.max_disp,
+            spread_max_disp_m: self.spread(|r| r.max_disp),
+            spread_first_peak_disp_m: self.spread(|r| r.first_peak_disp),
+            max_rise_m: r.max_rise,
+            max_rise_time_s: r.max_rise_time,
+            max_velocity_m_per_s: r.max_velocity,
+            max_accel_m_per_s2: r.max_accel,
+            max_impact_force_n: r.max_impact_force,
+            max_impactor_drift_m: r.max_impactor_drift,
+            max_impactor_rotation_rad: r.max_impactor_rotation,
+            collapsed: r.collapsed,
+            collapsed_runs: self.collapsed_runs(),
+            runs_count: self.runs.len(),
+            collapse_time_s: r.collapse_time,
+            energy: EnergySummary {
+                input_j: e(|x| x.input),
+                kinetic_j: e(|x| x.kinetic),
+                elastic_j: e(|x| x.elastic),
+                friction_j: e(|x| x.friction),
+                damping_j: e(|x| x.damping),
+                gravity_work_j: e(|x| x.gravity_work),
+                final_excess_j: r.final_energy_excess,
+                max_excess_j: r.max_energy_excess,
+                max_abs_error_j: r.max_energy_error,
+            },
+            steps: r.steps,
+            dt_s: r.dt,
+            wall_s: r.wall_s,
+            runs: self
+                .runs
+                .iter()
+                .map(|x| RunSummary {
+                    height_offset_m: x.case.height_offset,
+                    first_peak_disp_m: x.first_peak_disp,
+                    max_disp_m: x.max_disp,
+                    max_velocity_m_per_s: x.max_velocity,
+                    collapsed: x.collapsed,
+                    max_energy_excess_j: x.max_energy_excess,
+                    max_energy_error_j: x.max_energy_error,
+                    wall_s: x.wall_s,
+                })
+                .collect(),
+            experiment: Experiment {
+                collapsed: s.collapsed,
+                max_disp_m: s.max_disp,
+                max_velocity_m_per_s: s.max_velocity,
+                max_accel_m_per_s2: s.max_accel,
+            },
+        }
     }
 }
 
@@ -206,22 +429,88 @@ fn main() {
     }
 }
 
+fn history_csv(r: &ImpactResult) -> String {
+    let mut csv = String::from(
+        "time [s],quarter-span displacement [m],velocity [m/s],acceleration [m/s2],impact force [N],\
+impactor velocity [m/s],impactor drift x [m],impactor drift z [m],kinetic [J],impactor kinetic [J],\
+ring potential [J],elastic [J],friction [J],damping [J],gravity work [J],energy input [J],energy accounted [J]\n",
+    );
+    for s in &r.samples {
+        csv.push_str(&format!(
+            "{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}\n",
+            s.time,
+            s.disp,
+            s.velocity,
+            s.accel,
+            s.impact_force,
+            s.impactor_velocity,
+            s.impactor_drift_x,
+            s.impactor_drift_z,
+            s.kinetic,
+            s.impactor_kinetic,
+            s.arch_potential,
+            s.elastic,
+            s.friction,
+            s.damping,
+            s.gravity_work,
+            s.input,
+            s.accounted
+        ));
+    }
+    csv
+}
+
 fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     let o = parse()?;
     let started = Instant::now();
-    let cases = cases(&o)?;
-    let base = &cases[0];
+    let groups = groups(&o)?;
+    // Every group runs at every drop-height perturbation (the central one first).
+    let mut offsets: Vec<f64> = o.offsets_mm.iter().map(|mm| mm * 1e-3).collect();
+    offsets.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
+    let cases: Vec<(usize, ImpactCase)> = groups
+        .iter()
+        .enumerate()
+        .flat_map(|(k, g)| {
+            offsets.iter().map(move |&dh| {
+                (
+                    k,
+                    ImpactCase {
+                        height_offset: dh,
+                        ..g.base.clone()
+                    },
+                )
+            })
+        })
+        .collect();
+    let base = &groups[0].base;
     println!(
-        "Drop-weight impact tests of the reference arch (Pulatsu et al. 2021), {} runs",
+        "Drop-weight impact tests of the reference arch (Pulatsu et al. 2021): {} groups × {} drop heights = {} runs",
+        groups.len(),
+        offsets.len(),
         cases.len()
     );
     println!(
-        "Adopted (BENCHMARKS.md): width {} m; impactor {} m × {} m × width, guided (only vertical translation free),",
-        base.width, base.impactor_length, base.impactor_height
+        "Adopted (BENCHMARKS.md): width {} m; impactor {} m along the span × {} m × width, {};",
+        base.width,
+        base.impactor_length,
+        base.impactor_height,
+        guide_name(base.guide)
     );
+    if base.guide == ImpactorGuide::Frame {
+        println!(
+            "  base {:?} (parallel to the 20.7° extrados of voussoir 5 when sloped), striking voussoir 5 directly; frame blocks {} m thick, {} mm away, impactor–frame joint φ {}° (frictionless at 0), {} mm above the extrados;",
+            base.base,
+            base.guide_thickness,
+            base.guide_clearance * 1e3,
+            base.guide_friction_deg,
+            base.guide_standoff * 1e3
+        );
+    }
     println!(
-        "  released {} mm above a steel seat on voussoir 5 with v0 = √(2gH); arch settled first (local damping 0.8);",
-        base.release_gap * 1e3
+        "  release {} ({} mm gap, speed √(2g(H − gap)), so that it strikes at √(2gH)); drop heights H + {:?} mm; arch settled first (local damping 0.8);",
+        release_name(base.release),
+        base.release_gap * 1e3,
+        o.offsets_mm
     );
     println!(
         "  joints kn {:.1e} Pa/m, ks {:.1e} Pa/m, φ {}°; Rayleigh {} % stiffness-proportional at {} Hz; {} s; large displacements;",
@@ -234,146 +523,177 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     );
     println!("  collapse rule: a voussoir's centroid drops by more than half the ring thickness (0.1 m).");
     let bar = progress::bar(cases.len() as u64, "impact runs");
-    let results: Vec<ImpactResult> = cases
+    let results: Vec<(usize, ImpactResult)> = cases
         .par_iter()
-        .map(|case| {
-            let result = if o.paraview && case.label == case.setup.name {
+        .map(|(k, case)| {
+            let g = &groups[*k];
+            let result = if o.paraview && g.kind == "main" && case.height_offset == 0.0 {
                 let mut series = vtk::Series::new(o.out.join("paraview"), &case.setup.name);
                 run(case, Some(0.01), |m| series.write_frame(m))
             } else {
                 run(case, None, |_| Ok(()))
             };
             bar.inc(1);
-            result
+            result.map(|r| (*k, r))
         })
         .collect::<Result<_, _>>()?;
     bar.finish_and_clear();
+    let outcomes: Vec<Outcome> = groups
+        .iter()
+        .enumerate()
+        .map(|(k, g)| {
+            let runs: Vec<&ImpactResult> = results.iter().filter(|(i, _)| *i == k).map(|(_, r)| r).collect();
+            Outcome {
+                group: g,
+                central: runs[0],
+                runs,
+            }
+        })
+        .collect();
 
     println!();
     println!(
-        "{:<24} {:>7} {:>9} {:>9} {:>9} {:>8} {:>8} {:>10} {:>9} {:>7} {:>9}",
+        "{:<26} {:>6} {:>8} {:>8} {:>13} {:>6} {:>6} {:>6} {:>7} {:>6} {:>8} {:>7} {:>9}",
         "run",
         "E [J]",
-        "1st [mm]",
-        "max [mm]",
-        "exp [mm]",
-        "v [m/s]",
+        "1st[mm]",
+        "max[mm]",
+        "spread [mm]",
+        "exp",
+        "rise",
+        "v m/s",
         "exp v",
-        "a [m/s²]",
-        "exp a",
-        "wall s",
-        "steps/s"
+        "a/1e3",
+        "|err| J",
+        "coll.",
+        "outcome"
     );
-    for r in &results {
+    for x in &outcomes {
+        let r = x.central;
         let s = &r.case.setup;
         let verdict = |c: bool| if c { "collapse" } else { "stands" };
         let exp_disp = s.max_disp.map_or("—".to_owned(), |d| format!("{:.0}", d * 1e3));
+        let sp = x.spread(|r| r.max_disp);
         println!(
-            "{:<24} {:>7.1} {:>9.1} {:>9.1} {:>9} {:>8.2} {:>8.2} {:>10.0} {:>9.0} {:>7.1} {:>9.0}   model {} / test {}",
-            r.case.label,
+            "{:<26} {:>6.1} {:>8.1} {:>8.1} {:>6.1}–{:<6.1} {:>6} {:>6.1} {:>6.2} {:>7.2} {:>6.2} {:>8.2} {:>4}/{:<2} {} / test {}",
+            x.group.label,
             r.kinetic_energy,
             r.first_peak_disp * 1e3,
             r.max_disp * 1e3,
+            sp[0] * 1e3,
+            sp[1] * 1e3,
             exp_disp,
+            r.max_rise * 1e3,
             r.max_velocity,
             s.max_velocity,
-            r.max_accel,
-            s.max_accel,
-            r.wall_s,
-            r.steps as f64 / r.wall_s,
+            r.max_accel / 1e3,
+            r.max_energy_error,
+            x.collapsed_runs(),
+            x.runs.len(),
             verdict(r.collapsed),
             verdict(s.collapsed)
         );
     }
-    let agree = results
+    let main: Vec<&Outcome> = outcomes.iter().filter(|x| x.group.kind == "main").collect();
+    let agree = main
         .iter()
-        .filter(|r| r.case.label == r.case.setup.name && r.collapsed == r.case.setup.collapsed)
+        .filter(|x| x.central.collapsed == x.central.case.setup.collapsed)
         .count();
-    let total = results.iter().filter(|r| r.case.label == r.case.setup.name).count();
-    println!("\ncollapse / no collapse as observed: {agree} of {total} setups");
+    println!(
+        "\ncollapse / no collapse as observed: {agree} of {} setups (central runs)",
+        main.len()
+    );
+    let wall: Vec<f64> = results.iter().map(|(_, r)| r.wall_s).collect();
+    println!(
+        "per-run wall {:.2}–{:.2} s (mean {:.2} s)",
+        wall.iter().copied().fold(f64::INFINITY, f64::min),
+        wall.iter().copied().fold(0.0, f64::max),
+        wall.iter().sum::<f64>() / wall.len() as f64
+    );
 
     std::fs::create_dir_all(&o.out)?;
     let summary = serde_json::json!({
         "parameters": base,
+        "height_offsets_m": offsets,
         "collapse_rule": "a voussoir's centroid drops by more than half the ring thickness below its settled position",
-        "setups": results.iter().map(summarise).collect::<Vec<_>>(),
+        "outcomes_as_observed": agree,
+        "setups": main.iter().map(|x| x.summary()).collect::<Vec<_>>(),
+        "study": outcomes.iter().filter(|x| x.group.kind == "study").map(|x| x.summary()).collect::<Vec<_>>(),
+        "release_comparison": outcomes.iter().filter(|x| x.group.kind == "release").map(|x| x.summary()).collect::<Vec<_>>(),
         "total_wall_s": started.elapsed().as_secs_f64(),
     });
     write_json(&o.out.join("summary.json"), &summary)?;
-    for r in &results {
-        let mut csv = String::from("time [s],quarter-span displacement [m],velocity [m/s],acceleration [m/s2],impact force [N],impactor velocity [m/s],kinetic [J],energy input [J],energy accounted [J]\n");
-        for s in &r.samples {
-            csv.push_str(&format!(
-                "{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}\n",
-                s.time,
-                s.disp,
-                s.velocity,
-                s.accel,
-                s.impact_force,
-                s.impactor_velocity,
-                s.kinetic,
-                s.input,
-                s.accounted
-            ));
-        }
-        let file = format!("history_{}.csv", r.case.label.replace([' ', '%', '/'], "_"));
-        std::fs::write(o.out.join(file), csv)?;
+    for x in &outcomes {
+        let file = format!("history_{}.csv", x.group.label.replace([' ', '%', '/'], "_"));
+        std::fs::write(o.out.join(file), history_csv(x.central))?;
     }
-    let main_runs: Vec<&ImpactResult> = results.iter().filter(|r| r.case.label == r.case.setup.name).collect();
     LinePlot {
         title: "Quarter-span vertical displacement".into(),
-        x_label: "time after impact [s]".into(),
+        x_label: "time after release [s]".into(),
         y_label: "displacement [mm]".into(),
-        curves: main_runs
+        curves: main
             .iter()
-            .map(|r| Curve {
-                label: r.case.setup.name.clone(),
-                points: r.samples.iter().map(|s| (s.time, s.disp * 1e3)).collect(),
+            .map(|x| Curve {
+                label: x.central.case.setup.name.clone(),
+                points: x.central.samples.iter().map(|s| (s.time, s.disp * 1e3)).collect(),
             })
             .collect(),
         references: Vec::new(),
+        legend: LegendPosition::Auto,
     }
     .write_svg(&o.out.join("displacement_time.svg"))?;
-    let standing: Vec<&&ImpactResult> = main_runs.iter().filter(|r| r.case.setup.max_disp.is_some()).collect();
-    let mut refs: Vec<Reference> = standing
+    let standing: Vec<&&Outcome> = main
         .iter()
-        .map(|r| Reference::Point {
-            label: format!("{} test", r.case.setup.name),
-            x: r.kinetic_energy,
-            y: r.case.setup.max_disp.unwrap_or(0.0) * 1e3,
+        .filter(|x| x.central.case.setup.max_disp.is_some())
+        .collect();
+    let refs: Vec<Reference> = standing
+        .iter()
+        .map(|x| Reference::Point {
+            label: format!("{} test", x.central.case.setup.name),
+            x: x.central.kinetic_energy,
+            y: x.central.case.setup.max_disp.unwrap_or(0.0) * 1e3,
         })
         .collect();
-    refs.truncate(3);
+    let curve = |label: &str, f: &dyn Fn(&Outcome) -> f64| Curve {
+        label: label.into(),
+        points: standing
+            .iter()
+            .map(|x| (x.central.kinetic_energy, f(x) * 1e3))
+            .collect(),
+    };
     LinePlot {
         title: "Maximum quarter-span displacement: model vs test (cf. paper Fig. 13)".into(),
         x_label: "impact energy [J]".into(),
         y_label: "max displacement [mm]".into(),
-        curves: vec![Curve {
-            label: "model (M60 setups)".into(),
-            points: standing.iter().map(|r| (r.kinetic_energy, r.max_disp * 1e3)).collect(),
-        }],
+        curves: vec![
+            curve("model (M60 setups)", &|x| x.central.max_disp),
+            curve("model, lowest of ±0.5 mm drops", &|x| x.spread(|r| r.max_disp)[0]),
+            curve("model, highest of ±0.5 mm drops", &|x| x.spread(|r| r.max_disp)[1]),
+        ],
         references: refs,
+        legend: LegendPosition::Auto,
     }
     .write_svg(&o.out.join("max_disp_vs_experiment.svg"))?;
     if o.study {
         let mut curves = Vec::new();
         for s in ["M60H20", "M60H25", "M60H30"] {
-            let pick = |pred: &dyn Fn(&ImpactResult) -> Option<f64>| -> Vec<(f64, f64)> {
-                let mut v: Vec<(f64, f64)> = results
+            let pick = |pred: &dyn Fn(&ImpactCase) -> Option<f64>| -> Vec<(f64, f64)> {
+                let mut v: Vec<(f64, f64)> = outcomes
                     .iter()
-                    .filter(|r| r.case.setup.name == s)
-                    .filter_map(|r| pred(r).map(|x| (x, r.max_disp * 1e3)))
+                    .filter(|x| x.central.case.setup.name == s && x.group.kind != "release")
+                    .filter_map(|x| pred(&x.central.case).map(|p| (p, x.central.max_disp * 1e3)))
                     .collect();
                 v.sort_by(|a, b| a.0.total_cmp(&b.0));
+                v.dedup_by(|a, b| a.0 == b.0);
                 v
             };
             curves.push(Curve {
                 label: format!("{s}: vs kn [GPa/m]"),
-                points: pick(&|r| (r.case.damping_ratio == base.damping_ratio).then_some(r.case.kn / 1e9)),
+                points: pick(&|c| (c.damping_ratio == base.damping_ratio).then_some(c.kn / 1e9)),
             });
             curves.push(Curve {
                 label: format!("{s}: vs damping [%]"),
-                points: pick(&|r| (r.case.kn == base.kn).then_some(r.case.damping_ratio * 100.0)),
+                points: pick(&|c| (c.kn == base.kn).then_some(c.damping_ratio * 100.0)),
             });
         }
         LinePlot {
@@ -382,6 +702,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             y_label: "max displacement [mm]".into(),
             curves,
             references: Vec::new(),
+            legend: LegendPosition::Auto,
         }
         .write_svg(&o.out.join("sensitivity.svg"))?;
     }

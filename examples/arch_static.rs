@@ -336,6 +336,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             label: format!("experiment peak {EXPERIMENT_PEAK_KN} kN"),
             y: EXPERIMENT_PEAK_KN,
         }],
+        ..Default::default()
     }
     .write_svg(&o.out.join("force_displacement.svg"))?;
     let mut sweep: Vec<(f64, f64)> = results
@@ -357,6 +358,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             x: 30.5,
             y: EXPERIMENT_PEAK_KN,
         }],
+        ..Default::default()
     }
     .write_svg(&o.out.join("capacity_vs_friction.svg"))?;
     println!(

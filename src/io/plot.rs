@@ -38,16 +38,34 @@ pub enum Reference {
     },
 }
 
+/// Where the legend goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LegendPosition {
+    /// The corner that covers the fewest curve points and no reference marker if it can
+    /// (preference on a tie: upper right, upper left, lower right, lower left).
+    #[default]
+    Auto,
+    /// Upper left corner.
+    UpperLeft,
+    /// Upper right corner.
+    UpperRight,
+    /// Lower left corner.
+    LowerLeft,
+    /// Lower right corner.
+    LowerRight,
+}
+
 /// A line plot: title, axis labels (with units), curves and references.
 ///
 /// ```
-/// use voussoir::io::plot::{Curve, LinePlot, Reference};
+/// use voussoir::io::plot::{Curve, LegendPosition, LinePlot, Reference};
 /// let plot = LinePlot {
 ///     title: "load–displacement".into(),
 ///     x_label: "displacement [mm]".into(),
 ///     y_label: "load [kN]".into(),
 ///     curves: vec![Curve { label: "model".into(), points: vec![(0.0, 0.0), (1.0, 2.5), (2.0, 2.0)] }],
 ///     references: vec![Reference::Horizontal { label: "experiment".into(), y: 2.71 }],
+///     legend: LegendPosition::Auto,
 /// };
 /// let svg = plot.to_svg_string()?;
 /// assert!(svg.contains("<svg") && svg.contains("experiment"));
@@ -65,6 +83,8 @@ pub struct LinePlot {
     pub curves: Vec<Curve>,
     /// Reference lines and points.
     pub references: Vec<Reference>,
+    /// Where the legend goes.
+    pub legend: LegendPosition,
 }
 
 const SIZE: (u32, u32) = (800, 560);
@@ -134,6 +154,79 @@ impl LinePlot {
         (span(&xs), span(&ys))
     }
 
+    /// The legend corner: the given one, or for [`LegendPosition::Auto`] the corner whose
+    /// legend box (estimated from the number of entries and the longest label) covers the
+    /// fewest curve points (segments sampled at 16 points each) — a reference marker or line
+    /// counts as 1000 points.
+    fn legend_corner(&self, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> LegendPosition {
+        if self.legend != LegendPosition::Auto {
+            return self.legend;
+        }
+        let labels = self
+            .curves
+            .iter()
+            .map(|c| c.label.as_str())
+            .chain(self.references.iter().map(|r| match r {
+                Reference::Horizontal { label, .. } | Reference::Point { label, .. } => label.as_str(),
+            }));
+        let (count, longest) = labels.fold((0usize, 0usize), |(n, w), l| (n + 1, w.max(l.chars().count())));
+        // Plot area about 700 × 430 px; legend rows 20 px, characters about 7.5 px, plus the
+        // sample and margins (45 px).
+        let w = ((longest as f64 * 7.5 + 45.0) / 700.0).min(1.0);
+        let h = ((count as f64 * 20.0 + 10.0) / 430.0).min(1.0);
+        let to_frac = |x: f64, y: f64| ((x - x0) / (x1 - x0), (y - y0) / (y1 - y0));
+        let corners = [
+            (LegendPosition::UpperRight, (1.0 - w, 1.0), (1.0 - h, 1.0)),
+            (LegendPosition::UpperLeft, (0.0, w), (1.0 - h, 1.0)),
+            (LegendPosition::LowerRight, (1.0 - w, 1.0), (0.0, h)),
+            (LegendPosition::LowerLeft, (0.0, w), (0.0, h)),
+        ];
+        let inside = |(fx, fy): (f64, f64), (ax, bx): (f64, f64), (ay, by): (f64, f64)| {
+            fx >= ax && fx <= bx && fy >= ay && fy <= by
+        };
+        let mut best = (LegendPosition::UpperRight, f64::INFINITY);
+        for (corner, bx, by) in corners {
+            let mut score = 0.0;
+            for c in &self.curves {
+                for pair in c.points.windows(2) {
+                    let ((xa, ya), (xb, yb)) = (pair[0], pair[1]);
+                    for k in 0..16 {
+                        let t = k as f64 / 16.0;
+                        if inside(to_frac(xa + t * (xb - xa), ya + t * (yb - ya)), bx, by) {
+                            score += 1.0;
+                        }
+                    }
+                }
+                if let Some(&(x, y)) = c.points.last() {
+                    if inside(to_frac(x, y), bx, by) {
+                        score += 1.0;
+                    }
+                }
+            }
+            for r in &self.references {
+                let hit = match *r {
+                    Reference::Point { x, y, .. } => {
+                        // The marker's half-size, about 10 px.
+                        let (fx, fy) = to_frac(x, y);
+                        let (mx, my) = (10.0 / 700.0, 10.0 / 430.0);
+                        fx + mx >= bx.0 && fx - mx <= bx.1 && fy + my >= by.0 && fy - my <= by.1
+                    }
+                    Reference::Horizontal { y, .. } => {
+                        let fy = to_frac(x0, y).1;
+                        fy >= by.0 && fy <= by.1
+                    }
+                };
+                if hit {
+                    score += 1000.0;
+                }
+            }
+            if score < best.1 {
+                best = (corner, score);
+            }
+        }
+        best.0
+    }
+
     fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, plotters::coord::Shift>) -> std::result::Result<(), String>
     where
         DB::ErrorType: 'static,
@@ -186,10 +279,49 @@ impl LinePlot {
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
+            .position(match self.legend_corner((x0, x1), (y0, y1)) {
+                LegendPosition::UpperLeft => SeriesLabelPosition::UpperLeft,
+                LegendPosition::LowerLeft => SeriesLabelPosition::LowerLeft,
+                LegendPosition::LowerRight => SeriesLabelPosition::LowerRight,
+                LegendPosition::UpperRight | LegendPosition::Auto => SeriesLabelPosition::UpperRight,
+            })
             .draw()
             .map_err(err)?;
         root.present().map_err(err)?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The impact benchmark's plot: three test markers rising to the upper right, model curves
+    /// low. The legend must not go to the upper right, where it would hide the M60H30 marker.
+    #[test]
+    fn auto_legend_avoids_markers() {
+        let model = |dy: f64| Curve {
+            label: "model".into(),
+            points: vec![(122.5, 15.0 + dy), (152.5, 17.0 + dy), (182.3, 18.0 + dy)],
+        };
+        let plot = LinePlot {
+            curves: vec![model(0.0), model(-1.0), model(1.0)],
+            references: [(122.5, 34.0), (152.5, 40.0), (182.3, 53.0)]
+                .iter()
+                .map(|&(x, y)| Reference::Point {
+                    label: "test".into(),
+                    x,
+                    y,
+                })
+                .collect(),
+            ..Default::default()
+        };
+        let ((x0, x1), (y0, y1)) = plot.ranges();
+        assert_eq!(plot.legend_corner((x0, x1), (y0, y1)), LegendPosition::UpperLeft);
+        let fixed = LinePlot {
+            legend: LegendPosition::LowerRight,
+            ..plot
+        };
+        assert_eq!(fixed.legend_corner((x0, x1), (y0, y1)), LegendPosition::LowerRight);
     }
 }

@@ -1,16 +1,30 @@
 //! The drop-weight impact tests of the reference arch (`BENCHMARKS.md` §4).
 //!
-//! Model: the arch of [`crate::build::arch::ArchSpec::reference`]; a steel seat resting on the extrados of voussoir 5
-//! with a horizontal top (the bearing of the test); a rigid impactor of the test's mass, 0.10 m
-//! along the span × the arch width, **guided by constrained degrees of freedom**: only its
-//! vertical translation is free. The arch and seat are first settled under gravity with local
-//! damping while the impactor is held just above the seat; then the impactor is released **just
-//! above the seat with `v0 = √(2gH)`** and the run continues with stiffness-proportional Rayleigh
-//! damping for `duration` seconds, or until the arch collapses.
+//! Default model ([`ImpactorGuide::Frame`], as the paper's §4.2: "new rigid blocks are added to
+//! simulate the frame and the free-falling object … noncohesive bonds between the falling object
+//! and frame-blocks"): the arch of [`crate::build::arch::ArchSpec::reference`]; a rigid impactor
+//! of the test's mass, 0.10 m along the span × the arch width, that is a **free** block (no
+//! constrained degree of freedom); four **fixed frame blocks** around it, two along the span and
+//! two across the width, each [`ImpactCase::guide_clearance`] away from its faces, in contact
+//! with it through a noncohesive, by default frictionless, joint (material pair
+//! [`super::STEEL`]–[`super::FRAME`]). The impactor strikes the **extrados of voussoir 5
+//! directly**; its bottom face is parallel to that extrados ([`ImpactorBase::Sloped`], the
+//! default) or horizontal ([`ImpactorBase::Flat`]).
+//!
+//! The other variant ([`ImpactorGuide::SeatConstrained`]): a steel seat resting on the extrados of
+//! voussoir 5 with a horizontal top, and an impactor guided by constrained degrees of freedom
+//! (only its vertical translation free).
+//!
+//! In both, the arch (and seat) are first settled under gravity with local damping while the
+//! impactor is held; then the impactor is released and the run continues with stiffness-
+//! proportional Rayleigh damping for `duration` seconds, or until the arch collapses. Release
+//! ([`Release`]): just above the point of contact ([`ImpactCase::release_gap`]) with the speed
+//! of the fall at that point, `√(2g(H − gap))`, so that it strikes at `√(2gH)` (the default), or
+//! at rest from the full drop height `H` above the point of contact.
 //!
 //! Collapse rule ([`collapsed_voussoir`]): a voussoir's centroid has dropped by more than half
 //! the ring thickness below its settled position. First-impact peak: the largest downward
-//! quarter-span displacement until the impactor first leaves the seat.
+//! quarter-span displacement until the impactor first leaves the arch (or seat).
 
 use std::time::Instant;
 
@@ -18,10 +32,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::block::{Block, BlockId, Dof, Fixity, RigidBlock};
 use crate::build::arch::Arch;
-use crate::error::Result;
+use crate::constitutive::CoulombSlip;
+use crate::error::{in_range, non_negative, positive, Error, Result};
 use crate::integrate::Damping;
 use crate::math::{Real, Vector};
 use crate::model::Model;
+
+/// Gravitational acceleration of the scenario (m/s², along −y).
+pub const GRAVITY: Real = 9.81;
 
 /// One of the six tests, with what was observed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -63,6 +81,40 @@ pub fn setups() -> Vec<ImpactSetup> {
     ]
 }
 
+/// How the impactor is guided.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ImpactorGuide {
+    /// A free block between fixed frame blocks, guided only through contacts, striking the
+    /// extrados of voussoir 5 directly (the paper's model; default).
+    #[default]
+    Frame,
+    /// Only the vertical translation is free (constrained degrees of freedom); it strikes a
+    /// steel seat with a horizontal top resting on voussoir 5.
+    SeatConstrained,
+}
+
+/// The shape of the impactor's bottom face ([`ImpactorGuide::Frame`] only).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum ImpactorBase {
+    /// Parallel to the extrados of voussoir 5 (20.7° to the horizontal): the whole footprint
+    /// strikes at once (default).
+    #[default]
+    Sloped,
+    /// Horizontal: the impactor strikes with the edge of its footprint on the higher side.
+    Flat,
+}
+
+/// Where the impactor starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum Release {
+    /// [`ImpactCase::release_gap`] above the point of contact, moving down at the speed of the
+    /// fall there, `√(2g(H − gap))` (default).
+    #[default]
+    JustAbove,
+    /// At rest, the drop height `H` above the point of contact.
+    FullHeight,
+}
+
 /// One analysis: a setup and the model parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImpactCase {
@@ -70,7 +122,7 @@ pub struct ImpactCase {
     pub setup: ImpactSetup,
     /// Label (setup plus what differs from the baseline).
     pub label: String,
-    /// Normal joint stiffness (Pa/m).
+    /// Normal joint stiffness (Pa/m), every stone and stone–steel joint.
     pub kn: Real,
     /// Shear joint stiffness (Pa/m).
     pub ks: Real,
@@ -86,13 +138,31 @@ pub struct ImpactCase {
     pub duration: Real,
     /// Sub-contacts per joint edge.
     pub per_edge: u16,
+    /// How the impactor is guided.
+    pub guide: ImpactorGuide,
+    /// Shape of the impactor's bottom face (frame guide only).
+    pub base: ImpactorBase,
+    /// Where the impactor starts.
+    pub release: Release,
+    /// Change of the drop height from the test's (m): the perturbation of the robustness runs.
+    pub height_offset: Real,
     /// Impactor footprint along the span (m).
     pub impactor_length: Real,
-    /// Impactor height (m); its density is set to give the test's mass.
+    /// Impactor height (m, at mid-footprint); its density is set to give the test's mass.
     pub impactor_height: Real,
-    /// Seat thickness above the highest extrados corner of voussoir 5 (m).
+    /// Gap between the impactor and each frame block (m).
+    pub guide_clearance: Real,
+    /// Thickness of the frame blocks (m).
+    pub guide_thickness: Real,
+    /// Friction angle of the impactor–frame joint (degrees); 0 = frictionless.
+    pub guide_friction_deg: Real,
+    /// Vertical distance kept between the frame blocks along the span and the arch's extrados
+    /// below them (m).
+    pub guide_standoff: Real,
+    /// Seat thickness above the highest extrados corner of voussoir 5 (m), seat variant.
     pub seat_thickness: Real,
-    /// Gap between impactor and seat at release (m).
+    /// Vertical gap between the impactor and what it strikes at release (m),
+    /// [`Release::JustAbove`].
     pub release_gap: Real,
     /// Interval of the recorded histories (s).
     pub sample_interval: Real,
@@ -100,7 +170,8 @@ pub struct ImpactCase {
 
 impl ImpactCase {
     /// The paper's values for a setup: kn = 4 GPa/m, ks = 1.6 GPa/m, φ = 30.5°, 1 % stiffness-
-    /// proportional damping at 25 Hz, width 0.15 m, 1 s.
+    /// proportional damping at 25 Hz, width 0.15 m, 1 s; the frame-guided free impactor with a
+    /// sloped base, frictionless guides 0.5 mm away, released 0.5 mm above the extrados.
     pub fn baseline(setup: ImpactSetup) -> Self {
         Self {
             label: setup.name.clone(),
@@ -113,17 +184,82 @@ impl ImpactCase {
             width: 0.15,
             duration: 1.0,
             per_edge: 15,
+            guide: ImpactorGuide::Frame,
+            base: ImpactorBase::Sloped,
+            release: Release::JustAbove,
+            height_offset: 0.0,
             impactor_length: 0.10,
             impactor_height: 0.20,
+            guide_clearance: 5e-4,
+            guide_thickness: 0.05,
+            guide_friction_deg: 0.0,
+            guide_standoff: 0.02,
             seat_thickness: 0.01,
             release_gap: 5e-4,
             sample_interval: 5e-4,
         }
     }
 
+    /// The previous default: steel seat on voussoir 5, impactor guided by constrained degrees of
+    /// freedom.
+    pub fn seat_constrained(setup: ImpactSetup) -> Self {
+        Self {
+            guide: ImpactorGuide::SeatConstrained,
+            ..Self::baseline(setup)
+        }
+    }
+
+    /// Drop height `H` of this case: the test's plus [`ImpactCase::height_offset`] (m).
+    pub fn drop_height(&self) -> Real {
+        self.setup.height + self.height_offset
+    }
+
     /// Impact velocity `√(2gH)` (m/s).
     pub fn impact_velocity(&self) -> Real {
-        (2.0 * 9.81 * self.setup.height).sqrt()
+        (2.0 * GRAVITY * self.drop_height()).sqrt()
+    }
+
+    /// Checks the parameters the scenario itself uses (the joint laws and the model check the
+    /// rest).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the first bad value.
+    pub fn validate(&self) -> Result<()> {
+        positive("impact.mass", self.setup.mass)?;
+        positive("impact.drop_height", self.drop_height())?;
+        positive("impact.width", self.width)?;
+        positive("impact.duration", self.duration)?;
+        positive("impact.impactor_length", self.impactor_length)?;
+        positive("impact.impactor_height", self.impactor_height)?;
+        non_negative("impact.guide_clearance", self.guide_clearance)?;
+        positive("impact.guide_thickness", self.guide_thickness)?;
+        positive("impact.guide_standoff", self.guide_standoff)?;
+        positive("impact.seat_thickness", self.seat_thickness)?;
+        positive("impact.sample_interval", self.sample_interval)?;
+        in_range(
+            "impact.guide_friction_deg",
+            self.guide_friction_deg,
+            0.0,
+            89.999,
+            "must lie in [0°, 90°)",
+        )?;
+        non_negative("impact.release_gap", self.release_gap)?;
+        if self.release == Release::JustAbove && self.release_gap >= self.drop_height() {
+            return Err(Error::InvalidParameter {
+                name: "impact.release_gap".into(),
+                value: self.release_gap,
+                expected: "smaller than the drop height",
+            });
+        }
+        // The footprint must lie on the extrados of voussoir 5 (0.1436 m along the span).
+        in_range(
+            "impact.impactor_length",
+            self.impactor_length,
+            0.0,
+            0.14,
+            "at most 0.14 m (the extrados of voussoir 5)",
+        )?;
+        Ok(())
     }
 }
 
@@ -139,15 +275,33 @@ pub struct ImpactSample {
     pub velocity: Real,
     /// Its vertical acceleration, from the velocity change over the sample interval (m/s²).
     pub accel: Real,
-    /// Force between impactor and seat (N).
+    /// Vertical force of the struck blocks (voussoirs, or seat) on the impactor (N, up positive).
     pub impact_force: Real,
     /// Impactor velocity (m/s, up positive).
     pub impactor_velocity: Real,
-    /// Kinetic energy (J).
+    /// Horizontal displacement of the impactor's centroid since release (m): along the span.
+    pub impactor_drift_x: Real,
+    /// Across the width (m).
+    pub impactor_drift_z: Real,
+    /// Kinetic energy of every block (J).
     pub kinetic: Real,
-    /// Energy input since release: initial kinetic + works of gravity, loads and supports (J).
+    /// Kinetic energy of the impactor (J).
+    pub impactor_kinetic: Real,
+    /// Potential energy of the ring (voussoirs, and the seat) relative to its settled position,
+    /// `Σ m·g·Δy` (J).
+    pub arch_potential: Real,
+    /// Elastic energy in the joint springs, change since release (J).
+    pub elastic: Real,
+    /// Energy dissipated by slip since release (J).
+    pub friction: Real,
+    /// Energy dissipated by damping since release (J).
+    pub damping: Real,
+    /// Work of gravity since release (J).
+    pub gravity_work: Real,
+    /// Energy input since just before release: the kinetic energy given to the impactor + works
+    /// of gravity, loads and supports (J).
     pub input: Real,
-    /// Kinetic + elastic + dissipated energy (J).
+    /// Change of kinetic + elastic + dissipated energy since just before release (J).
     pub accounted: Real,
 }
 
@@ -156,29 +310,51 @@ pub struct ImpactSample {
 pub struct ImpactResult {
     /// The case.
     pub case: ImpactCase,
-    /// Impactor velocity just before contact (m/s, downwards positive).
+    /// Nominal impact velocity `√(2gH)` (m/s, downwards positive).
     pub v0: Real,
-    /// Impactor momentum just before contact (kg·m/s).
+    /// Vertical gap between impactor and target measured after settling, at release (m).
+    pub release_gap: Real,
+    /// Impactor speed given at release (m/s, downwards).
+    pub release_velocity: Real,
+    /// Impactor speed at the last step before first contact (m/s, downwards).
+    pub contact_speed: Real,
+    /// Time of the first contact force (s after release).
+    pub contact_time: Real,
+    /// Impactor momentum at contact, nominal (kg·m/s).
     pub momentum: Real,
-    /// Impactor kinetic energy just before contact (J).
+    /// Impactor kinetic energy at contact, nominal (J).
     pub kinetic_energy: Real,
     /// Largest downward quarter-span displacement during the first impact, until the impactor
-    /// first leaves the seat (m).
+    /// first leaves the arch (m).
     pub first_peak_disp: Real,
     /// Largest downward quarter-span displacement over the run (m).
     pub max_disp: Real,
+    /// Largest upward quarter-span displacement above its settled position after first contact
+    /// (m), and when (s after release).
+    pub max_rise: Real,
+    /// Time of [`ImpactResult::max_rise`] (s).
+    pub max_rise_time: Real,
     /// Largest quarter-span speed (m/s).
     pub max_velocity: Real,
     /// Largest quarter-span acceleration (m/s²).
     pub max_accel: Real,
     /// Largest impact force (N).
     pub max_impact_force: Real,
-    /// Whether the collapse rule fired, and when (s after release).
+    /// Largest horizontal displacement of the impactor's centroid (m), along the span and
+    /// across, sampled.
+    pub max_impactor_drift: [Real; 2],
+    /// Largest rotation of the impactor (rad), sampled.
+    pub max_impactor_rotation: Real,
+    /// Whether the collapse rule fired.
     pub collapsed: bool,
-    /// Time of collapse (s).
+    /// Time of collapse (s after release).
     pub collapse_time: Option<Real>,
     /// Largest excess of energy over input during the run (J).
     pub max_energy_excess: Real,
+    /// Largest `|accounted − input|` during the run (J).
+    pub max_energy_error: Real,
+    /// Excess of energy over input at the end of the run (J).
+    pub final_energy_excess: Real,
     /// Histories.
     pub samples: Vec<ImpactSample>,
     /// Steps after release.
@@ -196,10 +372,20 @@ pub struct ImpactModel {
     pub model: Model,
     /// The arch.
     pub arch: Arch,
-    /// The seat on voussoir 5.
-    pub seat: BlockId,
+    /// The seat on voussoir 5 ([`ImpactorGuide::SeatConstrained`]).
+    pub seat: Option<BlockId>,
     /// The impactor.
     pub impactor: BlockId,
+    /// The fixed frame blocks ([`ImpactorGuide::Frame`]): along the span (left, right), then
+    /// across the width (front, back).
+    pub frame: Vec<BlockId>,
+    /// The blocks the impactor can strike: every voussoir, or the seat.
+    pub targets: Vec<BlockId>,
+    /// The impactor's two lowest corners along the span at mid-width, as built (world, m).
+    pub impactor_bottom: [Vector; 2],
+    /// The surface it strikes, as two points of the target block at mid-width (world, as built):
+    /// the extrados chord of voussoir 5, or the seat's top.
+    pub struck: (BlockId, [Vector; 2]),
 }
 
 const VOUSSOIR: usize = 5;
@@ -207,8 +393,9 @@ const VOUSSOIR: usize = 5;
 /// Builds the model (not settled; impactor held).
 ///
 /// # Errors
-/// Invalid parameters.
+/// [`Error::InvalidParameter`] for bad parameters.
 pub fn build(case: &ImpactCase) -> Result<ImpactModel> {
+    case.validate()?;
     let (mut model, arch) = super::reference_arch_model(super::ArchJoints {
         width: case.width,
         per_edge: case.per_edge,
@@ -217,34 +404,128 @@ pub fn build(case: &ImpactCase) -> Result<ImpactModel> {
         friction_deg: case.friction_deg,
         mode: crate::contact::DisplacementMode::Large,
     })?;
-    let steel = super::STEEL;
+    let (steel, frame) = (super::STEEL, super::FRAME);
+    let stone_law = CoulombSlip::dry(case.kn, case.ks, case.friction_deg)?;
+    let guide_law = CoulombSlip::dry(case.kn, case.ks, case.guide_friction_deg)?;
+    model.set_joint_law(steel, frame, guide_law)?;
+    // The frame is not meant to touch the arch; should a stone reach it, it is a stone joint.
+    model.set_joint_law(super::STONE, frame, stone_law)?;
+    model.set_joint_law(frame, frame, stone_law)?;
+
+    let b = case.width;
     let e0 = arch.joints[VOUSSOIR - 1].extrados;
     let e1 = arch.joints[VOUSSOIR].extrados;
-    let top = e0.y.max(e1.y) + case.seat_thickness;
-    let b = case.width;
-    let seat_outline = [e0, e1, Vector::new(e1.x, top, 0.0), Vector::new(e0.x, top, 0.0)];
-    let seat_pts: Vec<Vector> = seat_outline
-        .iter()
-        .flat_map(|p| [Vector::new(p.x, p.y, 0.0), Vector::new(p.x, p.y, b)])
-        .collect();
-    let seat = model.add_block(RigidBlock::from_vertices("seat", &seat_pts, 7850.0)?.with_material(steel))?;
     let xc = arch.extrados_midpoint(VOUSSOIR).x;
     let (l, h) = (case.impactor_length, case.impactor_height);
+    let (xl, xr) = (xc - 0.5 * l, xc + 0.5 * l);
+    let slope = (e1.y - e0.y) / (e1.x - e0.x);
+    let extrados_y = |x: Real| e0.y + slope * (x - e0.x);
+    // Height above the point of contact at which the impactor starts.
+    let lift = match case.release {
+        Release::JustAbove => case.release_gap,
+        Release::FullHeight => case.drop_height(),
+    };
+    let mid = 0.5 * b;
+    let extrude = |outline: &[(Real, Real)], z0: Real, z1: Real| -> Vec<Vector> {
+        outline
+            .iter()
+            .flat_map(|&(x, y)| [Vector::new(x, y, z0), Vector::new(x, y, z1)])
+            .collect()
+    };
     let density = case.setup.mass / (l * h * b);
-    let lo = Vector::new(xc - 0.5 * l, top + case.release_gap, 0.0);
-    let impactor = RigidBlock::cuboid("impactor", lo, lo + Vector::new(l, h, b), density)?
-        .with_material(steel)
-        .with_fixity(Fixity::FIXED);
-    let impactor = model.add_block(impactor)?;
-    Ok(ImpactModel {
-        model,
-        arch,
-        seat,
-        impactor,
-    })
+    match case.guide {
+        ImpactorGuide::SeatConstrained => {
+            let top = e0.y.max(e1.y) + case.seat_thickness;
+            let seat_pts = extrude(&[(e0.x, e0.y), (e1.x, e1.y), (e1.x, top), (e0.x, top)], 0.0, b);
+            let seat = model.add_block(RigidBlock::from_vertices("seat", &seat_pts, 7850.0)?.with_material(steel))?;
+            let y0 = top + lift;
+            let lo = Vector::new(xl, y0, 0.0);
+            let impactor = RigidBlock::cuboid("impactor", lo, lo + Vector::new(l, h, b), density)?
+                .with_material(steel)
+                .with_fixity(Fixity::FIXED);
+            let impactor = model.add_block(impactor)?;
+            Ok(ImpactModel {
+                model,
+                arch,
+                seat: Some(seat),
+                impactor,
+                frame: Vec::new(),
+                targets: vec![seat],
+                impactor_bottom: [Vector::new(xl, y0, mid), Vector::new(xr, y0, mid)],
+                struck: (seat, [Vector::new(e0.x, top, mid), Vector::new(e1.x, top, mid)]),
+            })
+        }
+        ImpactorGuide::Frame => {
+            // The impactor at the point of contact: bottom corners and top.
+            let (bl, br, top) = match case.base {
+                ImpactorBase::Sloped => (extrados_y(xl), extrados_y(xr), extrados_y(xc) + h),
+                ImpactorBase::Flat => {
+                    let y = extrados_y(xl).max(extrados_y(xr));
+                    (y, y, y + h)
+                }
+            };
+            let outline = [(xl, bl + lift), (xr, br + lift), (xr, top + lift), (xl, top + lift)];
+            let impactor = RigidBlock::from_vertices("impactor", &extrude(&outline, 0.0, b), density)?
+                .with_material(steel)
+                .with_fixity(Fixity::FIXED);
+            let impactor = model.add_block(impactor)?;
+            // The frame spans the whole fall (as the test's did), whatever the release, from
+            // `guide_standoff` above the extrados below it to above the impactor at full height.
+            let frame_top = top + case.drop_height().max(lift) + case.guide_standoff;
+            let (c, t) = (case.guide_clearance, case.guide_thickness);
+            let extrados_max = |x0: Real, x1: Real| -> Real {
+                let mut y = Real::NEG_INFINITY;
+                let polyline: Vec<Vector> = arch.joints.iter().map(|j| j.extrados).collect();
+                for w in polyline.windows(2) {
+                    let (p, q) = (w[0], w[1]);
+                    let (a, z) = (p.x.max(x0), q.x.min(x1));
+                    if a <= z {
+                        let at = |x: Real| p.y + (q.y - p.y) * (x - p.x) / (q.x - p.x);
+                        y = y.max(at(a)).max(at(z));
+                    }
+                }
+                y
+            };
+            let mut frame_ids = Vec::new();
+            for (name, x0, x1) in [("frame left", xl - c - t, xl - c), ("frame right", xr + c, xr + c + t)] {
+                let bottom = extrados_max(x0, x1) + case.guide_standoff;
+                let pts = extrude(&[(x0, bottom), (x1, bottom), (x1, frame_top), (x0, frame_top)], 0.0, b);
+                let block = RigidBlock::from_vertices(name, &pts, 7850.0)?
+                    .with_material(frame)
+                    .with_fixity(Fixity::FIXED);
+                frame_ids.push(model.add_block(block)?);
+            }
+            // Across the width the frame lies outside the arch (z < 0, z > b): it reaches down
+            // to the springing line without touching a stone.
+            for (name, z0, z1) in [("frame front", -c - t, -c), ("frame back", b + c, b + c + t)] {
+                let pts = extrude(&[(xl, 0.0), (xr, 0.0), (xr, frame_top), (xl, frame_top)], z0, z1);
+                let block = RigidBlock::from_vertices(name, &pts, 7850.0)?
+                    .with_material(frame)
+                    .with_fixity(Fixity::FIXED);
+                frame_ids.push(model.add_block(block)?);
+            }
+            let targets = (1..=arch.spec.voussoirs)
+                .map(|k| BlockId(arch.voussoir(k) as u32))
+                .collect();
+            let struck = (
+                BlockId(arch.voussoir(VOUSSOIR) as u32),
+                [Vector::new(e0.x, e0.y, mid), Vector::new(e1.x, e1.y, mid)],
+            );
+            Ok(ImpactModel {
+                model,
+                arch,
+                seat: None,
+                impactor,
+                frame: frame_ids,
+                targets,
+                impactor_bottom: [Vector::new(xl, bl + lift, mid), Vector::new(xr, br + lift, mid)],
+                struck,
+            })
+        }
+    }
 }
 
-/// The guide: only the vertical translation is free.
+/// The guide of the seat variant: only the vertical translation is free.
 fn guided() -> Fixity {
     Fixity {
         translation: [Dof::Fixed, Dof::Free, Dof::Fixed],
@@ -262,60 +543,115 @@ pub fn collapsed_voussoir(model: &Model, arch: &Arch, settled: &[Vector]) -> Opt
     })
 }
 
+/// The current position of a point given in the world frame of the block's initial pose.
+fn moved(model: &Model, id: BlockId, initial_world: Vector) -> Vector {
+    let b = &model.blocks()[id.index()];
+    b.world_point(b.initial_pose().inverse_transform_point(initial_world))
+}
+
+/// Smallest vertical gap between the impactor's bottom corners and the struck surface (m).
+fn vertical_gap(model: &Model, m: &ImpactModel) -> Real {
+    let (id, [p, q]) = m.struck;
+    let (p, q) = (moved(model, id, p), moved(model, id, q));
+    m.impactor_bottom
+        .iter()
+        .map(|&c| {
+            let c = moved(model, m.impactor, c);
+            c.y - (p.y + (q.y - p.y) * (c.x - p.x) / (q.x - p.x))
+        })
+        .fold(Real::INFINITY, Real::min)
+}
+
+/// Vertical force of the targets on the impactor (N, up positive): the impactor is added after
+/// them, so it is the `b` block of each contact.
+fn impact_force(model: &Model, targets: &[BlockId], impactor: BlockId) -> Real {
+    targets
+        .iter()
+        .filter_map(|&t| model.contact_between(t, impactor))
+        .map(|c| c.resultant().y)
+        .sum()
+}
+
 /// Runs a case.
 ///
 /// # Errors
-/// Divergence or settling failure.
+/// Invalid parameters, divergence or settling failure.
 pub fn run(
     case: &ImpactCase,
     frame_every: Option<Real>,
     mut on_frame: impl FnMut(&Model) -> Result<()>,
 ) -> Result<ImpactResult> {
     let started = Instant::now();
-    let ImpactModel {
-        mut model,
-        arch,
-        seat,
-        impactor,
-    } = build(case)?;
-    model.run_to_equilibrium(1e-5, 200_000)?;
+    let mut im = build(case)?;
+    im.model.run_to_equilibrium(1e-5, 200_000)?;
+    let arch = im.arch.clone();
+    let impactor = im.impactor;
     let settled: Vec<Vector> = (1..=arch.spec.voussoirs)
-        .map(|k| model.blocks()[arch.voussoir(k)].state().pose.translation)
+        .map(|k| im.model.blocks()[arch.voussoir(k)].state().pose.translation)
+        .collect();
+    // Blocks of the ring whose potential energy is tracked: voussoirs and seat.
+    let ring: Vec<(BlockId, Real, Real)> = (1..=arch.spec.voussoirs)
+        .map(|k| BlockId(arch.voussoir(k) as u32))
+        .chain(im.seat)
+        .map(|id| {
+            let b = &im.model.blocks()[id.index()];
+            (id, b.mass_properties().mass, b.state().pose.translation.y)
+        })
         .collect();
     let quarter = arch.extrados_midpoint(VOUSSOIR);
     let q_block = BlockId(arch.voussoir(VOUSSOIR) as u32);
-    let q_local = model.blocks()[q_block.index()]
-        .initial_pose()
-        .inverse_transform_point(quarter);
-    let q_settled = model.blocks()[q_block.index()].world_point(q_local);
+    let q_settled = moved(&im.model, q_block, quarter);
 
-    // Release.
+    // Release: the speed of the fall at the measured gap, so that the impactor strikes at √(2gH).
+    let gap = vertical_gap(&im.model, &im);
     let v0 = case.impact_velocity();
-    model.set_fixity(impactor, guided())?;
-    model.set_velocity(impactor, Vector::new(0.0, -v0, 0.0), Vector::ZERO)?;
+    let v_release = (2.0 * GRAVITY * (case.drop_height() - gap).max(0.0)).sqrt();
+    let fixity = match case.guide {
+        ImpactorGuide::Frame => Fixity::FREE,
+        ImpactorGuide::SeatConstrained => guided(),
+    };
+    let targets = im.targets.clone();
+    let model = &mut im.model;
+    // Energies from just before release: the kinetic energy given to the impactor counts as input.
+    let e0 = model.energies();
+    model.set_fixity(impactor, fixity)?;
+    model.set_velocity(impactor, Vector::new(0.0, -v_release, 0.0), Vector::ZERO)?;
     model.set_damping(Damping::rayleigh_stiffness(case.damping_ratio, case.damping_frequency)?)?;
+    let impactor_start = model.blocks()[impactor.index()].state().pose;
     let t0 = model.time();
     let step0 = model.step_count();
-    let e0 = model.energies();
-    let input0 = e0.input();
     let mut samples = Vec::new();
     let mut last_v = 0.0;
     let mut next_sample = 0.0;
     let mut next_frame = 0.0;
     let (mut first_peak, mut first_done, mut impact_started): (Real, bool, bool) = (0.0, false, false);
+    let (mut contact_speed, mut contact_time) = (v_release, Real::NAN);
     let (mut max_disp, mut max_v, mut max_a, mut max_f, mut max_excess): (Real, Real, Real, Real, Real) =
         (0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut max_rise, mut max_rise_time): (Real, Real) = (0.0, 0.0);
+    let (mut max_drift, mut max_rot): ([Real; 2], Real) = ([0.0; 2], 0.0);
+    let mut max_error: Real = 0.0;
     let mut collapse_time = None;
     let mut last_sample_t = 0.0;
     loop {
+        let before = -model.blocks()[impactor.index()].state().velocity.y;
         model.step()?;
         let t = model.time() - t0;
+        if !impact_started {
+            // Checked every step until the first contact, so the speed at contact is exact.
+            let force = impact_force(model, &targets, impactor);
+            if force > 0.0 {
+                impact_started = true;
+                contact_speed = before;
+                contact_time = t;
+            }
+        }
         if t + 1e-12 < next_sample && t < case.duration {
             continue;
         }
         next_sample += case.sample_interval;
         let qb = &model.blocks()[q_block.index()];
-        let p = qb.world_point(q_local);
+        let p = moved(model, q_block, quarter);
         let disp = p.y - q_settled.y;
         let velocity = qb.point_velocity(p).y;
         let accel = if t > last_sample_t {
@@ -325,43 +661,63 @@ pub fn run(
         };
         last_v = velocity;
         last_sample_t = t;
-        let force = model.contact_between(seat, impactor).map_or(0.0, |c| c.resultant().y);
+        let force = impact_force(model, &targets, impactor);
         let e = model.energies();
+        let ib = &model.blocks()[impactor.index()];
+        let pose = ib.state().pose;
+        let drift = pose.translation - impactor_start.translation;
+        let rotation = (pose.rotation * impactor_start.rotation.inverse()).to_axis_angle().1;
+        let arch_potential: Real = ring
+            .iter()
+            .map(|&(id, m, y0)| m * GRAVITY * (model.blocks()[id.index()].state().pose.translation.y - y0))
+            .sum();
         let sample = ImpactSample {
             time: t,
             disp,
             velocity,
             accel,
             impact_force: force,
-            impactor_velocity: model.blocks()[impactor.index()].state().velocity.y,
+            impactor_velocity: ib.state().velocity.y,
+            impactor_drift_x: drift.x,
+            impactor_drift_z: drift.z,
             kinetic: e.kinetic,
-            input: e.input() - input0,
+            impactor_kinetic: ib.kinetic_energy(),
+            arch_potential,
+            elastic: e.elastic - e0.elastic,
+            friction: e.friction - e0.friction,
+            damping: e.damping - e0.damping,
+            gravity_work: e.gravity_work - e0.gravity_work,
+            input: e.input() - e0.input(),
             accounted: e.accounted() - e0.accounted(),
         };
-        if force > 0.0 {
-            impact_started = true;
-        }
         if impact_started && !first_done {
             first_peak = first_peak.max(-disp);
-            // The first impact ends when the impactor leaves the seat (the contact force returns
+            // The first impact ends when the impactor leaves the arch (the contact force returns
             // to zero); if it rides the arch down, the first peak is the overall maximum.
             if force <= 0.0 {
                 first_done = true;
             }
         }
+        if impact_started && disp > max_rise {
+            max_rise = disp;
+            max_rise_time = t;
+        }
         max_disp = max_disp.max(-disp);
         max_v = max_v.max(velocity.abs());
         max_a = max_a.max(accel.abs());
         max_f = max_f.max(force);
+        max_drift = [max_drift[0].max(drift.x.abs()), max_drift[1].max(drift.z.abs())];
+        max_rot = max_rot.max(rotation.abs());
         max_excess = max_excess.max(sample.accounted - sample.input);
+        max_error = max_error.max((sample.accounted - sample.input).abs());
         samples.push(sample);
         if let Some(every) = frame_every {
             if t >= next_frame {
-                on_frame(&model)?;
+                on_frame(model)?;
                 next_frame += every;
             }
         }
-        if collapse_time.is_none() && collapsed_voussoir(&model, &arch, &settled).is_some() {
+        if collapse_time.is_none() && collapsed_voussoir(model, &arch, &settled).is_some() {
             collapse_time = Some(t);
         }
         // After a collapse, keep 0.1 s for the record, then stop.
@@ -373,16 +729,26 @@ pub fn run(
     Ok(ImpactResult {
         case: case.clone(),
         v0,
+        release_gap: gap,
+        release_velocity: v_release,
+        contact_speed,
+        contact_time,
         momentum: mass * v0,
         kinetic_energy: 0.5 * mass * v0 * v0,
         first_peak_disp: first_peak,
         max_disp,
+        max_rise,
+        max_rise_time,
         max_velocity: max_v,
         max_accel: max_a,
         max_impact_force: max_f,
+        max_impactor_drift: max_drift,
+        max_impactor_rotation: max_rot,
         collapsed: collapse_time.is_some(),
         collapse_time,
         max_energy_excess: max_excess,
+        max_energy_error: max_error,
+        final_energy_excess: samples.last().map_or(0.0, |s| s.accounted - s.input),
         samples,
         steps: model.step_count() - step0,
         dt: model.dt(),

@@ -17,6 +17,8 @@ use crate::model::{Model, ModelParameters};
 pub const STONE: MaterialId = MaterialId(0);
 /// Material of the steel loading parts (plate, seat, impactor).
 pub const STEEL: MaterialId = MaterialId(1);
+/// Material of the fixed frame that guides the impactor of the impact tests.
+pub const FRAME: MaterialId = MaterialId(2);
 
 /// The joint parameters shared by the scenarios.
 #[derive(Debug, Clone, Copy)]
