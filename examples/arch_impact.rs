@@ -460,6 +460,73 @@ ring potential [J],elastic [J],friction [J],damping [J],gravity work [J],energy 
     csv
 }
 
+/// Markdown tables of the run, for `docs/benchmarks/arch-impact.md`.
+fn markdown(outcomes: &[Outcome], agree: usize, main_count: usize) -> String {
+    let mm = |x: f64| format!("{:.1}", x * 1e3);
+    let verdict = |c: bool| if c { "collapse" } else { "stands" };
+    let mut md = String::new();
+    md.push_str(&format!(
+        "Outcomes as observed (central runs): **{agree} of {main_count}**.\n\n\
+| run | E [J] | model | test | collapsed runs | first impact [mm] | max [mm] | spread of max [mm] | test max [mm] | max / test | v max [m/s] | test v | a max [m/s²] | test a | rise [mm] at [s] |\n\
+|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
+    ));
+    for x in outcomes {
+        let r = x.central;
+        let s = &r.case.setup;
+        let sp = x.spread(|r| r.max_disp);
+        let sp1 = x.spread(|r| r.first_peak_disp);
+        md.push_str(&format!(
+            "| {} | {:.1} | {} | {} | {}/{} | {} ({}–{}) | {} | {}–{} | {} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {} at {:.3} |\n",
+            x.group.label,
+            r.kinetic_energy,
+            verdict(r.collapsed),
+            verdict(s.collapsed),
+            x.collapsed_runs(),
+            x.runs.len(),
+            mm(r.first_peak_disp),
+            mm(sp1[0]),
+            mm(sp1[1]),
+            mm(r.max_disp),
+            mm(sp[0]),
+            mm(sp[1]),
+            s.max_disp.map_or("—".into(), mm),
+            s.max_disp.map_or("—".into(), |d| format!("{:.2}", r.max_disp / d)),
+            r.max_velocity,
+            s.max_velocity,
+            r.max_accel,
+            s.max_accel,
+            mm(r.max_rise),
+            r.max_rise_time
+        ));
+    }
+    md.push_str(
+        "\nEnergy balance of the central runs, changes from just before release to the end of the run (J):\n\n\
+| run | input | kinetic | elastic | friction | damping | gravity work | ring potential | max \\|error\\| | steps | dt [s] | wall [s] |\n\
+|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for x in outcomes {
+        let r = x.central;
+        if let Some(l) = r.samples.last() {
+            md.push_str(&format!(
+                "| {} | {:.1} | {:.2} | {:.2} | {:.1} | {:.1} | {:.1} | {:.1} | {:.3} | {} | {:.2e} | {:.2} |\n",
+                x.group.label,
+                l.input,
+                l.kinetic,
+                l.elastic,
+                l.friction,
+                l.damping,
+                l.gravity_work,
+                l.arch_potential,
+                r.max_energy_error,
+                r.steps,
+                r.dt,
+                r.wall_s
+            ));
+        }
+    }
+    md
+}
+
 fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     let o = parse()?;
     let started = Instant::now();
@@ -623,6 +690,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         "total_wall_s": started.elapsed().as_secs_f64(),
     });
     write_json(&o.out.join("summary.json"), &summary)?;
+    std::fs::write(o.out.join("tables.md"), markdown(&outcomes, agree, main.len()))?;
     for x in &outcomes {
         let file = format!("history_{}.csv", x.group.label.replace([' ', '%', '/'], "_"));
         std::fs::write(o.out.join(file), history_csv(x.central))?;

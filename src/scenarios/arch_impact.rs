@@ -24,7 +24,7 @@
 //!
 //! Collapse rule ([`collapsed_voussoir`]): a voussoir's centroid has dropped by more than half
 //! the ring thickness below its settled position. First-impact peak: the largest downward
-//! quarter-span displacement until the impactor first leaves the arch (or seat).
+//! quarter-span displacement until the impactor first moves up (its first rebound).
 
 use std::time::Instant;
 
@@ -325,7 +325,7 @@ pub struct ImpactResult {
     /// Impactor kinetic energy at contact, nominal (J).
     pub kinetic_energy: Real,
     /// Largest downward quarter-span displacement during the first impact, until the impactor
-    /// first leaves the arch (m).
+    /// first moves up (m).
     pub first_peak_disp: Real,
     /// Largest downward quarter-span displacement over the run (m).
     pub max_disp: Real,
@@ -692,9 +692,10 @@ pub fn run(
         };
         if impact_started && !first_done {
             first_peak = first_peak.max(-disp);
-            // The first impact ends when the impactor leaves the arch (the contact force returns
-            // to zero); if it rides the arch down, the first peak is the overall maximum.
-            if force <= 0.0 {
+            // The first impact ends when the impactor first moves up (its rebound); if it rides
+            // the arch down, the first peak is the overall maximum. (The contact force is no
+            // measure of it: the impactor chatters on the arch within the first milliseconds.)
+            if sample.impactor_velocity > 0.0 {
                 first_done = true;
             }
         }
