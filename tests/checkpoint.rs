@@ -149,7 +149,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("wrenches");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 7"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 8"),
         "{err}"
     );
     // One wrench per contact.

@@ -338,11 +338,11 @@ fn bad_contact_and_run_parameters() {
         ),
         (
             ContactParameters {
-                face_angle_tolerance: 1.0,
+                face_angle_tolerance: 1.4,
                 ..ContactParameters::default()
             },
             "contact.face_angle_tolerance",
-            1.0,
+            1.4,
         ),
         (
             ContactParameters {

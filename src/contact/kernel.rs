@@ -6,7 +6,6 @@ use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, 
 use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::constitutive::{ConstitutiveLaw, ElasticRegime, JointAxes, JointForce, JointStatus, JointStep};
-use crate::geometry::ContactKind;
 use crate::math::{Matrix, Real, Vector, Vector2};
 
 /// What a contact's update returns besides what it stores in the contact: its wrench on the two
@@ -16,6 +15,8 @@ pub(crate) struct ContactStep {
     pub wrench: ContactWrench,
     /// Work done on the joint springs (J), trapezoidal rule.
     pub work: Real,
+    /// Energy the law dissipated at the sub-contacts that slid or changed state (J).
+    pub dissipated: Real,
     /// Work of the dashpot forces (J, negative: dissipated).
     pub dashpot_work: Real,
 }
@@ -60,28 +61,21 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let host = pair.frame(reference, &sa.pose, &sb.pose, ctx.mode);
     let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, ctx.mode);
     let xh = host.translation;
-    // Face-face, large displacements: gap(p) = (d − m·p)/(m·h) for the other face's plane
-    // m·x = d and the host face's normal h; with p = x_h + r, gap = g₀ − q·r.
+    // Large displacements: the gap of the anchor p is its signed distance from the other
+    // block's plane m·x = d (m its outward normal, turning with it), gap = m·p − d; with
+    // p = x_h + r, gap = g₀ − q·r for g₀ = m·x_h − d and q = −m. The joint normal is m,
+    // oriented from a to b, so that the normal force is the gradient of the spring energy.
     let mut face_plane = None;
     if ctx.mode == DisplacementMode::Large {
-        match pair.kind {
-            ContactKind::FaceFace { .. } => {
-                let na = *rotation_a * pair.local_normal_a;
-                let nb = *rotation_b * pair.local_normal_b;
-                pair.normal = (na - nb).normalize();
-                let (host_n, other_n, other_x) = if pair.host_is_a {
-                    (na, nb, sb.pose.translation)
-                } else {
-                    (nb, na, sa.pose.translation)
-                };
-                let other_offset = pair.local_other_offset + other_n.dot(other_x);
-                let inv_cos = 1.0 / other_n.dot(host_n);
-                face_plane = Some(((other_offset - other_n.dot(xh)) * inv_cos, other_n * inv_cos));
-            }
-            ContactKind::Point { normal_local } => {
-                pair.normal = *rotation_a * normal_local;
-            }
-        }
+        let (rotation_other, x_other) = if pair.host_is_a {
+            (rotation_b, sb.pose.translation)
+        } else {
+            (rotation_a, sa.pose.translation)
+        };
+        let m = *rotation_other * pair.plane_normal;
+        let d = pair.plane_offset + m.dot(x_other);
+        pair.normal = if pair.host_is_a { -m } else { m };
+        face_plane = Some((m.dot(xh) - d, -m));
         pair.tangent = turned_tangent(previous_axes, pair.normal);
     }
     let axes = pair.axes();
@@ -140,10 +134,11 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // Without dashpot forces, four sub-contacts at a time; the rest (and everything when there
     // are dashpots) one at a time, continuing the sums of the groups.
     let mut done = 0;
+    let mut dissipated = 0.0;
     let elastic_regime = if dashpots { None } else { law.elastic_regime() };
     if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
-        sums = match face_gap_coefficients {
+        (sums, dissipated) = match face_gap_coefficients {
             Some(g) => update_elastic_first(subs, law, &regime, &kinematics, Some(g), axes, dt),
             None => update_elastic_first(subs, law, &regime, &kinematics, None, axes, dt),
         };
@@ -161,7 +156,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             update_group(group, law, &frame, &mut lanes);
         }
         done = groups.len() * LANES;
-        sums = lanes.total();
+        (sums, dissipated) = lanes.total();
     }
     for (sub, record) in subs[done..].iter_mut().zip(records[done..].iter_mut()) {
         let (x, y) = (sub.plane.x, sub.plane.y);
@@ -177,7 +172,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let [du_n, du_1, du_2] = increment(&kinematics, x, y);
         let du_s = Vector2::new(du_1, du_2);
         let gap = face.unwrap_or(sub.gap + du_n);
-        let status = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        dissipated += lost;
         sums.add_joint(&sub.force, sub.plane);
         if dashpots {
             let mut dashpot = Vector::ZERO;
@@ -220,15 +216,17 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             moment_b,
         },
         work: -0.5 * spring_sum,
+        dissipated,
         dashpot_work: -0.5 * dashpot_sum,
     }
 }
 
 /// The sub-contacts of a contact without dashpot forces, for a law with an [`ElasticRegime`]:
 /// a virgin sub-contact whose trial forces stand takes them directly; the others (open, sliding,
-/// failed) go through the law exactly as in the one-at-a-time loop. `face` holds the face-face
-/// gap coefficients (large displacements), `None` for gaps carried incrementally. Returns the
-/// spring-force sums in the joint axes, taken in sub-contact order.
+/// failed) go through the law exactly as in the one-at-a-time loop. `face` holds the gap
+/// coefficients (large displacements), `None` for gaps carried incrementally. Returns the
+/// spring-force sums in the joint axes, taken in sub-contact order, and the energy the law
+/// dissipated.
 #[inline(always)]
 fn update_elastic_first<L: ConstitutiveLaw>(
     subs: &mut [SubContact<L::State>],
@@ -238,9 +236,10 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     face: Option<(Real, Real, Real)>,
     axes: JointAxes,
     dt: Real,
-) -> ForceMoments {
+) -> (ForceMoments, Real) {
     let virgin = L::State::default();
     let mut sums = ForceMoments::default();
+    let mut dissipated = 0.0;
     for sub in subs.iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
@@ -262,10 +261,10 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             sub.gap = gap;
             continue;
         }
-        update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt).1;
         sums.add_joint(&sub.force, sub.plane);
     }
-    sums
+    (sums, dissipated)
 }
 
 /// The first tangent of `previous` turned into the plane normal to `normal` by the smallest
@@ -283,6 +282,13 @@ fn turned_tangent(previous: JointAxes, normal: Vector) -> Vector {
 /// Calls the law on one sub-contact with this step's gap and increments, and stores what it
 /// returns: forces and state (by the law), gap, status, and the slip while sliding. Every
 /// sub-contact loop goes through here, so a sub-contact's update does not depend on the loop.
+///
+/// Returns the status and the energy the law dissipated (`docs/theory.md` §6): zero for an
+/// elastic or open step; for a step that changed the law's state (a failure), the work done on
+/// the springs over the step (trapezoidal rule) less the change of their elastic energy,
+/// `−½ (F⁻ + F)·Δu − (E(F) − E(F⁻))`; for a sliding step, that of the shear spring alone,
+/// `−½ (F_s⁻ + F_s)·Δu_s − (|F_s|² − |F_s⁻|²)/(2 k_s A)`, the work of the slip — the normal
+/// spring stays elastic while the joint slides.
 #[inline(always)]
 pub(crate) fn update_with_law<L: ConstitutiveLaw>(
     law: &L,
@@ -292,7 +298,7 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
     du_s: Vector2,
     axes: JointAxes,
     dt: Real,
-) -> JointStatus {
+) -> (JointStatus, Real) {
     let step = JointStep {
         area: sub.area,
         normal_displacement: gap,
@@ -301,17 +307,34 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
         axes,
         dt,
     };
+    let before = sub.force;
+    let state_before = sub.state.clone();
     let status = law.update(&step, &mut sub.force, &mut sub.state);
+    let f = &sub.force;
+    let dissipated = if sub.state != state_before {
+        let work = -0.5 * ((before.normal + f.normal) * du_n + (before.shear + f.shear).dot(du_s));
+        work - (law.elastic_energy(sub.area, f, &sub.state) - law.elastic_energy(sub.area, &before, &state_before))
+    } else if status == JointStatus::Sliding {
+        let work = -0.5 * (before.shear + f.shear).dot(du_s);
+        let ks_area = law.stiffness().shear * sub.area;
+        if ks_area > 0.0 {
+            work - 0.5 * (f.shear.length_squared() - before.shear.length_squared()) / ks_area
+        } else {
+            work
+        }
+    } else {
+        0.0
+    };
     if status == JointStatus::Sliding {
         sub.slip += du_s.length();
     }
     sub.gap = gap;
     sub.status = status;
-    status
+    (status, dissipated)
 }
 
-/// Whether a face-face sub-contact at geometric gap `gap` may skip its kinematics and update:
-/// it is open with zero force and the law says it stays so ([`ConstitutiveLaw::stays_open`]).
+/// Whether a sub-contact at geometric gap `gap` may skip its update: it is open with zero force
+/// and the law says it stays so ([`ConstitutiveLaw::stays_open`]).
 #[inline(always)]
 pub(crate) fn stays_separated<L: ConstitutiveLaw>(law: &L, sub: &SubContact<L::State>, gap: Real) -> bool {
     sub.status == JointStatus::Open

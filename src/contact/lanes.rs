@@ -131,17 +131,22 @@ pub(crate) struct LaneSums {
     force: [F4; 3],
     per_x: [F4; 3],
     per_y: [F4; 3],
+    /// Energy dissipated by the law, in sub-contact order.
+    dissipated: Real,
 }
 
 impl LaneSums {
-    /// The lane sums added in lane order.
-    pub fn total(self) -> ForceMoments {
+    /// The lane sums added in lane order, and the dissipated energy.
+    pub fn total(self) -> (ForceMoments, Real) {
         let v = |s: [F4; 3]| Vector::new(s[0].sum(), s[1].sum(), s[2].sum());
-        ForceMoments {
-            force: v(self.force),
-            per_x: v(self.per_x),
-            per_y: v(self.per_y),
-        }
+        (
+            ForceMoments {
+                force: v(self.force),
+                per_x: v(self.per_x),
+                per_y: v(self.per_y),
+            },
+            self.dissipated,
+        )
     }
 }
 
@@ -169,7 +174,7 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
             continue;
         }
         let du_s = Vector2::new(du_1.0[l], du_2.0[l]);
-        update_with_law(law, sub, gap, du_n.0[l], du_s, frame.axes, frame.dt);
+        sums.dissipated += update_with_law(law, sub, gap, du_n.0[l], du_s, frame.axes, frame.dt).1;
     }
     // The forces as the law left them (zero where skipped), read back lane by lane.
     let f = [

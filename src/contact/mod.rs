@@ -70,15 +70,15 @@ pub struct ContactPair {
     pub(crate) tangent: Vector,
     /// The plane of the anchors in the host block's body frame (see [`AnchorPlane`]).
     pub(crate) anchors: AnchorPlane,
-    /// Face-face: outward normals of face `a` and face `b` in their blocks' body frames, and the
-    /// plane offset of the face that is not the host, in its body frame. Cached from the shapes
-    /// at detection and on checkpoint load, so that the step loop does not visit the polyhedra.
+    /// The plane the sub-contacts' gaps are measured to, fixed in the block that is not the
+    /// host: its outward unit normal and offset (`plane_normal·x = plane_offset`) in that
+    /// block's body frame — the other face of a face-face contact, the plane of a point
+    /// contact. Cached from the shapes (or the kind) at detection and on checkpoint load, so
+    /// that the step loop does not visit the polyhedra.
     #[serde(skip)]
-    pub(crate) local_normal_a: Vector,
+    pub(crate) plane_normal: Vector,
     #[serde(skip)]
-    pub(crate) local_normal_b: Vector,
-    #[serde(skip)]
-    pub(crate) local_other_offset: Real,
+    pub(crate) plane_offset: Real,
     /// Whether the sub-contacts may hold dashpot forces (Rayleigh damping in the last step, or
     /// history carried over at detection); only saves reading them when not. Checkpointed: it
     /// selects the sub-contact loop, and with it the order of the sums.
@@ -205,13 +205,25 @@ impl ContactPair {
     pub fn subcontact_count(&self) -> usize {
         self.count as usize
     }
-    /// Fills the body-frame face data the step loop uses (face-face contacts).
+    /// Fills the body-frame plane the step loop measures gaps to ([`ContactPair::plane_normal`]).
     pub(crate) fn cache_local_faces(&mut self, shape_a: &Polyhedron, shape_b: &Polyhedron) {
-        if let ContactKind::FaceFace { face_a, face_b } = self.kind {
-            let (fa, fb) = (&shape_a.faces()[face_a as usize], &shape_b.faces()[face_b as usize]);
-            self.local_normal_a = fa.normal;
-            self.local_normal_b = fb.normal;
-            self.local_other_offset = if self.host_is_a { fb.offset } else { fa.offset };
+        match self.kind {
+            ContactKind::FaceFace { face_a, face_b } => {
+                let face = if self.host_is_a {
+                    &shape_b.faces()[face_b as usize]
+                } else {
+                    &shape_a.faces()[face_a as usize]
+                };
+                self.plane_normal = face.normal;
+                self.plane_offset = face.offset;
+            }
+            ContactKind::Point {
+                plane_normal,
+                plane_offset,
+            } => {
+                self.plane_normal = plane_normal;
+                self.plane_offset = plane_offset;
+            }
         }
     }
 
@@ -413,8 +425,8 @@ impl<S> SubContact<S> {
     }
 }
 
-/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity, dashpot force
-/// and gap offset. Stored in a parallel array (same index as the sub-contact), so that the step
+/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity and dashpot
+/// force. Stored in a parallel array (same index as the sub-contact), so that the step
 /// streams only the [`SubContact`]s and touches a record only while the sub-contact carries a
 /// dashpot force.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -424,11 +436,6 @@ pub struct SubContactRecord {
     /// without Rayleigh damping.
     #[serde(default)]
     pub(crate) dashpot: Vector,
-    /// Added to the geometric gap of a point contact at each re-detection (m): the overlap a
-    /// face-face joint left behind when it turned into an edge contact, which the springs do not
-    /// carry. Zero otherwise.
-    #[serde(default)]
-    pub(crate) gap_offset: Real,
 }
 
 impl SubContactRecord {
@@ -436,7 +443,6 @@ impl SubContactRecord {
         Self {
             key,
             dashpot: Vector::ZERO,
-            gap_offset: 0.0,
         }
     }
     /// Stable identity within the pair.

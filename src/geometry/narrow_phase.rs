@@ -22,6 +22,10 @@ pub enum SubcontactDensity {
     Spacing(Real),
 }
 
+/// Largest face angle tolerance (rad, 75°): beyond it the projection of one face on the other
+/// is too oblique to place sub-contacts.
+const MAX_FACE_ANGLE: Real = 5.0 * std::f64::consts::PI / 12.0;
+
 /// Largest number of sub-contact nodes along a face edge (keys hold 16-bit indices).
 const MAX_NODES_PER_EDGE: u32 = 65_535;
 
@@ -35,8 +39,12 @@ pub struct ContactParameters {
     /// Contacts are re-detected once some block has moved more than this fraction of
     /// `tolerance` since its last detection. Default `0.25`.
     pub redetect_fraction: Real,
-    /// Two faces are treated as a face-to-face joint when their normals are opposite within this
-    /// angle (rad). Default 15°, so that an opening hinge keeps its sub-contacts and their history.
+    /// The two faces most aligned with the contact normal form a face-to-face contact (a grid of
+    /// sub-contacts on the smaller face, gaps measured to the other face's plane) while their
+    /// normals are opposite within this angle (rad); beyond it the contact is a point contact.
+    /// Default 60°: an edge or a corner landing on a face, and a hinge rocking open, are the edge
+    /// row or corner node of the same face grid that carries the joint once it closes, so a
+    /// contact does not change its discretisation while it is loaded (`docs/theory.md` §2.2).
     pub face_angle_tolerance: Real,
     /// Sub-contact density on joint faces. Default `PerEdge(15)` (the paper's value).
     pub density: SubcontactDensity,
@@ -47,7 +55,7 @@ impl Default for ContactParameters {
         Self {
             tolerance: 1e-3,
             redetect_fraction: 0.25,
-            face_angle_tolerance: 15f64.to_radians(),
+            face_angle_tolerance: 60f64.to_radians(),
             density: SubcontactDensity::PerEdge(15),
         }
     }
@@ -71,8 +79,8 @@ impl ContactParameters {
             "contact.face_angle_tolerance",
             self.face_angle_tolerance,
             0.0,
-            std::f64::consts::FRAC_PI_4,
-            "must lie in [0, pi/4) rad",
+            MAX_FACE_ANGLE,
+            "must lie in [0, 5 pi/12) rad (75 degrees)",
         )?;
         match self.density {
             SubcontactDensity::PerEdge(n) => {
@@ -111,19 +119,24 @@ pub enum ContactKind {
         /// Face of block `b`.
         face_b: u32,
     },
-    /// Edge–face, edge–edge or vertex–face: sub-contacts on a segment or at a point, anchored to
-    /// block `a`; the normal turns with block `a`.
+    /// Edge–face, edge–edge or vertex–face beyond the face angle tolerance: sub-contacts on a
+    /// segment or at a point, anchored to the host (the block whose feature has the lower
+    /// dimension), their gaps measured to a plane fixed in the other block: its face, or for
+    /// an edge or vertex the plane through it normal to the contact normal at detection.
     Point {
-        /// Contact normal in block `a`'s body frame.
-        normal_local: Vector,
+        /// Outward unit normal of the plane, in the other block's body frame.
+        plane_normal: Vector,
+        /// Offset of the plane along `plane_normal` (m): the plane is `plane_normal·x = offset`
+        /// in the other block's body frame.
+        plane_offset: Real,
     },
 }
 
 impl ContactKind {
     /// Whether a contact re-detected as `other` is the same joint, whose sub-contacts may carry
     /// their history over by key: the same pair of faces, or a point contact again. A point
-    /// contact's body-frame normal changes as its block turns, so it is not compared; the keys
-    /// (which name the features) decide which sub-contacts carry on.
+    /// contact's plane is set afresh at each detection, so it is not compared; the keys (which
+    /// name the features) decide which sub-contacts carry on.
     pub(crate) fn same_joint(&self, other: &ContactKind) -> bool {
         match (self, other) {
             (ContactKind::FaceFace { .. }, ContactKind::FaceFace { .. }) => self == other,
@@ -142,7 +155,8 @@ pub struct SubcontactSeed {
     pub anchor: Vector,
     /// Tributary area (m²).
     pub area: Real,
-    /// Normal gap at detection (m, positive = open).
+    /// Normal gap at detection (m, positive = open): the signed distance of the anchor from the
+    /// other block's plane.
     pub gap: Real,
 }
 
@@ -153,7 +167,8 @@ pub struct DetectedContact {
     pub kind: ContactKind,
     /// `true` if sub-contacts are anchored to block `a`, `false` for block `b`.
     pub host_is_a: bool,
-    /// World normal from `a` to `b`.
+    /// World normal from `a` to `b`: the normal of the other block's plane, oriented from `a`
+    /// to `b`.
     pub normal: Vector,
 }
 
@@ -329,11 +344,9 @@ fn face_face(
             .rev()
             .map(|&i| to2d(rel.transform_point(other.shape.vertices()[i as usize]))),
     );
-    // Reject faces that are far apart along the host normal (the polygon must lie within the
-    // tolerance band of the host plane).
+    // Faces more oblique than the largest tolerance are not projected on each other.
     let n_other = rel.rotation * other.shape.faces()[fo].normal;
-    let denom = n_other.dot(face.normal);
-    if denom > -0.5 {
+    if n_other.dot(face.normal) > -MAX_FACE_ANGLE.cos() {
         return None;
     }
     clip_convex(&mut scratch.other, &scratch.host, &mut scratch.tmp);
@@ -341,11 +354,12 @@ fn face_face(
     if overlap_area <= 1e-9 * face.area {
         return None;
     }
-    // Gap at the overlap's vertices: the other face's plane seen along the host normal.
+    // Gap at a point of the host face: its signed distance from the other face's plane, along
+    // that face's outward normal (the gap the step uses, `docs/theory.md` §3).
     let other_offset = n_other.dot(rel.transform_point(other.shape.vertices()[other.shape.face_loop(fo)[0] as usize]));
     let gap_at = |q: DVec2| {
         let p = origin + u * q.x + v * q.y;
-        (other_offset - n_other.dot(p)) / denom
+        n_other.dot(p) - other_offset
     };
     let min_gap = scratch.other.iter().map(|&q| gap_at(q)).fold(Real::INFINITY, Real::min);
     if min_gap > params.tolerance {
@@ -415,15 +429,20 @@ fn face_face(
             }
         }
     }
-    let na = a.pose.rotation * a.shape.faces()[fa].normal;
-    let nb = b.pose.rotation * b.shape.faces()[fb].normal;
+    // The normal is the other face's: the direction of the gap's gradient, so that the
+    // springs' forces derive from their energy (`docs/theory.md` §3).
+    let normal = if host_is_a {
+        -(b.pose.rotation * b.shape.faces()[fb].normal)
+    } else {
+        a.pose.rotation * a.shape.faces()[fa].normal
+    };
     Some(DetectedContact {
         kind: ContactKind::FaceFace {
             face_a: fa as u32,
             face_b: fb as u32,
         },
         host_is_a,
-        normal: (na - nb).normalize(),
+        normal,
     })
 }
 
@@ -451,8 +470,9 @@ fn bounds(poly: &[DVec2]) -> (DVec2, DVec2) {
     )
 }
 
-/// Edge–face, edge–edge and vertex–face contacts: points on the intersection of the two support
-/// features, anchored to block `a`.
+/// Edge–face, edge–edge and vertex–face contacts beyond the face angle tolerance: points on the
+/// intersection of the two support features, anchored to the block whose feature has the lower
+/// dimension (the host), with gaps to the other block's supporting plane normal to `n`.
 fn point_contact(
     a: BlockGeometry<'_>,
     b: BlockGeometry<'_>,
@@ -496,6 +516,33 @@ fn point_contact(
             farthest_pair(&sub)
         }
     };
+    // The host carries the points; the other block's supporting plane normal to `n` (its face
+    // when its feature is a face) measures their gaps, fixed in that block.
+    let host_is_a = fa.dim <= fb.dim;
+    let (host, host_feature, other, other_feature, towards_host) = if host_is_a {
+        (a, &fa, b, &fb, -n)
+    } else {
+        (b, &fb, a, &fa, n)
+    };
+    let (plane_normal, plane_offset) = if other_feature.dim == 2 {
+        // The other block's face: its own normal, not the separating axis (which an edge-edge
+        // axis may have tilted).
+        let f = &other.shape.faces()[other
+            .shape
+            .most_aligned_face(other.pose.rotation.inverse() * towards_host)];
+        (f.normal, f.offset)
+    } else {
+        let m = other.pose.rotation.inverse() * towards_host;
+        let offset = other
+            .shape
+            .vertices()
+            .iter()
+            .map(|v| m.dot(*v))
+            .fold(Real::NEG_INFINITY, Real::max);
+        (m, offset)
+    };
+    let outward = other.pose.rotation * plane_normal;
+    let world_offset = plane_offset + outward.dot(other.pose.translation);
     let length = (p1 - p0).length();
     let count = ((length / h).ceil() as u32).max(1);
     let seg_area = if length > 1e-12 {
@@ -503,30 +550,28 @@ fn point_contact(
     } else {
         h * h
     };
-    let inv = a.pose.inverse();
+    let inv = host.pose.inverse();
     for k in 0..count {
         let q = p0 + (p1 - p0) * ((k as Real + 0.5) / count as Real);
-        let ha = fa.height(q, n);
-        let hb = fb.height(q, n);
-        let on_a = e1 * q.x + e2 * q.y + n * ha;
-        let gap = if hb.is_finite() && ha.is_finite() {
-            hb - ha
-        } else {
-            dist
-        };
+        let height = host_feature.height(q, n);
+        if !height.is_finite() {
+            continue;
+        }
+        let on_host = e1 * q.x + e2 * q.y + n * height;
         seeds.push(SubcontactSeed {
             key: SubKey::point(fa.dim * 4 + fb.dim, k),
-            anchor: inv.transform_point(on_a),
+            anchor: inv.transform_point(on_host),
             area: seg_area,
-            gap,
+            gap: outward.dot(on_host) - world_offset,
         });
     }
     Some(DetectedContact {
         kind: ContactKind::Point {
-            normal_local: a.pose.rotation.inverse() * n,
+            plane_normal,
+            plane_offset,
         },
-        host_is_a: true,
-        normal: n,
+        host_is_a,
+        normal: if host_is_a { -outward } else { outward },
     })
 }
 

@@ -18,7 +18,7 @@ use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 7;
+const VERSION: u32 = 8;
 
 /// The fields every version has, read before the rest (other fields are skipped).
 #[derive(Deserialize)]

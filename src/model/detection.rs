@@ -10,7 +10,7 @@ use crate::contact::{
     SubContactRecord,
 };
 use crate::error::{Error, Result};
-use crate::geometry::{detect, BlockGeometry, BroadPhase, ContactKind, NarrowPhaseScratch, SubcontactSeed};
+use crate::geometry::{detect, BlockGeometry, BroadPhase, NarrowPhaseScratch, SubcontactSeed};
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
 use crate::math::{Matrix, Real, Rotation, Vector};
 
@@ -183,50 +183,12 @@ impl<L: ConstitutiveLaw> Model<L> {
                     let o = &old_subs[k];
                     sub.force = o.force;
                     sub.slip = o.slip;
-                    sub.gap = seed.gap + old_records[k].gap_offset;
                     sub.status = o.status;
                     sub.state = o.state.clone();
                     record = old_records[k].clone();
                 }
                 sc.subs.push(sub);
                 sc.records.push(record);
-            }
-            // A face-face joint that rocks onto an edge becomes an edge-face (point) contact once
-            // the faces are more than `face_angle_tolerance` apart. The two discretise the joint
-            // differently (the edge-face strip is wider than the face grid's edge row), so the
-            // overlap left by the face-face springs, seen afresh as point-contact depth, loads the
-            // new contact with several times the joint force in one step and throws the blocks
-            // apart. Instead the joint force is carried over, and the part of the overlap it does
-            // not account for is kept as a gap offset for the life of the point contact.
-            if let (Some(k), ContactKind::Point { .. }) = (old, dc.kind) {
-                let p = &self.pairs[k];
-                if matches!(p.kind, ContactKind::FaceFace { .. }) {
-                    let olds = &self.subs[p.range()];
-                    let normal: Real = olds.iter().map(|s| s.force.normal).sum();
-                    let old_axes = p.axes();
-                    let shear: Vector = olds.iter().map(|s| old_axes.shear(s.force.shear)).sum();
-                    let new = &mut sc.subs[first as usize..];
-                    let new_records = &mut sc.records[first as usize..];
-                    let area: Real = new.iter().map(|s| s.area).sum();
-                    if normal > 0.0 && area > 0.0 {
-                        let law_ref = &self.joints.laws()[law as usize];
-                        let kn = law_ref.stiffness().normal;
-                        // The new contact has no carried history: its axes are `dc.normal`'s.
-                        let shear = axes.components(shear);
-                        for (s, r) in new.iter_mut().zip(new_records.iter_mut()) {
-                            let w = s.area / area;
-                            s.force = JointForce {
-                                normal: normal * w,
-                                shear: shear * w,
-                            };
-                            let gap = -s.force.normal / (kn * s.area);
-                            r.gap_offset = gap - s.gap;
-                            s.gap = gap;
-                            s.status = JointStatus::Elastic;
-                            r.dashpot = Vector::ZERO;
-                        }
-                    }
-                }
             }
             let mut pair = ContactPair {
                 a: i,
@@ -239,9 +201,8 @@ impl<L: ConstitutiveLaw> Model<L> {
                 normal: axes.normal,
                 tangent: axes.tangent,
                 anchors,
-                local_normal_a: Vector::ZERO,
-                local_normal_b: Vector::ZERO,
-                local_other_offset: 0.0,
+                plane_normal: Vector::ZERO,
+                plane_offset: 0.0,
                 dashpots: true,
                 normal_force: 0.0,
                 springs: ForceMoments::default(),
@@ -613,15 +574,6 @@ fn dropped_work<S>(
             .binary_search_by_key(&(p.a, p.b), |q| (q.a, q.b))
             .ok()
             .map(|k| &new.0[k]);
-        // A face-face joint turned point contact hands its spring force on (see `detect`): the
-        // point contact's first step books the second half of that force's work (not of the
-        // dashpot forces, which are not handed on).
-        let handed_on = successor.is_some_and(|q| {
-            matches!(
-                (p.kind, q.kind),
-                (ContactKind::FaceFace { .. }, ContactKind::Point { .. })
-            ) && q.springs.force != Vector::ZERO
-        });
         let carried = successor
             .filter(|q| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
             .map(|q| &new.1[q.range()]);
@@ -634,11 +586,7 @@ fn dropped_work<S>(
         let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
         let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
         for (s, r) in old.subs[p.range()].iter().zip(&old.records[p.range()]) {
-            let spring = if handed_on {
-                Vector::ZERO
-            } else {
-                p.axes().force(&s.force)
-            };
+            let spring = p.axes().force(&s.force);
             if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
                 continue;
             }

@@ -12,8 +12,11 @@ use crate::math::Real;
 /// the half-step velocities either side, the quantity central difference conserves; it differs
 /// from `½·m·v̄²` by `⅛·m·|v⁺ − v⁻|²`); works are each force times the displacement of the step,
 /// by the trapezoidal rule, so that the balance is exact for translation; `elastic` is the energy stored
-/// in the joint springs; `friction` is the work done on the joints (trapezoidal rule, per
-/// sub-contact) less the elastic energy, i.e. what slip and failure dissipated.
+/// in the joint springs; `friction` is what the joint laws dissipated: at every sub-contact
+/// step that slid or changed the law's state (failure), the work done on its springs less the
+/// change of their elastic energy. Elastic and open steps dissipate nothing, so with a
+/// frictionless law `friction` stays zero, and `balance_error` measures what the time
+/// integration and the discretisation of the joints did not conserve.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Energies {
     /// Kinetic energy (J).
@@ -28,11 +31,13 @@ pub struct Energies {
     pub load_work: Real,
     /// Work of the supports and prescribed velocities (J).
     pub boundary_work: Real,
-    /// Energy dissipated by slip and joint failure (J).
+    /// Energy dissipated by slip and joint failure (J): accumulated from the laws' inelastic
+    /// steps, never from a balance.
     pub friction: Real,
     /// Energy dissipated by damping: local, Rayleigh mass part and contact dashpots (J).
     pub damping: Real,
-    /// Total work done on the joint springs (J).
+    /// Total work done on the joint springs (J): the elastic energy plus `friction` plus what
+    /// the time integration and the joints' discretisation did not conserve.
     pub joint_work: Real,
 }
 

@@ -198,6 +198,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         e.kinetic = kinetic;
         for s in &self.pair_sums {
             e.joint_work += s.work;
+            e.friction += s.dissipated;
             e.damping += s.dashpot_work;
         }
         let force_magnitudes: Real = self.pair_sums.iter().map(|s| s.force_magnitude).sum();

@@ -320,6 +320,8 @@ pub struct ImpactResult {
     pub contact_speed: Real,
     /// Time of the first contact force (s after release).
     pub contact_time: Real,
+    /// Time step of the step that brought the first contact force (s).
+    pub contact_dt: Real,
     /// Impactor momentum at contact, nominal (kg·m/s).
     pub momentum: Real,
     /// Impactor kinetic energy at contact, nominal (J).
@@ -625,7 +627,7 @@ pub fn run(
     let mut next_sample = 0.0;
     let mut next_frame = 0.0;
     let (mut first_peak, mut first_done, mut impact_started): (Real, bool, bool) = (0.0, false, false);
-    let (mut contact_speed, mut contact_time) = (v_release, Real::NAN);
+    let (mut contact_speed, mut contact_time, mut contact_dt) = (v_release, Real::NAN, Real::NAN);
     let (mut max_disp, mut max_v, mut max_a, mut max_f, mut max_excess): (Real, Real, Real, Real, Real) =
         (0.0, 0.0, 0.0, 0.0, 0.0);
     let (mut max_rise, mut max_rise_time): (Real, Real) = (0.0, 0.0);
@@ -644,6 +646,7 @@ pub fn run(
                 impact_started = true;
                 contact_speed = before;
                 contact_time = t;
+                contact_dt = model.dt();
             }
         }
         if t + 1e-12 < next_sample && t < case.duration {
@@ -733,6 +736,7 @@ pub fn run(
         release_gap: gap,
         release_velocity: v_release,
         contact_speed,
+        contact_dt,
         contact_time,
         momentum: mass * v0,
         kinetic_energy: 0.5 * mass * v0 * v0,
