@@ -135,6 +135,7 @@ fn check_drops(label: &str, rotations: &[Rotation], min_impacts: usize) {
 /// the cube (`ωΔt` = 0.6 at safety 0.5), and central difference gains or loses up to a quarter
 /// of `(ωΔt)²` of the impact energy where the springs close and open (`docs/theory.md` §4):
 /// 4–15 % of `m g h` over five or six impacts (measured). Run with `--ignored`.
+#[test]
 #[ignore = "issue 16: 4-15 % of m g h over five flat impacts at the default step"]
 fn frictionless_flat_drops_keep_their_energy() {
     check_drops("flat", &[Rotation::IDENTITY], 5);
@@ -270,6 +271,7 @@ fn undamped_block_at_rest_on_an_incline_stays_put() {
 /// time-step error as a flat impact: the balance error reaches 4.5 % of the work of gravity at
 /// the default step, and the bricks slip by 0.13 mm as their normal forces swing through zero.
 /// Run with `--ignored`.
+#[test]
 #[ignore = "issue 16: balance error 4.5 % of the work of gravity at the default step"]
 fn undamped_wall_settles_without_walking() {
     let mut model: Model = Model::new(ModelParameters::default()).expect("model");
