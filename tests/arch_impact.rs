@@ -72,12 +72,23 @@ fn impact_energy_momentum_and_outcomes() {
     }
     // The response grows with the impact energy (357 J against 30 J), and the light drop leaves
     // the arch standing. Whether the heavy tests collapse is the benchmark's comparison with the
-    // experiment (`docs/benchmarks/arch-impact.md`), not a property to assert here.
+    // experiment (`docs/benchmarks/arch-impact.md`), not a property to assert here. The
+    // first-impact peak of a linear system struck by a mass grows as √E (`δ = v √(m/k)` =
+    // `√(2E/k)`): the ring's, which hinges, within a factor 2 of that (measured 3.76 against
+    // √(357.6/29.9) = 3.46). The later maxima come from the ring falling back after its rebound
+    // and are not ordered so simply (`docs/benchmarks/arch-impact.md`).
+    let expected = (r[0].kinetic_energy / r[1].kinetic_energy).sqrt();
+    let ratio = r[0].first_peak_disp / r[1].first_peak_disp;
+    println!(
+        "first-impact peaks: heavy {:.2} mm, light {:.2} mm, ratio {ratio:.2} (√E ratio {expected:.2})",
+        r[0].first_peak_disp * 1e3,
+        r[1].first_peak_disp * 1e3
+    );
     assert!(
-        r[0].max_disp > 5.0 * r[1].max_disp,
-        "heavy {} m vs light {} m",
-        r[0].max_disp,
-        r[1].max_disp
+        ratio > 0.5 * expected && ratio < 2.0 * expected,
+        "first-impact peaks: heavy {} m vs light {} m (ratio {ratio}, √E ratio {expected})",
+        r[0].first_peak_disp,
+        r[1].first_peak_disp
     );
     assert!(!r[1].collapsed, "the light drop (M60H5) must leave the arch standing");
 }
@@ -184,9 +195,10 @@ fn release_just_above_equals_full_drop() {
     // A free fall of H: √(2H/g) (the impactor does not touch the frame on the way down).
     let fall = (2.0 * f.release_gap / GRAVITY).sqrt();
     assert!(
-        (f.contact_time - fall).abs() < 2.0 * f.dt,
-        "{} vs {fall}",
-        f.contact_time
+        (f.contact_time - fall).abs() < 2.0 * f.contact_dt,
+        "{} vs {fall} (time step at contact {})",
+        f.contact_time,
+        f.contact_dt
     );
     assert!((f.contact_speed / a.contact_speed - 1.0).abs() < 1e-3);
     assert!((f.first_peak_disp / a.first_peak_disp - 1.0).abs() < 0.02);

@@ -22,6 +22,13 @@ pub enum SubcontactDensity {
     Spacing(Real),
 }
 
+/// Two faces further apart than the face angle tolerance but within this angle (rad, 60°) still
+/// form a face-face contact when the larger face covers the smaller one whole: an edge or a
+/// corner landing on a face is then the edge row or corner node of the grid that carries the
+/// face once it lands, instead of a differently discretised point contact (`docs/theory.md`
+/// §2.2). Where the faces overlap only in part (edge against edge), a point contact.
+const COVERED_FACE_ANGLE: Real = std::f64::consts::FRAC_PI_3;
+
 /// Largest face angle tolerance (rad, 75°): beyond it the projection of one face on the other
 /// is too oblique to place sub-contacts.
 const MAX_FACE_ANGLE: Real = 5.0 * std::f64::consts::PI / 12.0;
@@ -39,12 +46,12 @@ pub struct ContactParameters {
     /// Contacts are re-detected once some block has moved more than this fraction of
     /// `tolerance` since its last detection. Default `0.25`.
     pub redetect_fraction: Real,
-    /// The two faces most aligned with the contact normal form a face-to-face contact (a grid of
+    /// The two faces most aligned with the contact normal form a face-to-face joint (a grid of
     /// sub-contacts on the smaller face, gaps measured to the other face's plane) while their
-    /// normals are opposite within this angle (rad); beyond it the contact is a point contact.
-    /// Default 60°: an edge or a corner landing on a face, and a hinge rocking open, are the edge
-    /// row or corner node of the same face grid that carries the joint once it closes, so a
-    /// contact does not change its discretisation while it is loaded (`docs/theory.md` §2.2).
+    /// normals are opposite within this angle (rad). Default 15°, so that an opening hinge keeps
+    /// its sub-contacts and their history. Beyond it and up to 60°, they still form a face-face
+    /// contact when the larger face covers the smaller one whole (an edge or corner landing on
+    /// a face); otherwise the contact is a point contact (`docs/theory.md` §2.2).
     pub face_angle_tolerance: Real,
     /// Sub-contact density on joint faces. Default `PerEdge(15)` (the paper's value).
     pub density: SubcontactDensity,
@@ -55,7 +62,7 @@ impl Default for ContactParameters {
         Self {
             tolerance: 1e-3,
             redetect_fraction: 0.25,
-            face_angle_tolerance: 60f64.to_radians(),
+            face_angle_tolerance: 15f64.to_radians(),
             density: SubcontactDensity::PerEdge(15),
         }
     }
@@ -210,9 +217,11 @@ pub fn detect(
     let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
     let na = a.pose.rotation * a.shape.faces()[fa].normal;
     let nb = b.pose.rotation * b.shape.faces()[fb].normal;
-    if -na.dot(nb) >= params.face_angle_tolerance.cos() {
+    let cos = -na.dot(nb);
+    if cos >= params.face_angle_tolerance.cos() || cos >= COVERED_FACE_ANGLE.cos() {
         let start = seeds.len();
-        if let Some(found) = face_face(a, fa, b, fb, params, scratch, seeds) {
+        let require_cover = cos < params.face_angle_tolerance.cos();
+        if let Some(found) = face_face(a, fa, b, fb, require_cover, params, scratch, seeds) {
             return Some(found);
         }
         seeds.truncate(start);
@@ -308,18 +317,68 @@ fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubcontactDensity) -> Real {
     }
 }
 
+/// Faces whose normals are opposite within this angle (rad, 1°) are parallel: the smaller face
+/// hosts the sub-contacts. Beyond it, the face whose edge or corner digs into the other does.
+const PARALLEL_ANGLE: Real = 0.017_453_292_519_943_295;
+
+/// A face-face contact between face `fa` of `a` and face `fb` of `b`; with `require_cover`,
+/// only if the larger face covers the smaller one whole.
+///
+/// The host is the smaller face when the faces are parallel within [`PARALLEL_ANGLE`]. When
+/// they are not, the deepest point of the overlap lies on the boundary of the face whose edge or
+/// corner digs into the other, and that face hosts the sub-contacts, so that the loaded ones are
+/// its edge row or corner node, whose cells the other face covers: their areas do not change as
+/// the edge slides along the face. (Hosted by the other face, the deepest sub-contacts sit in
+/// the partly covered cells along the edge, whose areas are refreshed only at re-detections,
+/// and each refresh changed their stored energy by `½ k ΔA g²` at the deepest gaps.)
+#[allow(clippy::too_many_arguments)]
 fn face_face(
     a: BlockGeometry<'_>,
     fa: usize,
     b: BlockGeometry<'_>,
     fb: usize,
+    require_cover: bool,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
     seeds: &mut Vec<SubcontactSeed>,
 ) -> Option<DetectedContact> {
-    let area_a = a.shape.faces()[fa].area;
-    let area_b = b.shape.faces()[fb].area;
-    let host_is_a = area_a <= area_b;
+    let smaller_is_a = a.shape.faces()[fa].area <= b.shape.faces()[fb].area;
+    let start = seeds.len();
+    match face_face_hosted(a, fa, b, fb, smaller_is_a, true, require_cover, params, scratch, seeds) {
+        Hosted::Contact(found) => Some(found),
+        Hosted::None => None,
+        Hosted::DeepestOnOther => {
+            seeds.truncate(start);
+            match face_face_hosted(a, fa, b, fb, !smaller_is_a, false, false, params, scratch, seeds) {
+                Hosted::Contact(found) => Some(found),
+                _ => None,
+            }
+        }
+    }
+}
+
+/// What [`face_face_hosted`] found.
+enum Hosted {
+    Contact(DetectedContact),
+    /// The faces are not parallel and the overlap's deepest point is not on the host face's
+    /// boundary: the other face should host (nothing pushed).
+    DeepestOnOther,
+    None,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn face_face_hosted(
+    a: BlockGeometry<'_>,
+    fa: usize,
+    b: BlockGeometry<'_>,
+    fb: usize,
+    host_is_a: bool,
+    check_deepest: bool,
+    require_cover: bool,
+    params: &ContactParameters,
+    scratch: &mut NarrowPhaseScratch,
+    seeds: &mut Vec<SubcontactSeed>,
+) -> Hosted {
     let (host, fh, other, fo) = if host_is_a { (a, fa, b, fb) } else { (b, fb, a, fa) };
     let face = &host.shape.faces()[fh];
     let (origin, u, v) = face_frame(host.shape, fh);
@@ -347,12 +406,12 @@ fn face_face(
     // Faces more oblique than the largest tolerance are not projected on each other.
     let n_other = rel.rotation * other.shape.faces()[fo].normal;
     if n_other.dot(face.normal) > -MAX_FACE_ANGLE.cos() {
-        return None;
+        return Hosted::None;
     }
     clip_convex(&mut scratch.other, &scratch.host, &mut scratch.tmp);
     let (overlap_area, _) = area_centroid(&scratch.other);
-    if overlap_area <= 1e-9 * face.area {
-        return None;
+    if overlap_area <= 1e-9 * face.area || (require_cover && overlap_area < (1.0 - 1e-9) * face.area) {
+        return Hosted::None;
     }
     // Gap at a point of the host face: its signed distance from the other face's plane, along
     // that face's outward normal (the gap the step uses, `docs/theory.md` §3).
@@ -363,7 +422,27 @@ fn face_face(
     };
     let min_gap = scratch.other.iter().map(|&q| gap_at(q)).fold(Real::INFINITY, Real::min);
     if min_gap > params.tolerance {
-        return None;
+        return Hosted::None;
+    }
+    let inside_tol = 1e-9 * face.area.sqrt();
+    if check_deepest && n_other.dot(face.normal) > -PARALLEL_ANGLE.cos() {
+        // The midpoint of the overlap's deepest edge (an edge, so that an edge crossing the
+        // host face, whose end points lie on the host's boundary, is not taken for the host's).
+        let overlap = &scratch.other;
+        let deepest = (0..overlap.len())
+            .map(|k| (overlap[k], overlap[(k + 1) % overlap.len()]))
+            .min_by(|(p, q), (r, t)| (gap_at(*p) + gap_at(*q)).total_cmp(&(gap_at(*r) + gap_at(*t))))
+            .map_or(DVec2::ZERO, |(p, q)| 0.5 * (p + q));
+        let poly = &scratch.host;
+        let on_boundary = (0..poly.len()).any(|k| {
+            let (p, q) = (poly[k], poly[(k + 1) % poly.len()]);
+            let e = q - p;
+            let t = ((deepest - p).dot(e) / e.length_squared()).clamp(0.0, 1.0);
+            (deepest - (p + e * t)).length() <= 1e-6 * e.length()
+        });
+        if !on_boundary {
+            return Hosted::DeepestOnOther;
+        }
     }
 
     let (lo, hi) = bounds(&scratch.host);
@@ -396,7 +475,6 @@ fn face_face(
     let (i0, i1) = range(olo.x, ohi.x, first.x, cell.x, nu);
     let (j0, j1) = range(olo.y, ohi.y, first.y, cell.y, nv);
     let min_area = 1e-9 * cell.x * cell.y;
-    let inside_tol = 1e-9 * size.length();
     for i in i0..=i1 {
         for j in j0..=j1 {
             let node = first + cell * DVec2::new(i as Real, j as Real);
@@ -413,13 +491,29 @@ fn face_face(
                 } else {
                     SubKey::cell(fo32, fh32, i, j)
                 };
-                // The node if the overlap covers it, else the centroid of its share of the overlap.
-                let poly = &scratch.other;
-                let covered = (0..poly.len()).all(|k| {
-                    let (p, q) = (poly[k], poly[(k + 1) % poly.len()]);
+                // The node if it lies on the host face, else the centroid of the part of its cell
+                // on the host face: a material point that depends on the host face alone, not on
+                // the overlap, so that as the faces slide or turn the point stays put while its
+                // area (the overlap in its cell) follows the overlap. (At the centroid of its
+                // share of the overlap, a sub-contact at the overlap's edge jumped by up to half a
+                // cell whenever that edge crossed its node, and with it its gap and its stored
+                // energy at every re-detection of a hinging or sliding joint.)
+                let host = &scratch.host;
+                let on_host = (0..host.len()).all(|k| {
+                    let (p, q) = (host[k], host[(k + 1) % host.len()]);
                     (q - p).perp_dot(node - p) >= -inside_tol * (q - p).length()
                 });
-                let at = if covered { node } else { centroid };
+                let at = if on_host {
+                    node
+                } else {
+                    scratch.cell.clear();
+                    scratch.cell.extend_from_slice(host);
+                    clip_rect(&mut scratch.cell, clo, chi, &mut scratch.tmp);
+                    match area_centroid(&scratch.cell) {
+                        (host_area, host_centroid) if host_area > 0.0 => host_centroid,
+                        _ => centroid,
+                    }
+                };
                 seeds.push(SubcontactSeed {
                     key,
                     anchor: origin + u * at.x + v * at.y,
@@ -436,7 +530,7 @@ fn face_face(
     } else {
         a.pose.rotation * a.shape.faces()[fa].normal
     };
-    Some(DetectedContact {
+    Hosted::Contact(DetectedContact {
         kind: ContactKind::FaceFace {
             face_a: fa as u32,
             face_b: fb as u32,
