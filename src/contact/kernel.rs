@@ -288,7 +288,8 @@ fn turned_tangent(previous: JointAxes, normal: Vector) -> Vector {
 /// the springs over the step (trapezoidal rule) less the change of their elastic energy,
 /// `−½ (F⁻ + F)·Δu − (E(F) − E(F⁻))`; for a sliding step, that of the shear spring alone,
 /// `−½ (F_s⁻ + F_s)·Δu_s − (|F_s|² − |F_s⁻|²)/(2 k_s A)`, the work of the slip — the normal
-/// spring stays elastic while the joint slides.
+/// spring stays elastic while the joint slides; for a step that opens a joint holding a shear
+/// force, the same: the shear spring's energy, which the law drops with the contact, is lost.
 #[inline(always)]
 pub(crate) fn update_with_law<L: ConstitutiveLaw>(
     law: &L,
@@ -314,7 +315,7 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
     let dissipated = if sub.state != state_before {
         let work = -0.5 * ((before.normal + f.normal) * du_n + (before.shear + f.shear).dot(du_s));
         work - (law.elastic_energy(sub.area, f, &sub.state) - law.elastic_energy(sub.area, &before, &state_before))
-    } else if status == JointStatus::Sliding {
+    } else if status == JointStatus::Sliding || (status == JointStatus::Open && before.shear != Vector2::ZERO) {
         let work = -0.5 * (before.shear + f.shear).dot(du_s);
         let ks_area = law.stiffness().shear * sub.area;
         if ks_area > 0.0 {

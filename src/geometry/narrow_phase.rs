@@ -187,6 +187,7 @@ pub struct NarrowPhaseScratch {
     host: Vec<DVec2>,
     other: Vec<DVec2>,
     cell: Vec<DVec2>,
+    tmp_cell: Vec<DVec2>,
     tmp: Vec<DVec2>,
 }
 
@@ -201,9 +202,15 @@ pub struct BlockGeometry<'a> {
 
 /// Detects the contact between `a` and `b`, pushing its sub-contacts into `seeds`.
 /// Returns `None` (and pushes nothing) when the gap exceeds the tolerance.
+///
+/// `previous` is the contact the pair had before, if any: a face-face contact between the same
+/// two faces keeps its host, so that its sub-contacts keep their keys and history (the host of
+/// a new face-face contact between tilted faces is chosen by where the overlap is deepest, see
+/// `face_face`).
 pub fn detect(
     a: BlockGeometry<'_>,
     b: BlockGeometry<'_>,
+    previous: Option<(ContactKind, bool)>,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
     seeds: &mut Vec<SubcontactSeed>,
@@ -221,7 +228,15 @@ pub fn detect(
     if cos >= params.face_angle_tolerance.cos() || cos >= COVERED_FACE_ANGLE.cos() {
         let start = seeds.len();
         let require_cover = cos < params.face_angle_tolerance.cos();
-        if let Some(found) = face_face(a, fa, b, fb, require_cover, params, scratch, seeds) {
+        let kept_host = match previous {
+            Some((ContactKind::FaceFace { face_a, face_b }, host_is_a))
+                if face_a as usize == fa && face_b as usize == fb =>
+            {
+                Some(host_is_a)
+            }
+            _ => None,
+        };
+        if let Some(found) = face_face(a, fa, b, fb, require_cover, kept_host, params, scratch, seeds) {
             return Some(found);
         }
         seeds.truncate(start);
@@ -322,7 +337,8 @@ fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubcontactDensity) -> Real {
 const PARALLEL_ANGLE: Real = 0.017_453_292_519_943_295;
 
 /// A face-face contact between face `fa` of `a` and face `fb` of `b`; with `require_cover`,
-/// only if the larger face covers the smaller one whole.
+/// only if the larger face covers the smaller one whole; hosted by `kept_host` when given (the
+/// contact existed before).
 ///
 /// The host is the smaller face when the faces are parallel within [`PARALLEL_ANGLE`]. When
 /// they are not, the deepest point of the overlap lies on the boundary of the face whose edge or
@@ -338,11 +354,18 @@ fn face_face(
     b: BlockGeometry<'_>,
     fb: usize,
     require_cover: bool,
+    kept_host: Option<bool>,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
     seeds: &mut Vec<SubcontactSeed>,
 ) -> Option<DetectedContact> {
     let smaller_is_a = a.shape.faces()[fa].area <= b.shape.faces()[fb].area;
+    if let Some(host_is_a) = kept_host {
+        return match face_face_hosted(a, fa, b, fb, host_is_a, false, require_cover, params, scratch, seeds) {
+            Hosted::Contact(found) => Some(found),
+            _ => None,
+        };
+    }
     let start = seeds.len();
     match face_face_hosted(a, fa, b, fb, smaller_is_a, true, require_cover, params, scratch, seeds) {
         Hosted::Contact(found) => Some(found),
@@ -424,7 +447,6 @@ fn face_face_hosted(
     if min_gap > params.tolerance {
         return Hosted::None;
     }
-    let inside_tol = 1e-9 * face.area.sqrt();
     if check_deepest && n_other.dot(face.normal) > -PARALLEL_ANGLE.cos() {
         // The midpoint of the overlap's deepest edge (an edge, so that an edge crossing the
         // host face, whose end points lie on the host's boundary, is not taken for the host's).
@@ -491,28 +513,30 @@ fn face_face_hosted(
                 } else {
                     SubKey::cell(fo32, fh32, i, j)
                 };
-                // The node if it lies on the host face, else the centroid of the part of its cell
-                // on the host face: a material point that depends on the host face alone, not on
-                // the overlap, so that as the faces slide or turn the point stays put while its
-                // area (the overlap in its cell) follows the overlap. (At the centroid of its
-                // share of the overlap, a sub-contact at the overlap's edge jumped by up to half a
-                // cell whenever that edge crossed its node, and with it its gap and its stored
-                // energy at every re-detection of a hinging or sliding joint.)
-                let host = &scratch.host;
-                let on_host = (0..host.len()).all(|k| {
-                    let (p, q) = (host[k], host[(k + 1) % host.len()]);
-                    (q - p).perp_dot(node - p) >= -inside_tol * (q - p).length()
-                });
-                let at = if on_host {
-                    node
+                // The node, shifted by how far the overlap's share of the cell has its centroid
+                // from the centroid of the cell's part of the host face: the node itself when
+                // the overlap covers that part, and a point that follows the overlap's edge
+                // continuously as it crosses the cell. (At the node always, a sub-contact at the
+                // overlap's edge carried its force up to half a cell outside the overlap; at the
+                // centroid of its share once its node was uncovered, as before, it jumped by up
+                // to a quarter cell at that moment, and with it its gap and stored energy.)
+                let full = cell.x * cell.y;
+                let (host_area, host_centroid) = if area >= full * (1.0 - 1e-12) {
+                    (full, node)
                 } else {
-                    scratch.cell.clear();
-                    scratch.cell.extend_from_slice(host);
-                    clip_rect(&mut scratch.cell, clo, chi, &mut scratch.tmp);
-                    match area_centroid(&scratch.cell) {
-                        (host_area, host_centroid) if host_area > 0.0 => host_centroid,
-                        _ => centroid,
+                    scratch.tmp_cell.clear();
+                    scratch.tmp_cell.extend_from_slice(&scratch.host);
+                    clip_rect(&mut scratch.tmp_cell, clo, chi, &mut scratch.tmp);
+                    area_centroid(&scratch.tmp_cell)
+                };
+                let at = if area >= host_area * (1.0 - 1e-12) || host_area <= 0.0 {
+                    if host_area > 0.0 {
+                        node
+                    } else {
+                        centroid
                     }
+                } else {
+                    node + (centroid - host_centroid)
                 };
                 seeds.push(SubcontactSeed {
                     key,

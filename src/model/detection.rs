@@ -133,6 +133,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     shape: bj.shape(),
                     pose: &bj.state.pose,
                 },
+                old.map(|k| (self.pairs[k].kind, self.pairs[k].host_is_a)),
                 &params,
                 &mut sc.narrow,
                 &mut sc.seeds,
