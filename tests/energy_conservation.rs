@@ -203,37 +203,39 @@ fn energy_balance_holds_at_every_step_with_a_resolving_step() {
 }
 
 /// **An undamped block at rest on an incline below its friction angle stays put**: a 0.2 m
-/// cube on a 30° slope with φ = 40° (gravity turned by 30°), first brought to rest in static
-/// equilibrium (local damping, unbalanced-force ratio 1e-7), then run undamped for 1 s: it
-/// moves less than 0.1 mm, and nothing slides (no dissipation).
+/// cube on a slab inclined at 30° (gravity vertical), joint kn = ks = 1 GPa/m with φ = 40°, first
+/// brought to rest in static equilibrium (local damping, unbalanced-force ratio 1e-7), then run
+/// undamped for 1 s: it moves less than 0.1 mm, and nothing slides (no dissipation).
 ///
-/// It must start at rest in equilibrium: a cube released touching the slope with its joint
-/// unloaded oscillates on its springs (amplitude its elastic settlement, 4 µm), its normal force
-/// swings through zero at 225 Hz, and at each swing the joint slips by about a micrometre — a
-/// real response of an undamped elastic block to that release, not the walking this tests.
+/// It must start at rest in equilibrium. Released touching the slope with its joint unloaded,
+/// the cube drops onto its springs with every sub-contact slipping (no normal force yet), and
+/// keeps bouncing: its normal forces swing through zero at every cycle and it slips a little
+/// each time. How far depends on the joint's discretisation, and the energy balance closes
+/// while it does (gravity's work goes into friction): 11 mm in 1 s at 15 or 30 sub-contacts per
+/// edge, 36 mm at 8, 0.22 m at 3 (measured, with this build and the one before issue 16 alike);
+/// with ks = 0.4 kn, 0.26 mm. That is the response of the model to that release, which a real
+/// block resting on a slope never sees; it is not what this test is about.
 #[test]
 fn undamped_block_at_rest_on_an_incline_stays_put() {
-    let slope = 30f64.to_radians();
-    let params = ModelParameters {
-        gravity: 9.81 * Vector::new(slope.sin(), 0.0, -slope.cos()),
-        ..ModelParameters::default()
-    };
-    let mut model: Model = Model::new(params).expect("model");
+    let tilt = Pose::from_rotation(Rotation::from_rotation_y(-30f64.to_radians()));
+    let mut model: Model = Model::new(ModelParameters::default()).expect("model");
     model
         .set_joint_law(
             MaterialId(0),
             MaterialId(0),
-            CoulombSlip::dry(1e9, 4e8, 40.0).expect("law"),
+            CoulombSlip::dry(1e9, 1e9, 40.0).expect("law"),
         )
         .expect("law");
     model.set_damping(Damping::local()).expect("damping");
-    model.add_block(slab()).expect("slab");
+    model.add_block(slab().transformed(tilt)).expect("slab");
     let cube = model
         .add_block(
-            RigidBlock::cuboid("cube", Vector::new(-0.1, -0.1, 0.0), Vector::new(0.1, 0.1, 0.2), RHO).expect("cube"),
+            RigidBlock::cuboid("cube", Vector::new(-0.1, -0.1, 0.0), Vector::new(0.1, 0.1, 0.2), RHO)
+                .expect("cube")
+                .transformed(tilt),
         )
         .expect("cube");
-    model.run_to_equilibrium(1e-7, 200_000).expect("equilibrium");
+    model.run_to_equilibrium(1e-7, 400_000).expect("equilibrium");
     model.set_damping(Damping::None).expect("damping");
     let start = model.block(cube).expect("cube").state().pose;
     let (t0, friction0) = (model.time(), model.energies().friction);
@@ -248,8 +250,8 @@ fn undamped_block_at_rest_on_an_incline_stays_put() {
     }
     let e = model.energies();
     println!(
-        "incline: largest vertex displacement {largest:.3e} m; energies {e:?}; balance {:.3e} J",
-        e.input() - e.accounted()
+        "incline: largest vertex displacement {largest:.3e} m in 1 s undamped; dissipated {:.3e} J",
+        e.friction - friction0
     );
     assert!(largest < 1e-4, "the cube moved {largest} m");
     assert!(
