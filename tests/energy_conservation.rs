@@ -322,3 +322,105 @@ fn undamped_wall_settles_without_walking() {
     assert!(worst_balance <= 0.01 * scale, "balance {worst_balance} J vs {scale} J");
     assert!(e.friction >= 0.0);
 }
+
+/// A deterministic pseudo-random stream in [0, 1) (64-bit LCG), for reproducible random drops.
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> Real {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as Real) / ((1u64 << 53) as Real)
+    }
+}
+
+/// A cube (0), a regular tetrahedron (1) or a triangular wedge (2) of half-size `s`.
+fn sharp_block(kind: usize, s: Real) -> RigidBlock {
+    let v = |x, y, z| Vector::new(x, y, z);
+    match kind {
+        0 => RigidBlock::cuboid("cube", Vector::splat(-s), Vector::splat(s), RHO),
+        1 => RigidBlock::from_vertices(
+            "tetrahedron",
+            &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
+            RHO,
+        ),
+        _ => RigidBlock::from_vertices(
+            "wedge",
+            &[
+                v(-s, -s, -s),
+                v(s, -s, -s),
+                v(0.0, -s, s),
+                v(-s, s, -s),
+                v(s, s, -s),
+                v(0.0, s, s),
+            ],
+            RHO,
+        ),
+    }
+    .expect("block")
+}
+
+/// **Sharp blocks landing on sharp blocks keep their energy**: 40 frictionless undamped 5 cm
+/// drops of cubes, tetrahedra and wedges in random orientations onto fixed blocks of the same
+/// kinds, 0.6 s each; `|input − accounted|` within 1 % of `m g h` at the end.
+///
+/// Not yet met (issue 16 stays open): vertex, edge and tilted-face contacts between sharp
+/// features are point contacts, whose discretisation changes while loaded as a vertex contact
+/// grows to an edge or a face, and a block touching at a vertex alone gets a long step from that
+/// soft contact, so that the growing features are found deep (found by review). Measured at the
+/// end of the runs: 36 of the 40 drops beyond 1 % of `m g h`, 12 beyond `m g h`, the worst
+/// 9.8 `m g h` (friction exactly zero in all). Run with `--ignored`.
+#[test]
+#[ignore = "issue 16: 36 of 40 sharp-block drops beyond 1 % of m g h, worst 9.8 m g h"]
+fn frictionless_drops_of_sharp_blocks_keep_their_energy() {
+    let mut rng = Lcg(12345);
+    let mut failures = Vec::new();
+    for case in 0..40 {
+        let mut model: Model = Model::new(ModelParameters::default()).expect("model");
+        model
+            .set_joint_law(MaterialId(0), MaterialId(0), frictionless())
+            .expect("law");
+        model.set_damping(Damping::None).expect("damping");
+        let mut turn = |scale: Real| {
+            Rotation::from_scaled_axis(Vector::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5) * scale)
+        };
+        let base = sharp_block(case % 3, 0.15).transformed(Pose::from_rotation(turn(2.0)));
+        let top = base
+            .shape()
+            .vertices()
+            .iter()
+            .map(|v| base.world_point(*v).z)
+            .fold(Real::NEG_INFINITY, Real::max);
+        model
+            .add_block(
+                base.transformed(Pose::from_translation(Vector::new(0.0, 0.0, -top)))
+                    .with_fixity(Fixity::FIXED),
+            )
+            .expect("base");
+        let block = sharp_block((case / 3) % 3, 0.1).transformed(Pose::from_rotation(turn(3.0)));
+        let low = block
+            .shape()
+            .vertices()
+            .iter()
+            .map(|v| block.world_point(*v).z)
+            .fold(Real::INFINITY, Real::min);
+        let offset = Vector::new((rng.next() - 0.5) * 0.1, (rng.next() - 0.5) * 0.1, 0.05 - low);
+        let id = model
+            .add_block(block.transformed(Pose::from_translation(offset)))
+            .expect("block");
+        let mgh = model.block(id).expect("block").mass_properties().mass * 9.81 * 0.05;
+        model.run_until_time(0.6).expect("run");
+        let e = model.energies();
+        let error = (e.input() - e.accounted()).abs() / mgh;
+        println!(
+            "sharp drop {case}: |input − accounted| {error:.3} m g h, friction {:.1e} m g h",
+            e.friction / mgh
+        );
+        if error > 0.01 || e.friction != 0.0 {
+            failures.push((case, error));
+        }
+    }
+    assert!(failures.is_empty(), "{} of 40 drops: {failures:?}", failures.len());
+}

@@ -231,8 +231,8 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     /// `normal_displacement` (m), whatever the rest of the [`JointStep`] (shear and normal
     /// increments, normal, time step): [`ConstitutiveLaw::update`] would return
     /// [`JointStatus::Open`], leave the forces at zero and `state` unchanged. It is asked only
-    /// for face-face sub-contacts in large-displacement mode whose last status is `Open` with
-    /// zero forces (and no dashpot force).
+    /// for sub-contacts in large-displacement mode (where every contact's gap is geometric)
+    /// whose last status is `Open` with zero forces (and no dashpot force).
     ///
     /// The contact kernel then skips the sub-contact's kinematics and update (separated parts
     /// of joints are common: a quarter of the sub-contacts of a settled running-bond wall). It

@@ -38,7 +38,7 @@ pub(crate) struct KernelContext {
 ///
 /// Everything common to the contact is computed once: the joint axes `(n, t₁, t₂)` turned with
 /// the plane, and the displacement increment in those axes as a field affine in the anchor's
-/// plane coordinates `(x, y)`, `Δu = Δu_o + x Δu_x + y Δu_y`, and so is the face-face gap. A
+/// plane coordinates `(x, y)`, `Δu = Δu_o + x Δu_x + y Δu_y`, and so is the geometric gap. A
 /// sub-contact then costs six multiplications for its kinematics, its shear force needs no
 /// turning (its components follow the turning tangents), and its force enters the contact's
 /// resultant, moment and work through the sums `Σ f`, `Σ f x`, `Σ f y` (see [`ForceMoments`]).
@@ -313,7 +313,9 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
     let status = law.update(&step, &mut sub.force, &mut sub.state);
     let f = &sub.force;
     let dissipated = if sub.state != state_before {
-        let work = -0.5 * ((before.normal + f.normal) * du_n + (before.shear + f.shear).dot(du_s));
+        // The normal spring's work over the change of its gap (geometric in large-displacement
+        // mode), so that the time integration's error is not booked as dissipation.
+        let work = -0.5 * ((before.normal + f.normal) * (gap - sub.gap) + (before.shear + f.shear).dot(du_s));
         work - (law.elastic_energy(sub.area, f, &sub.state) - law.elastic_energy(sub.area, &before, &state_before))
     } else if status == JointStatus::Sliding || (status == JointStatus::Open && before.shear != Vector2::ZERO) {
         let work = -0.5 * (before.shear + f.shear).dot(du_s);

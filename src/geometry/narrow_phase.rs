@@ -47,7 +47,7 @@ pub struct ContactParameters {
     /// `tolerance` since its last detection. Default `0.25`.
     pub redetect_fraction: Real,
     /// The two faces most aligned with the contact normal form a face-to-face joint (a grid of
-    /// sub-contacts on the smaller face, gaps measured to the other face's plane) while their
+    /// sub-contacts on one of the faces, gaps measured to the other face's plane) while their
     /// normals are opposite within this angle (rad). Default 15°, so that an opening hinge keeps
     /// its sub-contacts and their history. Beyond it and up to 60°, they still form a face-face
     /// contact when the larger face covers the smaller one whole (an edge or corner landing on
@@ -433,7 +433,15 @@ fn face_face_hosted(
     }
     clip_convex(&mut scratch.other, &scratch.host, &mut scratch.tmp);
     let (overlap_area, _) = area_centroid(&scratch.other);
-    if overlap_area <= 1e-9 * face.area || (require_cover && overlap_area < (1.0 - 1e-9) * face.area) {
+    // Covered: the overlap is the smaller face whole (when the host is the larger face, the
+    // smaller face's projection on it).
+    let other_area = other.shape.faces()[fo].area;
+    let smaller_whole = if face.area <= other_area {
+        face.area
+    } else {
+        other_area * n_other.dot(face.normal).abs()
+    };
+    if overlap_area <= 1e-9 * face.area || (require_cover && overlap_area < (1.0 - 1e-9) * smaller_whole) {
         return Hosted::None;
     }
     // Gap at a point of the host face: its signed distance from the other face's plane, along

@@ -558,8 +558,8 @@ struct OldContacts<'a, S> {
 /// books it by the trapezoidal rule, half in step `n − 1` and half in step `n`: a dropped
 /// sub-contact never gets its second half `−½·F_{n−1}·Δu_n`, and the balance drifts by that much
 /// at every drop. Evaluated before the new lists replace the old ones (`dt` is still the step
-/// that produced the current poses); the stored energy that vanishes with the sub-contact ends
-/// up in `friction` (dissipated by the loss of contact).
+/// that produced the current poses); the stored energy that vanishes with the sub-contact is
+/// not dissipation and shows in [`crate::Energies::balance_error`].
 fn dropped_work<S>(
     old: OldContacts<'_, S>,
     new: (&[ContactPair], &[SubContactRecord]),
