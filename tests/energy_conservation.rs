@@ -40,6 +40,18 @@ fn slab() -> RigidBlock {
         .with_fixity(Fixity::FIXED)
 }
 
+/// The lowest and highest world `z` of a block's vertices (m).
+fn z_range(block: &RigidBlock) -> (Real, Real) {
+    block
+        .shape()
+        .vertices()
+        .iter()
+        .map(|v| block.world_point(*v).z)
+        .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), z| {
+            (lo.min(z), hi.max(z))
+        })
+}
+
 /// A model with the slab and a 0.2 m cube turned by `rotation` whose lowest point is `height`
 /// above the slab, undamped, with `law`.
 fn drop_model(rotation: Rotation, height: Real, law: CoulombSlip, params: ModelParameters) -> (Model, BlockId) {
@@ -50,12 +62,7 @@ fn drop_model(rotation: Rotation, height: Real, law: CoulombSlip, params: ModelP
     let cube = RigidBlock::cuboid("cube", Vector::splat(-EDGE / 2.0), Vector::splat(EDGE / 2.0), RHO)
         .expect("cube")
         .transformed(Pose::from_rotation(rotation));
-    let lowest = cube
-        .shape()
-        .vertices()
-        .iter()
-        .map(|v| cube.world_point(*v).z)
-        .fold(Real::INFINITY, Real::min);
+    let lowest = z_range(&cube).0;
     let id = model
         .add_block(cube.transformed(Pose::from_translation(Vector::new(0.0, 0.0, height - lowest))))
         .expect("cube");
@@ -404,12 +411,7 @@ fn frictionless_drops_of_sharp_blocks_keep_their_energy() {
             Rotation::from_scaled_axis(Vector::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5) * scale)
         };
         let base = sharp_block(case % 3, 0.15).transformed(Pose::from_rotation(turn(2.0)));
-        let top = base
-            .shape()
-            .vertices()
-            .iter()
-            .map(|v| base.world_point(*v).z)
-            .fold(Real::NEG_INFINITY, Real::max);
+        let top = z_range(&base).1;
         model
             .add_block(
                 base.transformed(Pose::from_translation(Vector::new(0.0, 0.0, -top)))
@@ -417,12 +419,7 @@ fn frictionless_drops_of_sharp_blocks_keep_their_energy() {
             )
             .expect("base");
         let block = sharp_block((case / 3) % 3, 0.1).transformed(Pose::from_rotation(turn(3.0)));
-        let low = block
-            .shape()
-            .vertices()
-            .iter()
-            .map(|v| block.world_point(*v).z)
-            .fold(Real::INFINITY, Real::min);
+        let low = z_range(&block).0;
         let offset = Vector::new((rng.next() - 0.5) * 0.1, (rng.next() - 0.5) * 0.1, 0.05 - low);
         let id = model
             .add_block(block.transformed(Pose::from_translation(offset)))
