@@ -143,7 +143,6 @@ fn check_drops(label: &str, rotations: &[Rotation], min_impacts: usize) {
 /// of `(ωΔt)²` of the impact energy where the springs close and open (`docs/theory.md` §4):
 /// 4–15 % of `m g h` over five or six impacts (measured). Run with `--ignored`.
 #[test]
-#[ignore = "issue 16: 4-15 % of m g h over five flat impacts at the default step"]
 fn frictionless_flat_drops_keep_their_energy() {
     check_drops("flat", &[Rotation::IDENTITY], 5);
 }

@@ -19,12 +19,24 @@ pub(crate) struct ContactStep {
     pub dissipated: Real,
     /// Work of the dashpot forces (J, negative: dissipated).
     pub dashpot_work: Real,
+    /// Whether a sub-contact is about to close or open fast (see [`KernelContext::impact_speed`]).
+    pub impact: bool,
+    /// Whether the relative speed over the contact may exceed the probe's speed.
+    pub fast: bool,
 }
 
 /// Read-only data shared by all contacts of a step.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct KernelContext {
+    /// The step that brought the blocks to their current poses (`Δt_{n−½}`): the displacement
+    /// increments are the velocities times it.
     pub dt: Real,
+    /// The impact probe: a sub-contact whose normal speed exceeds this (m/s) and that will
+    /// cross the spring's kink (close or open) within [`impact_horizon`](Self::impact_horizon)
+    /// at that speed marks its contact as impacting. Infinite: no probe.
+    pub impact_speed: Real,
+    /// The probe's look-ahead (s).
+    pub impact_horizon: Real,
     /// Rayleigh stiffness-proportional coefficient `b` (s).
     pub stiffness_damping: Real,
     pub mode: DisplacementMode,
@@ -55,6 +67,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     (sb, rotation_b): (&BlockState, &Matrix),
     law: &L,
     ctx: KernelContext,
+    host_radius: Real,
 ) -> ContactStep {
     // The axes of the previous step, in which the stored spring forces were composed.
     let previous_axes = pair.axes();
@@ -209,6 +222,24 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         (-(moment_host + (xb - xa).cross(force)), moment_host)
     };
     pair.normal_force = sums.force.x;
+    // The impact probe: first a bound of the relative speed over the host's anchors
+    // (|r| ≤ the host's radius), so that a quiet contact costs a few operations; then each
+    // sub-contact's normal speed and its gap (as updated above) against the kink, where the law
+    // has one: a sub-contact that would be open at that gap with no force (a spring carrying
+    // tension, or a law that does not say, `stays_open` false, has no kink to resolve).
+    let mut impact = false;
+    let fast = ctx.impact_speed.is_finite() && v0.length() + dw.length() * host_radius > ctx.impact_speed;
+    if fast {
+        let threshold = ctx.impact_speed * dt;
+        let reach = ctx.impact_horizon / dt;
+        impact = subs.iter().any(|s| {
+            let du_n = increment(&kinematics, s.plane.x, s.plane.y)[0];
+            du_n.abs() > threshold
+                && (s.gap > 0.0) != (du_n > 0.0)
+                && s.gap.abs() < reach * du_n.abs()
+                && law.stays_open(s.area, s.gap.abs(), &s.state)
+        });
+    }
     ContactStep {
         wrench: ContactWrench {
             force,
@@ -218,6 +249,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         work: -0.5 * spring_sum,
         dissipated,
         dashpot_work: -0.5 * dashpot_sum,
+        impact,
+        fast,
     }
 }
 

@@ -27,6 +27,13 @@ impl CentralDifference {
     }
 }
 
+/// The two durations of a variable step (see [`Integrator::advance_variable`]).
+#[derive(Debug, Clone, Copy)]
+struct Steps {
+    kick: Real,
+    drift: Real,
+}
+
 /// Blocks per rayon task.
 const BLOCKS_PER_TASK: usize = 256;
 /// Up to this many blocks are advanced on the calling thread: a chunk of the model's block pass
@@ -35,6 +42,19 @@ const SERIAL_BLOCKS: usize = 512;
 
 impl Integrator for CentralDifference {
     fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]) {
+        self.advance_variable(blocks, forces, dt, dt, records);
+    }
+
+    /// Variable steps: the kick over `kick`, the drift (and the mid-step rotation) over `drift`.
+    fn advance_variable(
+        &self,
+        blocks: &mut [RigidBlock],
+        forces: &[Wrench],
+        kick: Real,
+        drift: Real,
+        records: &mut [StepRecord],
+    ) {
+        let dt = Steps { kick, drift };
         let damping = self.damping;
         let avx2 = crate::dispatch::has_avx2();
         let run = |blocks: &mut [RigidBlock], loads: &[Wrench], records: &mut [StepRecord]| {
@@ -72,7 +92,7 @@ impl Integrator for CentralDifference {
 }
 
 #[inline(always)]
-fn advance_chunk(blocks: &mut [RigidBlock], loads: &[Wrench], records: &mut [StepRecord], dt: Real, damping: Damping) {
+fn advance_chunk(blocks: &mut [RigidBlock], loads: &[Wrench], records: &mut [StepRecord], dt: Steps, damping: Damping) {
     for ((block, load), rec) in blocks.iter_mut().zip(loads).zip(records) {
         *rec = advance_block(block, load, dt, damping);
     }
@@ -88,7 +108,7 @@ unsafe fn advance_chunk_avx2(
     blocks: &mut [RigidBlock],
     loads: &[Wrench],
     records: &mut [StepRecord],
-    dt: Real,
+    dt: Steps,
     damping: Damping,
 ) {
     advance_chunk(blocks, loads, records, dt, damping);
@@ -117,7 +137,9 @@ fn sign(x: Real) -> Real {
 }
 
 #[inline(always)]
-fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Damping) -> StepRecord {
+fn advance_block(block: &mut RigidBlock, load: &Wrench, steps: Steps, damping: Damping) -> StepRecord {
+    // The impulse over the kick; the mid-step rotation and the move over the drift.
+    let Steps { kick, drift } = steps;
     let mass = block.mass_properties().mass;
     // A free block's fixity is the constant (its own sits on a cache line the step need not read).
     let fixity = if block.is_free() { Fixity::FREE } else { *block.fixity() };
@@ -127,21 +149,21 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
         Damping::None => (0.0, 0.0),
     };
     let s0 = block.state;
-    let (c1, c2) = (1.0 - 0.5 * a * dt, 1.0 / (1.0 + 0.5 * a * dt));
+    let (c1, c2) = (1.0 - 0.5 * a * kick, 1.0 / (1.0 + 0.5 * a * kick));
 
     // Translation.
     let f = local_damp(load.force, s0.velocity, alpha, &fixity.translation);
-    let mut v = (s0.velocity * c1 + f * (dt / mass)) * c2;
+    let mut v = (s0.velocity * c1 + f * (kick / mass)) * c2;
     let mut reaction = Wrench::default();
     for i in 0..3 {
         if let Some(p) = fixity.translation[i].prescribed() {
             v[i] = p;
-            reaction.force[i] = mass * (p - s0.velocity[i]) / dt - load.force[i];
+            reaction.force[i] = mass * (p - s0.velocity[i]) / kick - load.force[i];
         }
     }
     // Rotation.
     let m = local_damp(load.moment, s0.angular_velocity, alpha, &fixity.rotation);
-    let mut l = (s0.angular_momentum * c1 + m * dt) * c2;
+    let mut l = (s0.angular_momentum * c1 + m * kick) * c2;
     // ω(t+Δt/2) = R(t+Δt/2)·I⁻¹·R(t+Δt/2)ᵀ·L(t+Δt/2), with R(t+Δt/2) = exp(ω·Δt/2)·R(t): solved by
     // fixed-point iteration (contraction ~ |ω|Δt/2). Evaluating at R(t) instead makes the
     // rotation update first order and pumps energy into a free asymmetric spinner.
@@ -155,16 +177,16 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
     // ω₁ = ω₀ − (Δt/2)·A₀·(ω₀×L), within O(θ²)·|ω| of the fixed point (one exact pass less).
     let m0 = Matrix::from_quat(r0);
     let w0 = inertia_inverse_times(&m0, l);
-    let mut w = w0 - inertia_inverse_times(&m0, (0.5 * dt * w0).cross(l));
+    let mut w = w0 - inertia_inverse_times(&m0, (0.5 * drift * w0).cross(l));
     // The iteration contracts by about |ω|Δt/2 per pass: it stops when the next correction
     // would fall below round-off (at once for a block of masonry moving slowly, after three
     // exact passes at most).
     let mut change = (w - w0).length();
     for _ in 0..3 {
-        if change * (0.5 * dt * w.length()) <= Real::EPSILON * w.length() {
+        if change * (0.5 * drift * w.length()) <= Real::EPSILON * w.length() {
             break;
         }
-        let next = inertia_inverse_times(&Matrix::from_quat(rotation_from_vector(0.5 * dt * w) * r0), l);
+        let next = inertia_inverse_times(&Matrix::from_quat(rotation_from_vector(0.5 * drift * w) * r0), l);
         change = (next - w).length();
         w = next;
     }
@@ -179,7 +201,7 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
         l = block.world_inertia_times(w);
         for i in 0..3 {
             if fixity.rotation[i].prescribed().is_some() {
-                reaction.moment[i] = (l[i] - s0.angular_momentum[i]) / dt - load.moment[i];
+                reaction.moment[i] = (l[i] - s0.angular_momentum[i]) / kick - load.moment[i];
             }
         }
     }
@@ -207,8 +229,8 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, dt: Real, damping: Dampi
     st.velocity = v;
     st.angular_velocity = w;
     st.angular_momentum = l;
-    st.pose.translation += v * dt;
-    let angle = w * dt;
+    st.pose.translation += v * drift;
+    let angle = w * drift;
     if angle.length_squared() > 0.0 {
         st.pose.rotation = (rotation_from_vector(angle) * st.pose.rotation).normalize();
     }

@@ -84,6 +84,26 @@ pub trait Integrator: Send + Sync + std::fmt::Debug {
     /// Advances velocities to `t + dt/2` and poses to `t + dt`, filling `records`.
     fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]);
 
+    /// One step of a variable step: the velocities get the impulse of the forces over `kick`
+    /// (`½(Δt_{n−½} + Δt_{n+½})`, the time the force of level `n` stands for), the poses move
+    /// by the new velocities over `drift` (`Δt_{n+½}`). The model calls this every step;
+    /// `kick == drift` whenever the step did not change.
+    ///
+    /// The default calls [`advance`](Self::advance) with `drift`, which is first order at the
+    /// steps where the step changes (the model changes it around impacts, see
+    /// `ModelParameters::impact_step`); [`CentralDifference`] implements it exactly.
+    fn advance_variable(
+        &self,
+        blocks: &mut [RigidBlock],
+        forces: &[Wrench],
+        kick: Real,
+        drift: Real,
+        records: &mut [StepRecord],
+    ) {
+        let _ = kick;
+        self.advance(blocks, forces, drift, records);
+    }
+
     /// Whether [`advance`](Self::advance) treats each block on its own: a block's new state and
     /// record depend only on that block, its force and `dt`, as in any explicit scheme.
     ///

@@ -68,6 +68,16 @@ struct Snapshot<L: ConstitutiveLaw> {
     /// fixity or blocks before the save and not yet done.
     #[serde(default)]
     pending_detection: bool,
+    /// The last step's duration and the impact refinement's state (absent: a constant step).
+    #[serde(default)]
+    drift: Real,
+    #[serde(default)]
+    refine_until: Real,
+    #[serde(default)]
+    refine_omega2: Real,
+    /// The blocks under impact refinement.
+    #[serde(default)]
+    refining: Vec<u32>,
 }
 
 impl<L> Model<L>
@@ -108,6 +118,12 @@ where
             history: self.history.clone(),
             monitor_interval: self.monitor_interval,
             last_forces: self.records.iter().map(|r| (r.reaction, r.damping)).collect(),
+            drift: self.drift,
+            refine_until: self.refine_until,
+            refine_omega2: self.refine_omega2,
+            refining: (0..self.refining.len() as u32)
+                .filter(|&i| self.refining[i as usize])
+                .collect(),
             pending_detection: self.scratch.force_full_detection,
         };
         serde_json::to_string(&snap).map_err(|e| Error::Io {
@@ -273,6 +289,21 @@ where
         }
         model.ref_poses = snap.ref_poses;
         model.dt = snap.dt;
+        model.drift = if snap.drift > 0.0 && snap.started {
+            snap.drift
+        } else {
+            0.0
+        };
+        model.refine_until = snap.refine_until;
+        model.refine_omega2 = snap.refine_omega2;
+        if !snap.refining.is_empty() {
+            model.refining = vec![false; model.blocks.len()];
+            for &i in &snap.refining {
+                if let Some(f) = model.refining.get_mut(i as usize) {
+                    *f = true;
+                }
+            }
+        }
         model.critical = snap.critical;
         model.step = snap.step;
         model.time = snap.time;

@@ -234,7 +234,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             &sc.moved,
             &self.blocks,
             self.params.mode,
-            self.dt,
+            if self.drift > 0.0 { self.drift } else { self.dt },
         );
         self.energy.joint_work += work;
         self.energy.damping += dashpot;

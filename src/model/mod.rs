@@ -38,6 +38,11 @@ pub struct ModelParameters {
     pub mode: DisplacementMode,
     /// A block faster than this (m/s) means the run has diverged. Default 1000 m/s.
     pub max_speed: Real,
+    /// Impact-resolving step: with an automatic step, while a sub-contact is about to close or
+    /// open fast (an impact, a release), the step is refined to this fraction of the critical
+    /// step of the blocks involved, and relaxed back once their contacts no longer cross the
+    /// spring's kink (`docs/theory.md` §5.4). Default `Some(0.1)`; `None` keeps the step.
+    pub impact_step: Option<Real>,
 }
 
 impl Default for ModelParameters {
@@ -48,6 +53,7 @@ impl Default for ModelParameters {
             time_step: TimeStep::default(),
             mode: DisplacementMode::Large,
             max_speed: 1e3,
+            impact_step: Some(0.1),
         }
     }
 }
@@ -71,6 +77,9 @@ impl ModelParameters {
             }
         }
         positive("max_speed", self.max_speed)?;
+        if let Some(r) = self.impact_step {
+            crate::error::in_range("impact_step", r, 1e-6, 1.0 + 1e-12, "must lie in (0, 1]")?;
+        }
         Ok(())
     }
 }
@@ -122,7 +131,18 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     /// Rotation matrices of the blocks at the start of the step (see `prepare_blocks`).
     rotations: Vec<Matrix>,
     bounds: Vec<StiffnessBound>,
+    /// The step: `safety × critical` (or the fixed one), as set at the last evaluation.
     dt: Real,
+    /// The step that brought the blocks to their poses (`Δt_{n−½}`): `dt`, or shorter around
+    /// impacts (see [`ModelParameters::impact_step`]).
+    drift: Real,
+    /// Impact refinement: the time until which it holds, and the largest squared frequency
+    /// bound of the blocks that asked for it (0 when not refining).
+    refine_until: Real,
+    refine_omega2: Real,
+    /// The blocks of contacts the impact probe marked since the refinement began: the step is
+    /// not relaxed while one of their contacts is loaded and moving fast.
+    refining: Vec<bool>,
     critical: Option<CriticalStep>,
     step: u64,
     time: Real,
@@ -187,6 +207,10 @@ struct ContactPass<'a, L: ConstitutiveLaw> {
     /// The contacts' references, index for index with the contacts.
     references: &'a [ContactReference],
     laws: &'a [L],
+    /// The blocks' squared frequency bounds, for the impact probe.
+    bounds: &'a [StiffnessBound],
+    /// The blocks under impact refinement (empty when none).
+    refining: &'a [bool],
     subs: SubsPtr<SubContact<L::State>>,
     sub_records: SubsPtr<SubContactRecord>,
     total_subs: usize,
@@ -224,12 +248,30 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 (&b.state, rb),
                 &self.laws[p.law as usize],
                 self.ctx,
+                if p.host_is_a { a.radius } else { b.radius },
             );
             *w = step.wrench;
             sums.force_magnitude += step.wrench.force.length();
             sums.work += step.work;
             sums.dissipated += step.dissipated;
             sums.dashpot_work += step.dashpot_work;
+            if step.impact {
+                let w2 = self.bounds[p.a as usize]
+                    .omega_squared
+                    .max(self.bounds[p.b as usize].omega_squared);
+                sums.impact = sums.impact.max(w2);
+                if (sums.fired_count as usize) < sums.fired.len() {
+                    sums.fired[sums.fired_count as usize] = (p.a, p.b);
+                }
+                sums.fired_count += 1;
+            }
+            if step.fast
+                && p.normal_force > 0.0
+                && !self.refining.is_empty()
+                && (self.refining[p.a as usize] || self.refining[p.b as usize])
+            {
+                sums.busy = true;
+            }
         }
     }
 
@@ -262,6 +304,14 @@ struct PairSums {
     /// Energy dissipated by the joint laws (J).
     dissipated: Real,
     dashpot_work: Real,
+    /// The largest squared frequency bound of the blocks of an impacting contact (0: none).
+    impact: Real,
+    /// The blocks of the first impacting contacts, and how many there were (all the chunk's
+    /// contacts count when they do not fit).
+    fired: [(u32, u32); 4],
+    fired_count: u32,
+    /// Whether a loaded contact of a refining block moves fast.
+    busy: bool,
 }
 
 /// Per-chunk sums of the block passes.
@@ -351,6 +401,10 @@ impl<L: ConstitutiveLaw> Model<L> {
             rotations: Vec::new(),
             bounds: Vec::new(),
             dt: 0.0,
+            drift: 0.0,
+            refine_until: 0.0,
+            refine_omega2: 0.0,
+            refining: Vec::new(),
             critical: None,
             step: 0,
             time: 0.0,
@@ -564,6 +618,16 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.dt
     }
 
+    /// The duration of the last step (s): [`dt`](Self::dt), or shorter while the step was refined
+    /// around an impact (see [`ModelParameters::impact_step`]); `dt` before the first step.
+    pub fn last_step(&self) -> Real {
+        if self.drift > 0.0 {
+            self.drift
+        } else {
+            self.dt
+        }
+    }
+
     /// The critical time step and the block that limits it (after the first step).
     pub fn critical_step(&self) -> Option<CriticalStep> {
         self.critical
@@ -722,17 +786,24 @@ impl<L: ConstitutiveLaw> Model<L> {
             self.refresh_time_step()?;
             self.scratch.force_full_detection = false;
         }
+        if self.drift == 0.0 {
+            // The first step: the initial velocities stand for those of the half step before.
+            self.drift = self.dt;
+        }
         let detected = std::time::Instant::now();
-        self.compute_forces();
+        let (impact, busy) = self.compute_forces();
+        let previous = self.drift;
+        let drift = self.next_drift(impact, busy);
         let forces = std::time::Instant::now();
-        let diverged = self.advance_blocks();
+        let diverged = self.advance_blocks(0.5 * (previous + drift), drift);
+        self.drift = drift;
         let t = &mut self.timings;
         t.detection += (detected - started).as_secs_f64();
         t.contacts += (forces - detected).as_secs_f64();
         t.integration += forces.elapsed().as_secs_f64();
         t.steps += 1;
         self.step += 1;
-        self.time += self.dt;
+        self.time += drift;
         if let Some(i) = diverged {
             return Err(self.divergence_error(i));
         }
@@ -753,9 +824,64 @@ impl<L: ConstitutiveLaw> Model<L> {
         Ok(())
     }
 
-    fn compute_forces(&mut self) {
+    /// The step to take from the current poses, `Δt_{n+½}`, given the largest squared frequency
+    /// bound of the blocks whose contacts are about to close or open fast (0: none) and whether
+    /// a loaded contact of a refining block moves fast (`busy`): `dt`, or, from an impact,
+    /// `impact_step × 2/ω` for the fastest block that asked for it, until the refinement's hold
+    /// (three of that block's critical steps after the last probe that fired, which spans the
+    /// middle of a flat impact, where the sub-contacts are deep and the probe is quiet) has
+    /// passed and no contact of the refining blocks is both loaded and fast. The step thus
+    /// changes while the impacting contacts are open, or once the motion is quiet.
+    fn next_drift(&mut self, impact: Real, busy: bool) -> Real {
+        let (Some(r), TimeStep::Auto { .. }) = (self.params.impact_step, self.params.time_step) else {
+            return self.dt;
+        };
+        if impact > 0.0 {
+            let hold = 3.0 * 2.0 / impact.sqrt();
+            self.refine_until = self.refine_until.max(self.time + hold);
+            self.refine_omega2 = self.refine_omega2.max(impact);
+            self.refining.resize(self.blocks.len(), false);
+            for (k, s) in self.pair_sums.iter().enumerate() {
+                if s.fired_count as usize <= s.fired.len() {
+                    for &(a, b) in &s.fired[..s.fired_count as usize] {
+                        self.refining[a as usize] = true;
+                        self.refining[b as usize] = true;
+                    }
+                } else {
+                    let end = ((k + 1) * CONTACT_CHUNK).min(self.pairs.len());
+                    for p in &self.pairs[k * CONTACT_CHUNK..end] {
+                        self.refining[p.a as usize] = true;
+                        self.refining[p.b as usize] = true;
+                    }
+                }
+            }
+        }
+        if self.refine_omega2 > 0.0 && (self.time < self.refine_until || busy) {
+            self.dt.min(r * 2.0 / self.refine_omega2.sqrt())
+        } else {
+            self.refine_omega2 = 0.0;
+            self.refining.clear();
+            self.dt
+        }
+    }
+
+    /// The contact pass; returns the largest squared frequency bound of the blocks of the
+    /// contacts the impact probe marked (0: none), and whether a loaded contact of a refining
+    /// block moves fast.
+    fn compute_forces(&mut self) -> (Real, bool) {
+        // The probe: normal speeds beyond that of a fall through the contact tolerance,
+        // `√(2 g tol)` (a block settling on its joints moves much slower), crossing the kink
+        // within two steps.
+        let probe = matches!(self.params.time_step, TimeStep::Auto { .. }) && self.params.impact_step.is_some();
+        let impact_speed = if probe {
+            (2.0 * self.params.gravity.length() * self.params.contact.tolerance).sqrt()
+        } else {
+            Real::INFINITY
+        };
         let ctx = KernelContext {
-            dt: self.dt,
+            dt: self.drift,
+            impact_speed,
+            impact_horizon: 2.0 * self.dt,
             stiffness_damping: self.integrator.damping().stiffness_coefficient(),
             mode: self.params.mode,
         };
@@ -772,6 +898,8 @@ impl<L: ConstitutiveLaw> Model<L> {
             rotations: &self.rotations,
             references: &self.references,
             laws: self.joints.laws(),
+            bounds: &self.bounds,
+            refining: &self.refining,
             subs: SubsPtr(self.subs.as_mut_ptr()),
             sub_records: SubsPtr(self.sub_records.as_mut_ptr()),
             total_subs: self.subs.len(),
@@ -799,6 +927,10 @@ impl<L: ConstitutiveLaw> Model<L> {
                 }
                 pass.run(first, chunk, wrenches, sums);
             });
+        (
+            self.pair_sums.iter().map(|s| s.impact).fold(0.0, Real::max),
+            self.pair_sums.iter().any(|s| s.busy),
+        )
     }
 
     fn divergence_error(&self, i: usize) -> Error {
@@ -962,6 +1094,8 @@ mod tests {
     ) -> [usize; 4] {
         let ctx = KernelContext {
             dt: model.dt,
+            impact_speed: Real::INFINITY,
+            impact_horizon: 0.0,
             stiffness_damping: 0.0,
             mode: model.params.mode,
         };
@@ -1007,6 +1141,7 @@ mod tests {
                     sb,
                     law,
                     ctx,
+                    0.0,
                 )
                 .wrench;
             }

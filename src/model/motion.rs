@@ -27,7 +27,12 @@ struct BlockPass<'a> {
     contacts: &'a [u32],
     offsets: &'a [u32],
     gravity: Vector,
+    /// The step that brought the blocks to their current poses, `Δt_{n−½}`: the works of
+    /// step `n` are booked over its displacement.
     dt: Real,
+    /// `Δt_{n+½} / ½(Δt_{n−½} + Δt_{n+½})`: the drift over the kick of this step (1 while the
+    /// step does not change), for the kinetic energy.
+    drift_over_kick: Real,
     /// `½` on the first step (no force before it), else `1`: the weight of the `F_{n−1}` half of
     /// gravity's and the loads' work.
     first: Real,
@@ -99,7 +104,16 @@ impl BlockPass<'_> {
             // The velocities before the step, from the mean the integrator reports.
             let v0 = 2.0 * r.mean_velocity - v1;
             let w0 = 2.0 * r.mean_angular_velocity - w1;
-            sums.kinetic += 0.5 * m * v0.dot(v1) + 0.5 * w0.dot(b.state.angular_momentum);
+            // With a step that changes, `v⁻` as if the last step had been as long as this one,
+            // `v⁺ − (Δt_{n+½}/kick)(v⁺ − v⁻)`: the product then telescopes with the works over
+            // `Δt_{n−½}` (up to `¼ (Δt_{n+½} − Δt_{n−½}) kick |F|²/m` where the step changes).
+            let (v0k, w0k) = if self.drift_over_kick == 1.0 {
+                (v0, w0)
+            } else {
+                let s = self.drift_over_kick;
+                (v1 - (v1 - v0) * s, w1 - (w1 - w0) * s)
+            };
+            sums.kinetic += 0.5 * m * v0k.dot(v1) + 0.5 * w0k.dot(b.state.angular_momentum);
             sums.boundary_work += 0.5 * (r.reaction.force.dot(v0) + r.reaction.moment.dot(w0)) * dt;
             sums.damping -= 0.5 * (r.damping.force.dot(v0) + r.damping.moment.dot(w0)) * dt;
             if sums.diverged.is_none() && diverged(b, self.max_speed2) {
@@ -119,19 +133,19 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// exact identity of central difference for translation. Sums are taken per chunk of
     /// [`BLOCK_CHUNK`] blocks in block order, then over the chunks in order, whichever path
     /// runs: the results do not depend on the thread count, nor on whether the stages are fused.
-    pub(super) fn advance_blocks(&mut self) -> Option<usize> {
+    pub(super) fn advance_blocks(&mut self, kick: Real, drift: Real) -> Option<usize> {
         let pass = BlockPass {
             wrenches: &self.wrenches,
             contacts: &self.block_contacts,
             offsets: &self.block_offsets,
             gravity: self.params.gravity,
-            dt: self.dt,
+            dt: self.drift,
+            drift_over_kick: if kick == drift { 1.0 } else { drift / kick },
             first: if self.step == 0 { 0.5 } else { 1.0 },
             max_speed2: self.params.max_speed * self.params.max_speed,
             trigger: (self.params.mode == DisplacementMode::Large)
                 .then_some(self.params.contact.redetect_fraction * self.params.contact.tolerance),
         };
-        let dt = self.dt;
         self.block_sums.clear();
         self.block_sums
             .resize(self.blocks.len().div_ceil(BLOCK_CHUNK), BlockSums::default());
@@ -151,7 +165,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 .for_each(|(k, (((((blocks, forces), records), rotations), refs), sums))| {
                     let first_block = k * BLOCK_CHUNK;
                     pass.gather(first_block, blocks, forces, records, sums);
-                    integrator.advance(blocks, forces, dt, records);
+                    integrator.advance_variable(blocks, forces, kick, drift, records);
                     pass.settle(first_block, blocks, records, sums);
                     sums.moved = prepare_chunk(rotations, blocks, refs, pass.trigger);
                 });
@@ -168,7 +182,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     let end = (first_block + BLOCK_CHUNK).min(blocks.len());
                     pass.gather(first_block, &blocks[first_block..end], forces, records, sums);
                 });
-            integrator.advance(&mut self.blocks, &self.forces, dt, &mut self.records);
+            integrator.advance_variable(&mut self.blocks, &self.forces, kick, drift, &mut self.records);
             self.blocks
                 .par_chunks(BLOCK_CHUNK)
                 .zip(self.records.par_chunks(BLOCK_CHUNK))
@@ -230,6 +244,16 @@ mod tests {
     impl Integrator for Separate {
         fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]) {
             self.0.advance(blocks, forces, dt, records);
+        }
+        fn advance_variable(
+            &self,
+            blocks: &mut [RigidBlock],
+            forces: &[Wrench],
+            kick: Real,
+            drift: Real,
+            records: &mut [StepRecord],
+        ) {
+            self.0.advance_variable(blocks, forces, kick, drift, records);
         }
         fn damping(&self) -> crate::integrate::Damping {
             self.0.damping()
