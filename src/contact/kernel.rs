@@ -21,8 +21,9 @@ pub(crate) struct ContactStep {
     pub dashpot_work: Real,
     /// Whether a sub-contact is about to close or open fast (see [`KernelContext::impact_speed`]).
     pub impact: bool,
-    /// Whether the relative speed over the contact may exceed the probe's speed.
-    pub fast: bool,
+    /// For a watched contact (see [`update_contact`]): whether it carries a normal force and
+    /// the relative speed over it may exceed the probe's speed (an impact still under way).
+    pub busy: bool,
 }
 
 /// Read-only data shared by all contacts of a step.
@@ -56,6 +57,11 @@ pub(crate) struct KernelContext {
 /// resultant, moment and work through the sums `Σ f`, `Σ f x`, `Σ f y` (see [`ForceMoments`]).
 /// Without dashpot forces the sub-contacts go four at a time (`lanes.rs`), with the same
 /// operations per sub-contact.
+///
+/// The impact probe (see [`KernelContext::impact_speed`]) marks the contact when a sub-contact
+/// is about to cross the spring's kink fast; `host_radius` bounds the anchors' lever arms for
+/// its quick test, and a `watch`ed contact (one the probe marked since the refinement began)
+/// reports whether it is still loaded and moving.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(crate) fn update_contact<L: ConstitutiveLaw>(
@@ -68,6 +74,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     law: &L,
     ctx: KernelContext,
     host_radius: Real,
+    watch: bool,
 ) -> ContactStep {
     // The axes of the previous step, in which the stored spring forces were composed.
     let previous_axes = pair.axes();
@@ -228,6 +235,10 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let fast = 2.0 * (v0.length_squared() + dw.length_squared() * (host_radius * host_radius))
         > ctx.impact_speed * ctx.impact_speed;
     let impact = fast && impact_probe(subs, law, &kinematics, ctx);
+    // A contact the probe marked keeps the step refined while it is loaded and moving: a
+    // bound of the relative speed, so that a block rocking on a loaded edge whose sub-contacts
+    // barely move keeps it too (the step must not change while springs are loaded).
+    let busy = watch && fast && pair.normal_force > 0.0;
     ContactStep {
         wrench: ContactWrench {
             force,
@@ -238,7 +249,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         dissipated,
         dashpot_work: -0.5 * dashpot_sum,
         impact,
-        fast,
+        busy,
     }
 }
 

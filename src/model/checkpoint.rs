@@ -75,9 +75,9 @@ struct Snapshot<L: ConstitutiveLaw> {
     refine_until: Real,
     #[serde(default)]
     refine_omega2: Real,
-    /// The blocks under impact refinement.
+    /// The contacts under impact refinement (sorted block pairs).
     #[serde(default)]
-    refining: Vec<u32>,
+    refining: Vec<(u32, u32)>,
 }
 
 impl<L> Model<L>
@@ -121,9 +121,7 @@ where
             drift: self.drift,
             refine_until: self.refine_until,
             refine_omega2: self.refine_omega2,
-            refining: (0..self.refining.len() as u32)
-                .filter(|&i| self.refining[i as usize])
-                .collect(),
+            refining: self.refining.clone(),
             pending_detection: self.scratch.force_full_detection,
         };
         serde_json::to_string(&snap).map_err(|e| Error::Io {
@@ -296,14 +294,9 @@ where
         };
         model.refine_until = snap.refine_until;
         model.refine_omega2 = snap.refine_omega2;
-        if !snap.refining.is_empty() {
-            model.refining = vec![false; model.blocks.len()];
-            for &i in &snap.refining {
-                if let Some(f) = model.refining.get_mut(i as usize) {
-                    *f = true;
-                }
-            }
-        }
+        model.refining = snap.refining;
+        model.refining.sort_unstable();
+        model.refining.dedup();
         model.critical = snap.critical;
         model.step = snap.step;
         model.time = snap.time;

@@ -140,9 +140,9 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     /// bound of the blocks that asked for it (0 when not refining).
     refine_until: Real,
     refine_omega2: Real,
-    /// The blocks of contacts the impact probe marked since the refinement began: the step is
-    /// not relaxed while one of their contacts is loaded and moving fast.
-    refining: Vec<bool>,
+    /// The contacts (as sorted block pairs) the impact probe marked since the refinement began:
+    /// the step is not relaxed while one of them is loaded and moving fast.
+    refining: Vec<(u32, u32)>,
     critical: Option<CriticalStep>,
     step: u64,
     time: Real,
@@ -209,8 +209,8 @@ struct ContactPass<'a, L: ConstitutiveLaw> {
     laws: &'a [L],
     /// The blocks' squared frequency bounds, for the impact probe.
     bounds: &'a [StiffnessBound],
-    /// The blocks under impact refinement (empty when none).
-    refining: &'a [bool],
+    /// The contacts under impact refinement, sorted (empty when none).
+    refining: &'a [(u32, u32)],
     subs: SubsPtr<SubContact<L::State>>,
     sub_records: SubsPtr<SubContactRecord>,
     total_subs: usize,
@@ -249,6 +249,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 &self.laws[p.law as usize],
                 self.ctx,
                 if p.host_is_a { a.radius } else { b.radius },
+                !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok(),
             );
             *w = step.wrench;
             sums.force_magnitude += step.wrench.force.length();
@@ -265,13 +266,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 }
                 sums.fired_count += 1;
             }
-            if step.fast
-                && p.normal_force > 0.0
-                && !self.refining.is_empty()
-                && (self.refining[p.a as usize] || self.refining[p.b as usize])
-            {
-                sums.busy = true;
-            }
+            sums.busy |= step.busy;
         }
     }
 
@@ -310,7 +305,7 @@ struct PairSums {
     /// contacts count when they do not fit).
     fired: [(u32, u32); 4],
     fired_count: u32,
-    /// Whether a loaded contact of a refining block moves fast.
+    /// Whether a loaded impacting contact moves fast.
     busy: bool,
 }
 
@@ -826,11 +821,11 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// The step to take from the current poses, `Δt_{n+½}`, given the largest squared frequency
     /// bound of the blocks whose contacts are about to close or open fast (0: none) and whether
-    /// a loaded contact of a refining block moves fast (`busy`): `dt`, or, from an impact,
+    /// a loaded impacting contact moves fast (`busy`): `dt`, or, from an impact,
     /// `impact_step × 2/ω` for the fastest block that asked for it, until the refinement's hold
     /// (three of that block's critical steps after the last probe that fired, which spans the
     /// middle of a flat impact, where the sub-contacts are deep and the probe is quiet) has
-    /// passed and no contact of the refining blocks is both loaded and fast. The step thus
+    /// passed and none of the contacts the probe marked is both loaded and fast. The step thus
     /// changes while the impacting contacts are open, or once the motion is quiet.
     fn next_drift(&mut self, impact: Real, busy: bool) -> Real {
         let (Some(r), TimeStep::Auto { .. }) = (self.params.impact_step, self.params.time_step) else {
@@ -840,21 +835,17 @@ impl<L: ConstitutiveLaw> Model<L> {
             let hold = 3.0 * 2.0 / impact.sqrt();
             self.refine_until = self.refine_until.max(self.time + hold);
             self.refine_omega2 = self.refine_omega2.max(impact);
-            self.refining.resize(self.blocks.len(), false);
             for (k, s) in self.pair_sums.iter().enumerate() {
                 if s.fired_count as usize <= s.fired.len() {
-                    for &(a, b) in &s.fired[..s.fired_count as usize] {
-                        self.refining[a as usize] = true;
-                        self.refining[b as usize] = true;
-                    }
+                    self.refining.extend_from_slice(&s.fired[..s.fired_count as usize]);
                 } else {
                     let end = ((k + 1) * CONTACT_CHUNK).min(self.pairs.len());
-                    for p in &self.pairs[k * CONTACT_CHUNK..end] {
-                        self.refining[p.a as usize] = true;
-                        self.refining[p.b as usize] = true;
-                    }
+                    self.refining
+                        .extend(self.pairs[k * CONTACT_CHUNK..end].iter().map(|p| (p.a, p.b)));
                 }
             }
+            self.refining.sort_unstable();
+            self.refining.dedup();
         }
         if self.refine_omega2 > 0.0 && (self.time < self.refine_until || busy) {
             self.dt.min(r * 2.0 / self.refine_omega2.sqrt())
@@ -866,8 +857,8 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     /// The contact pass; returns the largest squared frequency bound of the blocks of the
-    /// contacts the impact probe marked (0: none), and whether a loaded contact of a refining
-    /// block moves fast.
+    /// contacts the impact probe marked (0: none), and whether a loaded contact it marked
+    /// since the refinement began moves fast.
     fn compute_forces(&mut self) -> (Real, bool) {
         // The probe: normal speeds beyond that of a fall through the contact tolerance,
         // `√(2 g tol)` (a block settling on its joints moves much slower), crossing the kink
@@ -1142,6 +1133,7 @@ mod tests {
                     law,
                     ctx,
                     0.0,
+                    false,
                 )
                 .wrench;
             }
