@@ -1,7 +1,6 @@
 //! Typed errors: every bad input names what is wrong, where, and the offending value.
 
-use crate::block::BlockId;
-use crate::constitutive::MaterialId;
+use crate::ids::{BlockId, MaterialId};
 use crate::math::Real;
 
 /// Result type of fallible voussoir operations.

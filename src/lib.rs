@@ -61,6 +61,7 @@ pub mod contact;
 mod dispatch;
 pub mod error;
 pub mod geometry;
+pub mod ids;
 pub mod integrate;
 pub mod io;
 pub mod math;

@@ -3,14 +3,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::block::{Block, BlockId};
+pub use crate::ids::MonitorId;
+
+use crate::block::Block;
+use crate::ids::BlockId;
 use crate::constitutive::ConstitutiveLaw;
 use crate::math::{Real, Vector};
 use crate::model::Model;
 
-/// Typed index of a monitor (its column in the [`History`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-pub struct MonitorId(pub u32);
 
 /// Component of a vector quantity.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

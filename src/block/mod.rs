@@ -2,28 +2,12 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::constitutive::MaterialId;
+pub use crate::ids::BlockId;
+use crate::ids::MaterialId;
 use crate::error::{positive, Error, Result};
 use crate::geometry::{MassProperties, Polyhedron};
 use crate::math::{is_finite_vector, Pose, Real, Vector};
 
-/// Typed index of a block in a [`crate::Model`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-pub struct BlockId(pub u32);
-
-impl std::fmt::Display for BlockId {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "#{}", self.0)
-    }
-}
-
-impl BlockId {
-    /// The index into the model's block list.
-    #[inline]
-    pub fn index(self) -> usize {
-        self.0 as usize
-    }
-}
 
 /// What a single degree of freedom does.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

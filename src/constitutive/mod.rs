@@ -13,18 +13,11 @@ use serde::{Deserialize, Serialize};
 pub use coulomb::{CoulombSlip, CoulombState};
 pub use elastic::LinearElastic;
 
+pub use crate::ids::MaterialId;
+
 use crate::error::Result;
 use crate::math::{plane_basis, Real, Vector, Vector2};
 
-/// Material of a block; joint laws are chosen per pair of materials.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default, Serialize, Deserialize)]
-pub struct MaterialId(pub u16);
-
-impl std::fmt::Display for MaterialId {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "material {}", self.0)
-    }
-}
 
 /// Elastic stiffness of a joint per unit area.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

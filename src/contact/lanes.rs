@@ -10,8 +10,8 @@
 
 use std::ops::{Add, Mul, Sub};
 
-use super::kernel::ForceMoments;
-use super::kernel::{stays_separated, update_with_law};
+use super::law_update::{stays_separated, update_with_law};
+use super::moments::ForceMoments;
 use super::SubContact;
 use crate::constitutive::{ConstitutiveLaw, JointAxes};
 use crate::math::{Real, Vector, Vector2};

@@ -3,21 +3,22 @@
 
 mod kernel;
 mod lanes;
+mod law_update;
+mod moments;
 
 use serde::{Deserialize, Serialize};
 
-pub(crate) use kernel::{update_contact, ForceMoments, KernelContext};
+pub(crate) use kernel::{update_contact, KernelContext};
+pub(crate) use moments::ForceMoments;
 
-use crate::block::BlockId;
+pub use crate::ids::ContactId;
+
+use crate::ids::BlockId;
 use crate::constitutive::{JointAxes, JointForce, JointStatus};
 use crate::geometry::Polyhedron;
 use crate::geometry::{ContactKind, SubKey};
 use crate::math::{Pose, Real, Rotation, Vector, Vector2};
 
-/// Typed index of a contact in the model's current contact list (valid until the next
-/// re-detection).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-pub struct ContactId(pub u32);
 
 /// Whether contact geometry follows the blocks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
