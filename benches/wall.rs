@@ -4,7 +4,7 @@
 //! updates per second.
 
 use divan::counter::ItemsCount;
-use voussoir::build::benchmark_wall;
+use voussoir::model::benchmark_wall;
 use voussoir::prelude::*;
 
 fn main() {

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use serde::Serialize;
-use voussoir::build::{benchmark_wall_with_spacing, BENCHMARK_SPACING};
+use voussoir::model::{benchmark_wall_with_spacing, BENCHMARK_SPACING};
 use voussoir::prelude::*;
 
 #[derive(Serialize)]

@@ -6,11 +6,10 @@ use serde::{Deserialize, Serialize};
 pub use crate::ids::MonitorId;
 
 use crate::block::Block;
-use crate::ids::BlockId;
 use crate::constitutive::ConstitutiveLaw;
+use crate::ids::BlockId;
 use crate::math::{Real, Vector};
 use crate::model::Model;
-
 
 /// Component of a vector quantity.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

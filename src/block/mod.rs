@@ -2,12 +2,11 @@
 
 use serde::{Deserialize, Serialize};
 
-pub use crate::ids::BlockId;
-use crate::ids::MaterialId;
 use crate::error::{positive, Error, Result};
 use crate::geometry::{MassProperties, Polyhedron};
+pub use crate::ids::BlockId;
+use crate::ids::MaterialId;
 use crate::math::{is_finite_vector, Pose, Real, Vector};
-
 
 /// What a single degree of freedom does.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

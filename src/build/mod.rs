@@ -5,7 +5,4 @@ mod vault;
 mod wall;
 
 pub use vault::{barrel_vault, dome, BarrelVaultSpec, DomeSpec};
-pub use wall::{
-    benchmark_wall, benchmark_wall_with_spacing, multi_leaf_wall, running_bond_wall, MultiLeafSpec, WallSpec,
-    BENCHMARK_SPACING,
-};
+pub use wall::{multi_leaf_wall, running_bond_wall, MultiLeafSpec, WallSpec};

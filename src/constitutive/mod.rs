@@ -18,7 +18,6 @@ pub use crate::ids::MaterialId;
 use crate::error::Result;
 use crate::math::{plane_basis, Real, Vector, Vector2};
 
-
 /// Elastic stiffness of a joint per unit area.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct JointStiffness {

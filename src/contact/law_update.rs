@@ -71,4 +71,3 @@ pub(crate) fn stays_separated<L: ConstitutiveLaw>(law: &L, sub: &SubContact<L::S
         && sub.force.shear == Vector2::ZERO
         && law.stays_open(sub.area, gap, &sub.state)
 }
-

@@ -13,12 +13,11 @@ pub(crate) use moments::ForceMoments;
 
 pub use crate::ids::ContactId;
 
-use crate::ids::BlockId;
 use crate::constitutive::{JointAxes, JointForce, JointStatus};
 use crate::geometry::Polyhedron;
 use crate::geometry::{ContactKind, SubKey};
+use crate::ids::BlockId;
 use crate::math::{Pose, Real, Rotation, Vector, Vector2};
-
 
 /// Whether contact geometry follows the blocks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

@@ -113,4 +113,3 @@ impl ForceMoments {
         (r.origin.cross(self.force) + r.u.cross(self.per_x)) + r.v.cross(self.per_y)
     }
 }
-

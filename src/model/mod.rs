@@ -1,5 +1,6 @@
 //! The model: blocks, joint laws, gravity and loads; stepping and runs.
 
+mod benchmark;
 mod checkpoint;
 mod detection;
 mod energy;
@@ -8,6 +9,7 @@ mod motion;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+pub use benchmark::{benchmark_wall, benchmark_wall_with_spacing, BENCHMARK_SPACING};
 pub use energy::Energies;
 
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
@@ -1024,7 +1026,7 @@ mod tests {
     fn avx2_and_portable_builds_are_bit_identical() {
         let run = |portable: bool| {
             crate::dispatch::set_portable_only(portable);
-            let mut model = crate::build::benchmark_wall(300).expect("wall");
+            let mut model = benchmark_wall(300).expect("wall");
             model.run_steps(300).expect("run");
             crate::dispatch::set_portable_only(false);
             let states: Vec<_> = model.blocks().iter().map(|b| *b.state()).collect();
@@ -1188,7 +1190,7 @@ mod tests {
     /// and small-displacement mode.
     #[test]
     fn grouped_and_single_sub_contact_loops_agree() {
-        let mut wall = crate::build::benchmark_wall(300).expect("wall");
+        let mut wall = benchmark_wall(300).expect("wall");
         wall.run_steps(40).expect("run");
         let coulomb = wall.joints.laws()[0];
         for counts in [

@@ -315,7 +315,7 @@ mod tests {
     /// The benchmark wall of 1,200 blocks (three chunks) under gravity tilted by 40° sideways:
     /// blocks slide and topple all along the wall, beyond the re-detection trigger.
     fn tilted_wall() -> Model {
-        let mut wall = crate::build::benchmark_wall(1200).expect("wall");
+        let mut wall = crate::model::benchmark_wall(1200).expect("wall");
         let t: Real = 40.0_f64.to_radians();
         let params = ModelParameters {
             gravity: Vector::new(0.0, t.sin(), -t.cos()) * 9.81,
