@@ -38,6 +38,6 @@ impl std::fmt::Display for MaterialId {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub struct ContactId(pub u32);
 
-/// Typed index of a monitor (its column in the [`History`]).
+/// Typed index of a monitor (its column in the [`crate::monitor::History`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct MonitorId(pub u32);

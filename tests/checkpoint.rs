@@ -51,9 +51,9 @@ fn state_bits(model: &Model) -> Vec<u64> {
         bits.extend(s.pose.rotation.to_array().map(f64::to_bits));
     }
     for c in model.contacts() {
-        for s in c.subs {
+        for s in c.subcontacts() {
             bits.push(s.normal_force().to_bits());
-            bits.extend(c.shear_force(s).to_array().map(f64::to_bits));
+            bits.extend(s.shear_force().to_array().map(f64::to_bits));
         }
     }
     let e = model.energies();
@@ -70,7 +70,7 @@ fn restarted_run_is_bit_identical() -> Result<()> {
     model.save_checkpoint(&path)?;
     let mut restarted: Model = Model::load_checkpoint(&path)?;
     // The contacts' resultants and the blocks' contact wrenches read the same before a step.
-    let resultants = |m: &Model| m.contacts().map(|c| c.wrench).collect::<Vec<_>>();
+    let resultants = |m: &Model| m.contacts().map(|c| c.wrench()).collect::<Vec<_>>();
     assert_eq!(resultants(&model), resultants(&restarted));
     assert!(resultants(&model).iter().any(|w| w.force != Vector::ZERO));
     for i in 0..model.blocks().len() {
@@ -85,7 +85,7 @@ fn restarted_run_is_bit_identical() -> Result<()> {
         "the test must cross re-detections"
     );
     assert!(
-        model.contacts().flat_map(|c| c.subs).any(|s| s.slip() > 0.0),
+        model.contacts().flat_map(|c| c.subcontacts()).any(|s| s.slip() > 0.0),
         "the test must include slip"
     );
     assert_eq!(state_bits(&model), state_bits(&restarted));
@@ -104,11 +104,13 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
         let err = Model::<CoulombSlip>::from_checkpoint_str(&text[..cut]).expect_err("truncated");
         assert!(matches!(err, Error::Checkpoint { .. }), "{err}");
     }
-    // Inconsistent indices that parse fine.
-    let bad_pair = text.replacen("\"law\":0,\"first\":0,", "\"law\":0,\"first\":7777,", 1);
-    assert_ne!(bad_pair, text);
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_pair).expect_err("bad sub-contact range");
-    assert!(err.to_string().contains("pairs[0]"), "{err}");
+    // Inconsistent indices that parse fine: a block or a law that does not exist.
+    for (field, value) in [("blocks", serde_json::json!([0, 7777])), ("law", serde_json::json!(7))] {
+        let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+        json["contacts"][0][field] = value;
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err(field);
+        assert!(err.to_string().contains("contacts[0]"), "{err}");
+    }
     // A bad law parameter is caught by the law's own validation, with its path.
     let bad_law = text.replacen("\"friction_deg\":25.0", "\"friction_deg\":95.0", 1);
     assert_ne!(bad_law, text);
@@ -119,19 +121,19 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     );
     // Spring moments that do not belong to the stored forces (they feed the joint work).
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
-    let force = &mut json["pairs"][0]["springs"]["force"][2];
+    let force = &mut json["contacts"][0]["springs"][0][2];
     let fz = force.as_f64().expect("a number");
     assert!(fz.abs() > 1.0, "the first contact is loaded: {fz}");
     *force = serde_json::json!(fz * 1.5);
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("bad springs");
-    assert!(err.to_string().contains("pairs[0].springs"), "{err}");
+    assert!(err.to_string().contains("contacts[0].springs"), "{err}");
     // Joint axes or anchor plane axes that are not orthonormal.
-    for (field, path) in [("tangent", "pairs[0].tangent"), ("anchors", "pairs[0].anchors")] {
+    for (field, path) in [("tangent", "contacts[0].tangent"), ("anchors", "contacts[0].anchors")] {
         let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
         let axis = if field == "tangent" {
-            &mut json["pairs"][0]["tangent"]
+            &mut json["contacts"][0]["tangent"]
         } else {
-            &mut json["pairs"][0]["anchors"]["v"]
+            &mut json["contacts"][0]["anchors"]["v"]
         };
         let scaled: Vec<f64> = axis
             .as_array()
@@ -146,17 +148,20 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     // Another version is named as such, whatever else changed between the versions.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
     json["version"] = serde_json::json!(6);
-    json.as_object_mut().expect("an object").remove("wrenches");
+    json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 8"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 9"),
         "{err}"
     );
-    // One wrench per contact.
+    // Every contact has its wrench.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
-    json["wrenches"].as_array_mut().expect("wrenches").pop();
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("wrenches");
-    assert!(err.to_string().contains("wrenches"), "{err}");
+    json["contacts"][0].as_object_mut().expect("a contact").remove("wrench");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("wrench");
+    assert!(
+        err.to_string().contains("contacts[0]") && err.to_string().contains("wrench"),
+        "{err}"
+    );
     json["format"] = serde_json::json!("something-else");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("format");
     assert!(err.to_string().contains("something-else"), "{err}");
@@ -186,5 +191,77 @@ fn pending_redetection_survives_a_checkpoint() -> Result<()> {
     model.run_steps(20)?;
     restored.run_steps(20)?;
     assert_eq!(state_bits(&model), state_bits(&restored));
+    Ok(())
+}
+
+/// The checkpoint format is the transfer structs' fields, nothing of the step's storage: these
+/// key sets change only with the format version.
+#[test]
+fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(20)?;
+    let json: serde_json::Value = serde_json::from_str(&model.to_checkpoint_string()?).expect("json");
+    let keys = |v: &serde_json::Value| -> Vec<String> {
+        let mut k: Vec<String> = v.as_object().expect("an object").keys().cloned().collect();
+        k.sort();
+        k
+    };
+    assert_eq!(json["version"], 9);
+    assert_eq!(
+        keys(&json),
+        [
+            "blocks",
+            "contacts",
+            "critical",
+            "damping",
+            "detections",
+            "drift",
+            "dt",
+            "energy",
+            "format",
+            "history",
+            "joints",
+            "last_forces",
+            "monitor_interval",
+            "monitors",
+            "params",
+            "pending_detection",
+            "ref_poses",
+            "refine_omega2",
+            "refine_until",
+            "refining",
+            "started",
+            "step",
+            "time",
+            "unbalanced_ratio",
+            "version",
+        ]
+    );
+    let contact = &json["contacts"][0];
+    assert_eq!(
+        keys(contact),
+        [
+            "anchors",
+            "area",
+            "blocks",
+            "bound_area",
+            "dashpots",
+            "host_is_a",
+            "kind",
+            "law",
+            "normal",
+            "normal_force",
+            "reference_centroids",
+            "reference_host_rotation",
+            "springs",
+            "subcontacts",
+            "tangent",
+            "wrench",
+        ]
+    );
+    assert_eq!(
+        keys(&contact["subcontacts"][0]),
+        ["area", "dashpot", "force", "gap", "key", "plane", "slip", "state", "status"]
+    );
     Ok(())
 }

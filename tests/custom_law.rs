@@ -331,7 +331,7 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
 
     // Let the tile settle on its joint, then start pushing.
     model.run_to_equilibrium(1e-5, 20_000).unwrap();
-    let normal_at_rest = model.contact_between(slab, block).unwrap().pair.normal_force();
+    let normal_at_rest = model.contact_between(slab, block).unwrap().normal_force();
     assert!(
         (normal_at_rest - weight).abs() < 1e-3 * weight,
         "{normal_at_rest} vs {weight}"
@@ -350,17 +350,16 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
     while model.block(pusher).unwrap().state().pose.translation.x - p0 < 3.5e-3 {
         model.step().unwrap();
         let joint = model.contact_between(slab, block).expect("the tile stays on the slab");
-        let subs = joint.subs;
         let mut sum = 0.0;
         let mut min_kappa = f64::INFINITY;
-        for (s, r) in joint.iter() {
+        for s in joint.subcontacts() {
             let kappa = s.law_state().plastic_slip;
             // History is never lost: per sub-contact (by key), plastic slip only grows.
-            let previous = kappa_by_key.insert(r.key().0, kappa).unwrap_or(0.0);
+            let previous = kappa_by_key.insert(s.key().0, kappa).unwrap_or(0.0);
             assert!(
                 kappa >= previous,
                 "sub-contact {:?} lost plastic slip at step {}: {previous} -> {kappa}",
-                r.key(),
+                s.key(),
                 model.step_count()
             );
             sum += kappa;
@@ -371,8 +370,8 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
             travel: model.block(pusher).unwrap().state().pose.translation.x - p0,
             slide: state.pose.translation.x - x0,
             resistance: -joint.resultant().x,
-            normal: joint.pair.normal_force(),
-            mean_kappa: sum / subs.len() as f64,
+            normal: joint.normal_force(),
+            mean_kappa: sum / joint.subcontact_count() as f64,
             min_kappa,
         });
         max_kinetic = max_kinetic.max(model.energies().kinetic);
@@ -435,9 +434,8 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
     );
     let joint = model.contact_between(slab, block).unwrap();
     assert!(joint
-        .subs
-        .iter()
-        .all(|s| model.joints().laws()[joint.pair.law_index()].is_failed(s.law_state())));
+        .subcontacts()
+        .all(|s| model.joints().laws()[joint.law_index()].is_failed(s.law_state())));
     // Energy: dissipation as in closed form, and the balance closes.
     assert!(
         (e.friction - dissipated_closed).abs() < 0.03 * dissipated_closed,
@@ -469,7 +467,8 @@ fn law_state_survives_a_checkpoint() {
     // Push until the joint is half softened.
     let half = |m: &Model<SofteningCoulomb>| {
         let joint = m.contact_between(slab, block).unwrap();
-        let mean = joint.subs.iter().map(|s| s.law_state().plastic_slip).sum::<f64>() / joint.subs.len() as f64;
+        let mean =
+            joint.subcontacts().map(|s| s.law_state().plastic_slip).sum::<f64>() / joint.subcontact_count() as f64;
         mean > 0.5 * U_SOFT
     };
     assert!(model.run_until(100_000, half).unwrap());
@@ -478,8 +477,8 @@ fn law_state_survives_a_checkpoint() {
     let kappas = |m: &Model<SofteningCoulomb>| -> Vec<(u64, u64)> {
         let joint = m.contact_between(slab, block).unwrap();
         joint
-            .iter()
-            .map(|(s, r)| (r.key().0, s.law_state().plastic_slip.to_bits()))
+            .subcontacts()
+            .map(|s| (s.key().0, s.law_state().plastic_slip.to_bits()))
             .collect()
     };
     assert_eq!(kappas(&model), kappas(&restored), "state restored exactly");

@@ -604,7 +604,7 @@ fn drop_cube(label: &str, rotation: Rotation) -> Result<()> {
         let low = world_vertices(blk).map(|v| v.z).fold(Real::INFINITY, Real::min);
         vertex_depth = vertex_depth.max(-low);
         for c in m.contacts() {
-            for s in c.subs {
+            for s in c.subcontacts() {
                 sub_depth = sub_depth.max(-s.normal_displacement());
                 landed |= s.normal_force() > 0.0;
             }

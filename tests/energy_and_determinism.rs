@@ -305,8 +305,8 @@ fn fingerprint(model: &Model) -> Vec<u64> {
     }
     for c in model.contacts() {
         push(c.resultant());
-        for s in c.subs {
-            push(c.shear_force(s));
+        for s in c.subcontacts() {
+            push(s.shear_force());
             push(Vector::new(s.normal_force(), s.slip(), s.normal_displacement()));
         }
     }

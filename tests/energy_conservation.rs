@@ -71,7 +71,9 @@ fn drop_model(rotation: Rotation, height: Real, law: CoulombSlip, params: ModelP
 
 /// Whether any sub-contact carries force.
 fn loaded(model: &Model) -> bool {
-    model.contacts().any(|c| c.subs.iter().any(|s| s.normal_force() > 0.0))
+    model
+        .contacts()
+        .any(|c| c.subcontacts().any(|s| s.normal_force() > 0.0))
 }
 
 /// What an undamped frictionless drop did, relative to `m g h`.

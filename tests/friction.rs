@@ -323,7 +323,7 @@ fn slender_block_topples_when_base_ratio_below_slope() -> Result<()> {
     let reached = s.model.run_until(1_000_000, |m| {
         let turned = tilt(m, block).unwrap_or(Real::NAN);
         match m.contact_between(base, block) {
-            Some(c) => max_normal = max_normal.max(c.pair.normal_force()),
+            Some(c) => max_normal = max_normal.max(c.normal_force()),
             None => {
                 if contact_lost.is_none() {
                     contact_lost = Some((m.time(), turned));

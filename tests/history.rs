@@ -113,7 +113,7 @@ fn a_stuck_edge_contact_keeps_its_shear_force_through_redetection() -> Result<()
     )?;
     // Settle under the push, then travel 60 mm: hundreds of re-detections.
     model.run_until_time(0.2)?;
-    let kinds = |model: &Model| [left, right].map(|r| model.contact_between(r, beam).map(|c| c.pair.kind()));
+    let kinds = |model: &Model| [left, right].map(|r| model.contact_between(r, beam).map(|c| c.kind()));
     assert!(
         kinds(&model)
             .iter()

@@ -83,19 +83,19 @@ fn joint_sums(m: &Model, a: BlockId, b: BlockId) -> JointSums {
         area: 0.0,
         normal_force: 0.0,
         first_moment: Vector::ZERO,
-        count: c.subs.len(),
+        count: c.subcontact_count(),
     };
-    for sub in c.subs {
+    for sub in c.subcontacts() {
         s.area += sub.area();
         s.normal_force += sub.normal_force();
-        s.first_moment += c.point(sub) * sub.normal_force();
+        s.first_moment += sub.point() * sub.normal_force();
     }
     // The pair's own resultant must agree with the sum over its sub-contacts (same additions,
     // possibly a different order: round-off only).
     assert!(
-        (c.pair.normal_force() - s.normal_force).abs() <= 1e-12 * s.normal_force.abs(),
+        (c.normal_force() - s.normal_force).abs() <= 1e-12 * s.normal_force.abs(),
         "pair normal force {} vs sum of sub-contacts {}",
-        c.pair.normal_force(),
+        c.normal_force(),
         s.normal_force
     );
     s
@@ -160,7 +160,7 @@ fn check_uniform_joint(m: &Model, base: BlockId, block: BlockId, w: f64, face: f
     let s = joint_sums(m, base, block);
     let c = m.contact_between(base, block).unwrap();
     let (mut smin, mut smax) = (f64::INFINITY, f64::NEG_INFINITY);
-    for sub in c.subs {
+    for sub in c.subcontacts() {
         smin = smin.min(sub.normal_stress());
         smax = smax.max(sub.normal_stress());
         assert_eq!(sub.status(), JointStatus::Elastic, "{sub:?}");
@@ -210,7 +210,7 @@ fn overhanging_block_areas_sum_to_the_overlap() {
     let s = joint_sums(&m, base, block);
     let c = m.contact_between(base, block).unwrap();
     assert!(
-        c.subs.iter().all(|sub| sub.normal_force() > 0.0),
+        c.subcontacts().all(|sub| sub.normal_force() > 0.0),
         "the whole overlap is in compression"
     );
     let centroid = m.block(block).unwrap().state().pose.translation;
@@ -284,10 +284,10 @@ fn eccentric(e: f64) -> Eccentric {
     let face_centre0 = Vector::new(0.0, 0.0, 0.0);
     let face_centre = face_centre0 + b.displacement_of(face_centre0);
     let c = m.contact_between(base, block).unwrap();
-    let mut subs = Vec::with_capacity(c.subs.len());
-    for sub in c.subs {
+    let mut subs = Vec::with_capacity(c.subcontact_count());
+    for sub in c.subcontacts() {
         // Back to the material point's initial position: x along the face from its centre.
-        let x0 = b.initial_pose().transform_point(b.local_point(c.point(sub)));
+        let x0 = b.initial_pose().transform_point(b.local_point(sub.point()));
         subs.push((x0.x - face_centre0.x, sub.normal_stress(), sub.normal_force()));
     }
     let sums = joint_sums(&m, base, block);
@@ -451,8 +451,7 @@ fn column_of_three_blocks_joints_carry_the_weight_above() {
         let c = m.contact_between(ids[k], ids[k + 1]).unwrap();
         let sigma = above / face;
         let err_s = c
-            .subs
-            .iter()
+            .subcontacts()
             .map(|sub| (sub.normal_stress() - sigma).abs() / sigma)
             .fold(0.0, f64::max);
         let err_n = (s.normal_force - above).abs() / above;

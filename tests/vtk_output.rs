@@ -55,7 +55,7 @@ fn vtu_frames_are_read_back_by_vtk() -> Result<()> {
     assert_eq!(pvd.matches("<DataSet").count(), 2);
 
     let volume: f64 = model.blocks().iter().map(|b| b.shape().volume()).sum();
-    let area: f64 = model.contacts().flat_map(|c| c.subs).map(|s| s.area()).sum();
+    let area: f64 = model.contacts().flat_map(|c| c.subcontacts()).map(|s| s.area()).sum();
     // Hexagon on the base (area 1.5·√3·r²) and the wedge's 0.3 × 0.2 face.
     let expected_area = 1.5 * 3f64.sqrt() * 0.01 + 0.06;
     assert!((area - expected_area).abs() < 1e-12, "{area} vs {expected_area}");

@@ -15,8 +15,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::block::{Block, BlockId};
+use crate::block::{Block, BlockId, RigidBlock};
 use crate::constitutive::ConstitutiveLaw;
+use crate::contact::Contact;
 use crate::math::{Real, Vector};
 use crate::model::Model;
 
@@ -133,7 +134,8 @@ pub fn classify_joints<L: ConstitutiveLaw>(
     let mut states = Vec::with_capacity(joints.len());
     let mut mechanism = Mechanism::default();
     for j in joints {
-        let state = joint_state(model, j, criteria);
+        let contact = model.contact_between(j.blocks.0, j.blocks.1);
+        let state = joint_state(contact.as_ref(), &model.blocks()[j.blocks.0.index()], j, criteria);
         if let Some(side) = state.hinge {
             mechanism.hinges.push(Hinge { joint: j.index, side });
         }
@@ -145,8 +147,10 @@ pub fn classify_joints<L: ConstitutiveLaw>(
     (states, mechanism)
 }
 
-fn joint_state<L: ConstitutiveLaw>(model: &Model<L>, j: &JointRef, c: &MechanismCriteria) -> JointState {
-    let Some(contact) = model.contact_between(j.blocks.0, j.blocks.1) else {
+/// Measures one joint, read through the law-free [`Contact`] interface (`None`: no contact),
+/// with the edge points carried by `block`, the joint's first block.
+fn joint_state(contact: Option<&impl Contact>, block: &RigidBlock, j: &JointRef, c: &MechanismCriteria) -> JointState {
+    let Some(contact) = contact else {
         return JointState {
             joint: j.index,
             open_fraction: 1.0,
@@ -158,19 +162,18 @@ fn joint_state<L: ConstitutiveLaw>(model: &Model<L>, j: &JointRef, c: &Mechanism
         };
     };
     // Edge points move with the first block.
-    let block = &model.blocks()[j.blocks.0.index()];
     let current = |p: Vector| block.world_point(block.initial_pose().inverse_transform_point(p));
     let (i, e) = (current(j.intrados), current(j.extrados));
     let depth = e - i;
     let (mut area, mut open, mut force, mut moment, mut slip) = (0.0, 0.0, 0.0, Vector::ZERO, 0.0);
-    for s in contact.subs {
-        area += s.area();
-        slip += s.slip() * s.area();
-        if s.normal_force() > 0.0 {
-            force += s.normal_force();
-            moment += contact.point(s) * s.normal_force();
+    for s in (0..contact.subcontact_count()).map(|k| contact.subcontact(k)) {
+        area += s.area;
+        slip += s.slip * s.area;
+        if s.normal_force > 0.0 {
+            force += s.normal_force;
+            moment += s.point * s.normal_force;
         } else {
-            open += s.area();
+            open += s.area;
         }
     }
     let open_fraction = if area > 0.0 { open / area } else { 1.0 };

@@ -5,18 +5,19 @@ mod kernel;
 mod lanes;
 mod law_update;
 mod moments;
+mod view;
 
 use serde::{Deserialize, Serialize};
 
 pub(crate) use kernel::{update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
+pub use view::{Contact, ContactView, SubContactSample, SubContactView};
 
 pub use crate::ids::ContactId;
 
 use crate::constitutive::{JointAxes, JointForce, JointStatus};
 use crate::geometry::Polyhedron;
 use crate::geometry::{ContactKind, SubKey};
-use crate::ids::BlockId;
 use crate::math::{Pose, Real, Rotation, Vector, Vector2};
 
 /// Whether contact geometry follows the blocks.
@@ -31,28 +32,14 @@ pub enum DisplacementMode {
     Small,
 }
 
-/// A block pair's interface: its plane, its sub-contacts and their resultant.
-pub trait Contact {
-    /// Per-sub-contact data type.
-    type SubContact;
-    /// The two blocks, `a` < `b`.
-    fn blocks(&self) -> (BlockId, BlockId);
-    /// Unit normal of the joint plane, from `a` to `b` (world).
-    fn normal(&self) -> Vector;
-    /// The sub-contacts.
-    fn subcontacts(&self) -> &[Self::SubContact];
-    /// Resultant force on block `b` (N, world); the force on `a` is its opposite.
-    fn resultant(&self) -> Vector;
-}
-
 /// One contact between blocks `a < b`, with a contiguous range of sub-contacts.
 ///
 /// Layout: what a step reads and writes; the reference geometry of small-displacement mode and
 /// the detection bookkeeping sit in a parallel internal list, which a large-displacement
 /// step does not read.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 #[repr(C)]
-pub struct ContactPair {
+pub(crate) struct ContactPair {
     pub(crate) a: u32,
     pub(crate) b: u32,
     pub(crate) kind: ContactKind,
@@ -75,14 +62,11 @@ pub struct ContactPair {
     /// block's body frame — the other face of a face-face contact, the plane of a point
     /// contact. Cached from the shapes (or the kind) at detection and on checkpoint load, so
     /// that the step loop does not visit the polyhedra.
-    #[serde(skip)]
     pub(crate) plane_normal: Vector,
-    #[serde(skip)]
     pub(crate) plane_offset: Real,
     /// Whether the sub-contacts may hold dashpot forces (Rayleigh damping in the last step, or
     /// history carried over at detection); only saves reading them when not. Checkpointed: it
     /// selects the sub-contact loop, and with it the order of the sums.
-    #[serde(default = "always")]
     pub(crate) dashpots: bool,
     /// Sum of normal forces (N, compression positive).
     pub(crate) normal_force: Real,
@@ -93,14 +77,10 @@ pub struct ContactPair {
     pub(crate) springs: ForceMoments,
 }
 
-fn always() -> bool {
-    true
-}
-
 /// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
 /// its geometry at detection, which small-displacement mode steps with, and the areas the
 /// critical-step bookkeeping compares.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ContactReference {
     /// Centroids at detection (lever arms in small-displacement mode).
     pub(crate) ref_a: Vector,
@@ -164,18 +144,6 @@ mod tests {
 }
 
 impl ContactPair {
-    /// The two blocks.
-    pub fn blocks(&self) -> (BlockId, BlockId) {
-        (BlockId(self.a), BlockId(self.b))
-    }
-    /// Contact case.
-    pub fn kind(&self) -> ContactKind {
-        self.kind
-    }
-    /// Unit normal a → b (world).
-    pub fn normal(&self) -> Vector {
-        self.normal
-    }
     /// The joint's normal and tangents (world); sub-contact shear forces are components along
     /// the tangents.
     pub fn axes(&self) -> JointAxes {
@@ -184,26 +152,10 @@ impl ContactPair {
             tangent: self.tangent,
         }
     }
-    /// The plane of the sub-contact anchors in the host block's body frame.
-    pub fn anchor_plane(&self) -> &AnchorPlane {
-        &self.anchors
-    }
     /// Material point of `sub` (one of this contact's sub-contacts) on the host block, in its
     /// body frame (m).
     pub fn anchor<S>(&self, sub: &SubContact<S>) -> Vector {
         self.anchors.point(sub.plane)
-    }
-    /// Sum of the sub-contact normal forces (N, compression positive).
-    pub fn normal_force(&self) -> Real {
-        self.normal_force
-    }
-    /// Index of the joint law in the model's [`crate::constitutive::JointTable`].
-    pub fn law_index(&self) -> usize {
-        self.law as usize
-    }
-    /// Number of sub-contacts.
-    pub fn subcontact_count(&self) -> usize {
-        self.count as usize
     }
     /// Fills the body-frame plane the step loop measures gaps to ([`ContactPair::plane_normal`]).
     pub(crate) fn cache_local_faces(&mut self, shape_a: &Polyhedron, shape_b: &Polyhedron) {
@@ -369,8 +321,8 @@ impl AnchorPlane {
 /// joint's tangents ([`JointAxes`]). Its identity, dashpot force and gap offset sit in a parallel
 /// [`SubContactRecord`]; its world position and forces follow from the contact, see
 /// [`ContactView::point`], [`ContactView::shear_force`] and [`ContactView::total_force`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SubContact<S> {
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SubContact<S> {
     /// Coordinates of the material point on the host block, on the contact's anchor plane (m).
     pub(crate) plane: Vector2,
     pub(crate) area: Real,
@@ -383,58 +335,15 @@ pub struct SubContact<S> {
     pub(crate) state: S,
 }
 
-impl<S> SubContact<S> {
-    /// Coordinates of the anchor on the contact's [`AnchorPlane`] (m); [`ContactPair::anchor`]
-    /// gives the body-frame point, [`ContactView::point`] the world point.
-    pub fn plane_coordinates(&self) -> Vector2 {
-        self.plane
-    }
-    /// Tributary area (m²).
-    pub fn area(&self) -> Real {
-        self.area
-    }
-    /// Normal displacement `u_n` (m, positive = open).
-    pub fn normal_displacement(&self) -> Real {
-        self.gap
-    }
-    /// Normal force (N, compression positive).
-    pub fn normal_force(&self) -> Real {
-        self.force.normal
-    }
-    /// Normal stress (Pa, compression positive).
-    pub fn normal_stress(&self) -> Real {
-        self.force.normal / self.area
-    }
-    /// Shear force on block `b` (N) as components along the joint's tangents
-    /// ([`ContactPair::axes`]); [`ContactView::shear_force`] gives the world vector.
-    pub fn shear_components(&self) -> Vector2 {
-        self.force.shear
-    }
-    /// Slip accumulated while sliding (m): the sum of the shear displacement increments of the
-    /// steps that ended sliding.
-    pub fn slip(&self) -> Real {
-        self.slip
-    }
-    /// Status after the last update.
-    pub fn status(&self) -> JointStatus {
-        self.status
-    }
-    /// The law's own state.
-    pub fn law_state(&self) -> &S {
-        &self.state
-    }
-}
-
 /// What a sub-contact keeps besides the fields of [`SubContact`]: its identity and dashpot
 /// force. Stored in a parallel array (same index as the sub-contact), so that the step
 /// streams only the [`SubContact`]s and touches a record only while the sub-contact carries a
 /// dashpot force.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SubContactRecord {
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SubContactRecord {
     pub(crate) key: SubKey,
     /// Stiffness-proportional (Rayleigh) dashpot force on `b` (world) of the last step; zero
     /// without Rayleigh damping.
-    #[serde(default)]
     pub(crate) dashpot: Vector,
 }
 
@@ -445,33 +354,6 @@ impl SubContactRecord {
             dashpot: Vector::ZERO,
         }
     }
-    /// Stable identity within the pair.
-    pub fn key(&self) -> SubKey {
-        self.key
-    }
-    /// Stiffness-proportional dashpot force on block `b` (N, world); zero without Rayleigh
-    /// damping.
-    pub fn dashpot_force(&self) -> Vector {
-        self.dashpot
-    }
-}
-
-/// A borrowed view of one contact and its sub-contacts.
-#[derive(Debug, Clone, Copy)]
-pub struct ContactView<'a, S> {
-    /// The contact.
-    pub pair: &'a ContactPair,
-    /// Its sub-contacts.
-    pub subs: &'a [SubContact<S>],
-    /// Their records (key, slip, dashpot force), index for index.
-    pub records: &'a [SubContactRecord],
-    /// Maps sub-contact anchors to world points: the host block's pose (its pose at detection in
-    /// small-displacement mode).
-    pub frame: Pose,
-    /// Resultant force of the sub-contacts' spring and dashpot forces on `b` and their moments
-    /// about the centroids of `a` and `b`, as of the last step (zero for a contact that
-    /// detection has just found).
-    pub wrench: ContactWrench,
 }
 
 /// What one contact applies to its two blocks: the resultant force on `b` (`−force` on `a`) and
@@ -484,51 +366,4 @@ pub struct ContactWrench {
     pub moment_a: Vector,
     /// Moment of the contact forces on `b` about `b`'s centroid (N·m).
     pub moment_b: Vector,
-}
-
-impl<S> ContactView<'_, S> {
-    /// Resultant force on `b` (N, world), spring and dashpot forces, as of the last step.
-    pub fn resultant(&self) -> Vector {
-        self.wrench.force
-    }
-    /// World position of one of this contact's sub-contacts (m).
-    pub fn point(&self, sub: &SubContact<S>) -> Vector {
-        self.frame.transform_point(self.pair.anchor(sub))
-    }
-    /// Shear force of one of this contact's sub-contacts on block `b` (N, world, in the joint
-    /// plane).
-    pub fn shear_force(&self, sub: &SubContact<S>) -> Vector {
-        self.pair.axes().shear(sub.force.shear)
-    }
-    /// World positions of the sub-contacts, in order.
-    pub fn points(&self) -> impl ExactSizeIterator<Item = Vector> + '_ {
-        self.subs.iter().map(|s| self.point(s))
-    }
-    /// The sub-contacts with their records, in order.
-    pub fn iter(&self) -> impl ExactSizeIterator<Item = (&SubContact<S>, &SubContactRecord)> + '_ {
-        self.subs.iter().zip(self.records)
-    }
-    /// Spring plus dashpot force of the sub-contact at `index` on block `b` (N, world).
-    ///
-    /// # Panics
-    /// If `index` is not below `subs.len()`.
-    pub fn total_force(&self, index: usize) -> Vector {
-        self.pair.axes().force(&self.subs[index].force) + self.records[index].dashpot
-    }
-}
-
-impl<S> Contact for ContactView<'_, S> {
-    type SubContact = SubContact<S>;
-    fn blocks(&self) -> (BlockId, BlockId) {
-        self.pair.blocks()
-    }
-    fn normal(&self) -> Vector {
-        self.pair.normal
-    }
-    fn subcontacts(&self) -> &[SubContact<S>] {
-        self.subs
-    }
-    fn resultant(&self) -> Vector {
-        ContactView::resultant(self)
-    }
 }

@@ -21,7 +21,7 @@ pub(crate) struct Lever {
 /// the moment about the host centroid, `Σ rᵢ × Fᵢ = R o × F + R u × F_x + R v × F_y`, and the work
 /// over a displacement field affine in the plane coordinates,
 /// `Σ Fᵢ·(w_o + xᵢ w_x + yᵢ w_y) = F·w_o + F_x·w_x + F_y·w_y`.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct ForceMoments {
     pub force: Vector,
     pub per_x: Vector,

@@ -119,10 +119,10 @@ pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> R
     );
     let (mut state, mut contact) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for (ci, c) in model.contacts().enumerate() {
-        let l = &law[c.pair.law_index()];
-        for s in c.subs {
-            points.extend(c.point(s).to_array());
-            shear.extend(c.shear_force(s).to_array());
+        let l = &law[c.law_index()];
+        for s in c.subcontacts() {
+            points.extend(s.point().to_array());
+            shear.extend(s.shear_force().to_array());
             normal_force.push(s.normal_force());
             normal_stress.push(s.normal_stress());
             area.push(s.area());

@@ -9,16 +9,22 @@ use serde::{Deserialize, Serialize};
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
-use crate::contact::{ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord};
+use crate::constitutive::{JointForce, JointStatus};
+use crate::contact::{
+    AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
+};
 use crate::error::{Error, Result};
+use crate::geometry::{ContactKind, SubKey};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
 use crate::io::io_error;
-use crate::math::{is_finite_vector, Pose, Real, Vector};
+use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
 use crate::model::Energies;
 use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
-const VERSION: u32 = 8;
+/// Version 9 stores joints through [`JointEntry`], apart from the step's storage layout, so
+/// that a layout change no longer changes the format.
+const VERSION: u32 = 9;
 
 /// The fields every version has, read before the rest (other fields are skipped).
 #[derive(Deserialize)]
@@ -39,15 +45,8 @@ struct Snapshot<L: ConstitutiveLaw> {
     damping: Damping,
     blocks: Vec<RigidBlock>,
     joints: JointTable<L>,
-    pairs: Vec<ContactPair>,
-    /// The contacts' reference geometry and areas, index for index.
-    references: Vec<ContactReference>,
-    /// The contacts' wrenches as of the last step, index for index (what `contact_wrench` and
-    /// the contacts' resultants report before the next step).
-    wrenches: Vec<ContactWrench>,
-    subs: Vec<SubContact<L::State>>,
-    /// The sub-contacts' records, index for index.
-    sub_records: Vec<SubContactRecord>,
+    /// The contacts, sorted by block pair, each with its sub-contacts.
+    contacts: Vec<JointEntry<L::State>>,
     ref_poses: Vec<Pose>,
     dt: Real,
     critical: Option<CriticalStep>,
@@ -80,6 +79,160 @@ struct Snapshot<L: ConstitutiveLaw> {
     refining: Vec<(u32, u32)>,
 }
 
+/// A joint as checkpoints store it: its geometry, law, the step's running sums and its
+/// sub-contacts, independent of how the step lays them out in memory.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JointEntry<S> {
+    blocks: (u32, u32),
+    kind: ContactKind,
+    host_is_a: bool,
+    law: u32,
+    normal: Vector,
+    tangent: Vector,
+    anchors: AnchorPlane,
+    /// Whether the sub-contacts may hold dashpot forces: it selects the sub-contact loop, and
+    /// with it the order of the sums.
+    dashpots: bool,
+    normal_force: Real,
+    /// Force and first moments of the spring forces as the step summed them (a recomputation
+    /// could sum in another order): `[F, F_x, F_y]`.
+    springs: [Vector; 3],
+    /// Centroids and host rotation at detection (small-displacement mode).
+    reference_centroids: (Vector, Vector),
+    reference_host_rotation: Rotation,
+    area: Real,
+    bound_area: Real,
+    /// Resultant and moments as of the last step.
+    wrench: ContactWrench,
+    subcontacts: Vec<SubContactEntry<S>>,
+}
+
+/// A sub-contact as checkpoints store it.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SubContactEntry<S> {
+    key: SubKey,
+    plane: Vector2,
+    area: Real,
+    gap: Real,
+    force: JointForce,
+    slip: Real,
+    status: JointStatus,
+    state: S,
+    dashpot: Vector,
+}
+
+impl<L: ConstitutiveLaw> Model<L> {
+    /// Contact `k` as a checkpoint stores it.
+    fn joint_entry(&self, k: usize) -> JointEntry<L::State> {
+        let (p, r) = (&self.pairs[k], &self.references[k]);
+        let range = p.range();
+        JointEntry {
+            blocks: (p.a, p.b),
+            kind: p.kind,
+            host_is_a: p.host_is_a,
+            law: p.law,
+            normal: p.normal,
+            tangent: p.tangent,
+            anchors: p.anchors,
+            dashpots: p.dashpots,
+            normal_force: p.normal_force,
+            springs: [p.springs.force, p.springs.per_x, p.springs.per_y],
+            reference_centroids: (r.ref_a, r.ref_b),
+            reference_host_rotation: r.ref_host_rotation,
+            area: r.area,
+            bound_area: r.bound_area,
+            wrench: self.wrenches[k],
+            subcontacts: self.subs[range.clone()]
+                .iter()
+                .zip(&self.sub_records[range])
+                .map(|(s, rec)| SubContactEntry {
+                    key: rec.key,
+                    plane: s.plane,
+                    area: s.area,
+                    gap: s.gap,
+                    force: s.force,
+                    slip: s.slip,
+                    status: s.status,
+                    state: s.state.clone(),
+                    dashpot: rec.dashpot,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The step's storage rebuilt from checkpointed joints: contacts, their references and
+/// wrenches, the sub-contacts and their records (each contact's range in order).
+#[allow(clippy::type_complexity)]
+fn into_storage<S>(
+    entries: Vec<JointEntry<S>>,
+) -> (
+    Vec<ContactPair>,
+    Vec<ContactReference>,
+    Vec<ContactWrench>,
+    Vec<SubContact<S>>,
+    Vec<SubContactRecord>,
+) {
+    let total = entries.iter().map(|e| e.subcontacts.len()).sum();
+    let (mut pairs, mut references, mut wrenches) = (
+        Vec::with_capacity(entries.len()),
+        Vec::with_capacity(entries.len()),
+        Vec::with_capacity(entries.len()),
+    );
+    let (mut subs, mut records) = (Vec::with_capacity(total), Vec::with_capacity(total));
+    for e in entries {
+        let first = subs.len() as u32;
+        let count = e.subcontacts.len() as u32;
+        for s in e.subcontacts {
+            subs.push(SubContact {
+                plane: s.plane,
+                area: s.area,
+                gap: s.gap,
+                force: s.force,
+                slip: s.slip,
+                status: s.status,
+                state: s.state,
+            });
+            records.push(SubContactRecord {
+                key: s.key,
+                dashpot: s.dashpot,
+            });
+        }
+        pairs.push(ContactPair {
+            a: e.blocks.0,
+            b: e.blocks.1,
+            kind: e.kind,
+            host_is_a: e.host_is_a,
+            law: e.law,
+            first,
+            count,
+            normal: e.normal,
+            tangent: e.tangent,
+            anchors: e.anchors,
+            plane_normal: Vector::ZERO,
+            plane_offset: 0.0,
+            dashpots: e.dashpots,
+            normal_force: e.normal_force,
+            springs: ForceMoments {
+                force: e.springs[0],
+                per_x: e.springs[1],
+                per_y: e.springs[2],
+            },
+        });
+        references.push(ContactReference {
+            ref_a: e.reference_centroids.0,
+            ref_b: e.reference_centroids.1,
+            ref_host_rotation: e.reference_host_rotation,
+            area: e.area,
+            bound_area: e.bound_area,
+        });
+        wrenches.push(e.wrench);
+    }
+    (pairs, references, wrenches, subs, records)
+}
+
 impl<L> Model<L>
 where
     L: ConstitutiveLaw + Serialize + DeserializeOwned,
@@ -100,11 +253,7 @@ where
             damping: self.integrator.damping(),
             blocks: self.blocks.clone(),
             joints: self.joints.clone(),
-            pairs: self.pairs.clone(),
-            references: self.references.clone(),
-            wrenches: self.wrenches.clone(),
-            subs: self.subs.clone(),
-            sub_records: self.sub_records.clone(),
+            contacts: (0..self.pairs.len()).map(|k| self.joint_entry(k)).collect(),
             ref_poses: self.ref_poses.clone(),
             dt: self.dt,
             critical: self.critical,
@@ -191,21 +340,15 @@ where
         if snap.ref_poses.len() != n {
             return Err(corrupt("ref_poses", "one pose per block expected"));
         }
-        if snap.references.len() != snap.pairs.len() {
-            return Err(corrupt("references", "one reference per contact expected"));
-        }
-        if snap.wrenches.len() != snap.pairs.len() {
-            return Err(corrupt("wrenches", "one wrench per contact expected"));
-        }
-        if let Some(k) = snap
-            .wrenches
+        let (pairs, references, wrenches, subs, sub_records) = into_storage(snap.contacts);
+        if let Some(k) = wrenches
             .iter()
             .position(|w| !(is_finite_vector(w.force) && is_finite_vector(w.moment_a) && is_finite_vector(w.moment_b)))
         {
-            return Err(corrupt(&format!("wrenches[{k}]"), "non-finite force or moment"));
+            return Err(corrupt(&format!("contacts[{k}].wrench"), "non-finite force or moment"));
         }
         let mut next = 0usize;
-        for (k, p) in snap.pairs.iter().enumerate() {
+        for (k, p) in pairs.iter().enumerate() {
             let faces_ok = match p.kind {
                 crate::geometry::ContactKind::FaceFace { face_a, face_b } => {
                     (p.a as usize) < n
@@ -216,15 +359,15 @@ where
                 crate::geometry::ContactKind::Point { .. } => true,
             };
             if !orthonormal(p.normal, p.tangent) {
-                return Err(corrupt(&format!("pairs[{k}].tangent"), "joint axes not orthonormal"));
+                return Err(corrupt(&format!("contacts[{k}].tangent"), "joint axes not orthonormal"));
             }
             if !orthonormal(p.anchors.u, p.anchors.v) {
                 return Err(corrupt(
-                    &format!("pairs[{k}].anchors"),
+                    &format!("contacts[{k}].anchors"),
                     "anchor plane axes not orthonormal",
                 ));
             }
-            let sorted = k == 0 || (snap.pairs[k - 1].a, snap.pairs[k - 1].b) < (p.a, p.b);
+            let sorted = k == 0 || (pairs[k - 1].a, pairs[k - 1].b) < (p.a, p.b);
             let (start, end) = (p.first as usize, p.first as usize + p.count as usize);
             let ok = faces_ok
                 && sorted
@@ -233,23 +376,22 @@ where
                 && p.a < p.b
                 && (p.law as usize) < snap.joints.laws().len()
                 && start == next
-                && end <= snap.subs.len();
+                && end <= subs.len();
             if !ok {
                 return Err(corrupt(
-                    &format!("pairs[{k}]"),
+                    &format!("contacts[{k}]"),
                     "inconsistent block, law or sub-contact indices",
                 ));
             }
             next = end;
         }
-        if next != snap.subs.len() {
-            return Err(corrupt("subs", "sub-contacts not covered by the contacts"));
-        }
-        if let Some(i) = snap.subs.iter().position(|s| s.area < 0.0) {
-            return Err(corrupt(&format!("subs[{i}].area"), "negative area"));
-        }
-        if snap.sub_records.len() != snap.subs.len() {
-            return Err(corrupt("sub_records", "one record per sub-contact expected"));
+        if let Some(i) = subs.iter().position(|s| s.area < 0.0) {
+            let k = pairs.partition_point(|p| p.first as usize + p.count as usize <= i);
+            let j = i - pairs[k].first as usize;
+            return Err(corrupt(
+                &format!("contacts[{k}].subcontacts[{j}].area"),
+                "negative area",
+            ));
         }
         for (name, m) in &snap.monitors {
             if m.blocks().iter().any(|b| b.index() >= n) {
@@ -264,11 +406,11 @@ where
         }
         model.joints = snap.joints;
         model.integrator = Box::new(CentralDifference::new(snap.damping));
-        model.pairs = snap.pairs;
-        model.references = snap.references;
-        model.wrenches = snap.wrenches;
-        model.subs = snap.subs;
-        model.sub_records = snap.sub_records;
+        model.pairs = pairs;
+        model.references = references;
+        model.wrenches = wrenches;
+        model.subs = subs;
+        model.sub_records = sub_records;
         for (k, p) in model.pairs.iter_mut().enumerate() {
             let (a, b) = (&model.blocks[p.a as usize], &model.blocks[p.b as usize]);
             p.cache_local_faces(Block::shape(a), Block::shape(b));
@@ -280,7 +422,7 @@ where
                 .matches(&ForceMoments::of_springs(&p.axes(), &model.subs[p.range()]))
             {
                 return Err(corrupt(
-                    &format!("pairs[{k}].springs"),
+                    &format!("contacts[{k}].springs"),
                     "inconsistent with the sub-contact forces",
                 ));
             }

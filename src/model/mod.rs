@@ -100,7 +100,7 @@ impl ModelParameters {
 /// let cube = model.add_block(RigidBlock::cuboid("cube", Vector::ZERO, Vector::splat(0.2), 2500.0)?)?;
 /// model.run_to_equilibrium(1e-4, 20_000)?;
 /// let weight = 2500.0 * 0.008 * 9.81;
-/// let support: f64 = model.contacts().map(|c| c.pair.normal_force()).sum();
+/// let support: f64 = model.contacts().map(|c| c.normal_force()).sum();
 /// assert!((support - weight).abs() < 1e-3 * weight);
 /// assert!(model.block(cube)?.displacement_of(Vector::splat(0.1)).length() < 1e-4);
 /// # Ok::<(), voussoir::Error>(())
@@ -586,13 +586,13 @@ impl<L: ConstitutiveLaw> Model<L> {
     fn view(&self, k: usize) -> ContactView<'_, L::State> {
         let p = &self.pairs[k];
         let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
-        ContactView {
-            pair: p,
-            subs: &self.subs[p.range()],
-            records: &self.sub_records[p.range()],
-            frame: p.frame(&self.references[k], &sa.pose, &sb.pose, self.params.mode),
-            wrench: self.wrenches[k],
-        }
+        ContactView::new(
+            p,
+            &self.subs[p.range()],
+            &self.sub_records[p.range()],
+            p.frame(&self.references[k], &sa.pose, &sb.pose, self.params.mode),
+            self.wrenches[k],
+        )
     }
 
     /// Total number of sub-contacts.
@@ -1280,7 +1280,7 @@ mod tests {
         model.pairs[0].refresh_springs(&subs);
         let world_shears = |m: &Model| -> Vec<(SubKey, Vector)> {
             let view = m.contacts().next().expect("the joint");
-            view.iter().map(|(s, r)| (r.key(), view.shear_force(s))).collect()
+            view.subcontacts().map(|s| (s.key(), s.shear_force())).collect()
         };
         let before = world_shears(&model);
         model.scratch.request_full_detection();

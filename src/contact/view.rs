@@ -1,0 +1,292 @@
+//! The read API of contacts: borrowed views over the model's contact storage.
+//!
+//! The storage itself (the contact list, the sub-contacts and their records, laid out for the
+//! step loop) is private to the crate, so that its layout can change without changing the API
+//! or the checkpoint format. Users read a joint through [`ContactView`] and its sub-contacts
+//! through [`SubContactView`]; code that does not need the law's own state reads either through
+//! the law-free [`Contact`] trait.
+
+use super::{AnchorPlane, ContactPair, ContactWrench, SubContact, SubContactRecord};
+use crate::constitutive::{JointAxes, JointStatus};
+use crate::geometry::{ContactKind, SubKey};
+use crate::ids::BlockId;
+use crate::math::{Pose, Real, Vector, Vector2};
+
+/// A law-free read interface of a joint between two blocks: what outputs and analyses need,
+/// whatever the joint law.
+///
+/// [`ContactView`] implements it; [`crate::analysis`] reads joints through it.
+///
+/// ```
+/// use voussoir::contact::Contact;
+///
+/// /// Share of a joint's sub-contacts in compression.
+/// fn closed_share(joint: &impl Contact) -> f64 {
+///     let n = joint.subcontact_count();
+///     (0..n).filter(|&i| joint.subcontact(i).normal_force > 0.0).count() as f64 / n.max(1) as f64
+/// }
+/// ```
+pub trait Contact {
+    /// The two blocks, `a` < `b`.
+    fn blocks(&self) -> (BlockId, BlockId);
+    /// Unit normal of the joint plane, from `a` to `b` (world).
+    fn normal(&self) -> Vector;
+    /// Resultant force on block `b` (N, world); the force on `a` is its opposite.
+    fn resultant(&self) -> Vector;
+    /// Sum of the sub-contact normal forces (N, compression positive).
+    fn normal_force(&self) -> Real;
+    /// Number of sub-contacts.
+    fn subcontact_count(&self) -> usize;
+    /// The sub-contact at `index` (below [`Contact::subcontact_count`]), law state left out.
+    ///
+    /// # Panics
+    /// If `index` is out of range.
+    fn subcontact(&self, index: usize) -> SubContactSample;
+}
+
+/// One sub-contact's values, copied out of the model, without the law's own state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubContactSample {
+    /// World position (m).
+    pub point: Vector,
+    /// Tributary area (m²).
+    pub area: Real,
+    /// Normal force (N, compression positive).
+    pub normal_force: Real,
+    /// Shear spring force on block `b` (N, world, in the joint plane).
+    pub shear_force: Vector,
+    /// Normal displacement `u_n` (m, positive = open).
+    pub normal_displacement: Real,
+    /// Slip accumulated while sliding (m).
+    pub slip: Real,
+    /// Status after the last update.
+    pub status: JointStatus,
+}
+
+/// A borrowed view of one joint (a block pair in contact) and its sub-contacts, as of the last
+/// step.
+///
+/// ```
+/// use voussoir::prelude::*;
+///
+/// let mut model: Model = Model::new(ModelParameters::default())?;
+/// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+/// let base = model.add_block(
+///     RigidBlock::cuboid("base", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), 2500.0)?
+///         .with_fixity(Fixity::FIXED),
+/// )?;
+/// let cube = model.add_block(RigidBlock::cuboid("cube", Vector::ZERO, Vector::splat(0.2), 2500.0)?)?;
+/// model.run_to_equilibrium(1e-4, 20_000)?;
+/// let joint = model.contact_between(base, cube).expect("in contact");
+/// let weight = 2500.0 * 0.008 * 9.81;
+/// assert!((joint.normal_force() - weight).abs() < 1e-3 * weight);
+/// // The sub-contacts carry the weight between them, all on the base's top face.
+/// let sum: f64 = joint.subcontacts().map(|s| s.normal_force()).sum();
+/// assert!((sum - joint.normal_force()).abs() < 1e-9 * weight);
+/// assert!(joint.subcontacts().all(|s| s.point().z.abs() < 1e-3 && s.status() == JointStatus::Elastic));
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy)]
+pub struct ContactView<'a, S> {
+    pair: &'a ContactPair,
+    subs: &'a [SubContact<S>],
+    records: &'a [SubContactRecord],
+    /// Maps anchors to world points: the host block's pose (its pose at detection in
+    /// small-displacement mode).
+    frame: Pose,
+    wrench: ContactWrench,
+}
+
+impl<'a, S> ContactView<'a, S> {
+    pub(crate) fn new(
+        pair: &'a ContactPair,
+        subs: &'a [SubContact<S>],
+        records: &'a [SubContactRecord],
+        frame: Pose,
+        wrench: ContactWrench,
+    ) -> Self {
+        debug_assert_eq!(subs.len(), records.len());
+        Self {
+            pair,
+            subs,
+            records,
+            frame,
+            wrench,
+        }
+    }
+
+    /// The two blocks, `a` < `b`.
+    pub fn blocks(&self) -> (BlockId, BlockId) {
+        (BlockId(self.pair.a), BlockId(self.pair.b))
+    }
+    /// Contact case (face-face, or a point contact with its plane).
+    pub fn kind(&self) -> ContactKind {
+        self.pair.kind
+    }
+    /// Unit normal a → b (world).
+    pub fn normal(&self) -> Vector {
+        self.pair.normal
+    }
+    /// The joint's normal and tangents (world); sub-contact shear forces are components along
+    /// the tangents.
+    pub fn axes(&self) -> JointAxes {
+        self.pair.axes()
+    }
+    /// The plane of the sub-contact anchors in the host block's body frame.
+    pub fn anchor_plane(&self) -> &'a AnchorPlane {
+        &self.pair.anchors
+    }
+    /// Sum of the sub-contact normal forces (N, compression positive).
+    pub fn normal_force(&self) -> Real {
+        self.pair.normal_force
+    }
+    /// Index of the joint law in the model's [`crate::constitutive::JointTable`].
+    pub fn law_index(&self) -> usize {
+        self.pair.law as usize
+    }
+    /// Resultant force on `b` (N, world), spring and dashpot forces, as of the last step (zero
+    /// for a contact that detection has just found).
+    pub fn resultant(&self) -> Vector {
+        self.wrench.force
+    }
+    /// The resultant with its moments about the centroids of `a` and `b`.
+    pub fn wrench(&self) -> ContactWrench {
+        self.wrench
+    }
+    /// Number of sub-contacts.
+    pub fn subcontact_count(&self) -> usize {
+        self.subs.len()
+    }
+    /// The sub-contacts, in order.
+    pub fn subcontacts(&self) -> impl ExactSizeIterator<Item = SubContactView<'a, S>> + 'a {
+        let (pair, frame) = (self.pair, self.frame);
+        self.subs
+            .iter()
+            .zip(self.records)
+            .map(move |(sub, record)| SubContactView {
+                pair,
+                frame,
+                sub,
+                record,
+            })
+    }
+    /// The sub-contact at `index`, if any.
+    pub fn subcontact(&self, index: usize) -> Option<SubContactView<'a, S>> {
+        Some(SubContactView {
+            pair: self.pair,
+            frame: self.frame,
+            sub: self.subs.get(index)?,
+            record: &self.records[index],
+        })
+    }
+    /// World positions of the sub-contacts, in order (m).
+    pub fn points(&self) -> impl ExactSizeIterator<Item = Vector> + 'a {
+        self.subcontacts().map(|s| s.point())
+    }
+}
+
+impl<S> Contact for ContactView<'_, S> {
+    fn blocks(&self) -> (BlockId, BlockId) {
+        ContactView::blocks(self)
+    }
+    fn normal(&self) -> Vector {
+        ContactView::normal(self)
+    }
+    fn resultant(&self) -> Vector {
+        ContactView::resultant(self)
+    }
+    fn normal_force(&self) -> Real {
+        ContactView::normal_force(self)
+    }
+    fn subcontact_count(&self) -> usize {
+        ContactView::subcontact_count(self)
+    }
+    fn subcontact(&self, index: usize) -> SubContactSample {
+        let s = ContactView::subcontact(self, index).expect("sub-contact index out of range");
+        SubContactSample {
+            point: s.point(),
+            area: s.area(),
+            normal_force: s.normal_force(),
+            shear_force: s.shear_force(),
+            normal_displacement: s.normal_displacement(),
+            slip: s.slip(),
+            status: s.status(),
+        }
+    }
+}
+
+/// A borrowed view of one sub-contact: a point of a joint with its tributary area, spring
+/// forces, slip and the law's own state, as of the last step.
+#[derive(Debug, Clone, Copy)]
+pub struct SubContactView<'a, S> {
+    pair: &'a ContactPair,
+    frame: Pose,
+    sub: &'a SubContact<S>,
+    record: &'a SubContactRecord,
+}
+
+impl<'a, S> SubContactView<'a, S> {
+    /// Stable identity within the block pair (carries history across re-detection).
+    pub fn key(&self) -> SubKey {
+        self.record.key
+    }
+    /// Coordinates of the anchor on the contact's [`AnchorPlane`] (m).
+    pub fn plane_coordinates(&self) -> Vector2 {
+        self.sub.plane
+    }
+    /// Material point on the host block, in its body frame (m).
+    pub fn anchor(&self) -> Vector {
+        self.pair.anchors.point(self.sub.plane)
+    }
+    /// World position (m).
+    pub fn point(&self) -> Vector {
+        self.frame.transform_point(self.anchor())
+    }
+    /// Tributary area (m²).
+    pub fn area(&self) -> Real {
+        self.sub.area
+    }
+    /// Normal displacement `u_n` (m, positive = open).
+    pub fn normal_displacement(&self) -> Real {
+        self.sub.gap
+    }
+    /// Normal force (N, compression positive).
+    pub fn normal_force(&self) -> Real {
+        self.sub.force.normal
+    }
+    /// Normal stress (Pa, compression positive).
+    pub fn normal_stress(&self) -> Real {
+        self.sub.force.normal / self.sub.area
+    }
+    /// Shear spring force on block `b` as components along the joint's tangents
+    /// ([`ContactView::axes`]) (N).
+    pub fn shear_components(&self) -> Vector2 {
+        self.sub.force.shear
+    }
+    /// Shear spring force on block `b` (N, world, in the joint plane).
+    pub fn shear_force(&self) -> Vector {
+        self.pair.axes().shear(self.sub.force.shear)
+    }
+    /// Stiffness-proportional (Rayleigh) dashpot force on block `b` (N, world); zero without
+    /// Rayleigh damping.
+    pub fn dashpot_force(&self) -> Vector {
+        self.record.dashpot
+    }
+    /// Spring plus dashpot force on block `b` (N, world).
+    pub fn total_force(&self) -> Vector {
+        self.pair.axes().force(&self.sub.force) + self.record.dashpot
+    }
+    /// Slip accumulated while sliding (m): the sum of the shear displacement increments of the
+    /// steps that ended sliding.
+    pub fn slip(&self) -> Real {
+        self.sub.slip
+    }
+    /// Status after the last update.
+    pub fn status(&self) -> JointStatus {
+        self.sub.status
+    }
+    /// The law's own state ([`crate::ConstitutiveLaw::State`]).
+    pub fn law_state(&self) -> &'a S {
+        &self.sub.state
+    }
+}
