@@ -2,6 +2,7 @@
 
 mod benchmark;
 mod checkpoint;
+mod contact_pass;
 mod detection;
 mod energy;
 mod motion;
@@ -15,8 +16,8 @@ pub use energy::Energies;
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
 use crate::contact::{
-    update_contact, ContactPair, ContactReference, ContactView, ContactWrench, DisplacementMode, KernelContext,
-    SubContact, SubContactRecord,
+    ContactPair, ContactReference, ContactView, ContactWrench, DisplacementMode, KernelContext, SubContact,
+    SubContactRecord,
 };
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
@@ -24,6 +25,7 @@ use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, Ste
 use crate::math::{is_finite_vector, Matrix, Pose, Real, Vector};
 use crate::monitor::{History, Monitor, MonitorId};
 
+use contact_pass::{ContactPass, ContactSlices, PairSums, CONTACT_CHUNK};
 use detection::DetectionScratch;
 
 /// Global parameters of a model, with documented defaults.
@@ -198,118 +200,6 @@ impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
 /// Blocks per chunk of the block passes: sums are taken per chunk, then over the chunks in order,
 /// so that they do not depend on the number of threads.
 const BLOCK_CHUNK: usize = 512;
-/// Contacts per chunk of the contact pass (as [`BLOCK_CHUNK`]).
-const CONTACT_CHUNK: usize = 64;
-
-/// What the contact pass shares between its tasks.
-struct ContactPass<'a, L: ConstitutiveLaw> {
-    blocks: &'a [RigidBlock],
-    /// The blocks' rotation matrices, index for index.
-    rotations: &'a [Matrix],
-    /// The contacts' references, index for index with the contacts.
-    references: &'a [ContactReference],
-    laws: &'a [L],
-    /// The blocks' squared frequency bounds, for the impact probe.
-    bounds: &'a [StiffnessBound],
-    /// The contacts under impact refinement, sorted (empty when none).
-    refining: &'a [(u32, u32)],
-    subs: SubsPtr<SubContact<L::State>>,
-    sub_records: SubsPtr<SubContactRecord>,
-    total_subs: usize,
-    ctx: KernelContext,
-}
-
-impl<L: ConstitutiveLaw> ContactPass<'_, L> {
-    /// Updates one chunk of contacts (the first being contact `first`) and their sub-contacts,
-    /// writes their wrenches to `wrenches` and adds their totals to `sums`.
-    #[inline(always)]
-    fn run(&self, first: usize, chunk: &mut [ContactPair], wrenches: &mut [ContactWrench], sums: &mut PairSums) {
-        let references = &self.references[first..first + chunk.len()];
-        for ((p, reference), w) in chunk.iter_mut().zip(references).zip(wrenches) {
-            let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
-            let (ra, rb) = (&self.rotations[p.a as usize], &self.rotations[p.b as usize]);
-            let range = p.range();
-            assert!(
-                range.start <= range.end && range.end <= self.total_subs,
-                "sub-contact range out of bounds"
-            );
-            // SAFETY: the contacts' sub-contact ranges are disjoint and within `subs` (built so
-            // by detection, checked on checkpoint load, asserted above), and the model's
-            // sub-contact vector is not otherwise borrowed while the pass runs, so every task
-            // has exclusive access to its own ranges.
-            let own = unsafe { std::slice::from_raw_parts_mut(self.subs.get().add(range.start), range.len()) };
-            // SAFETY: as above; the records vector has the same length as the sub-contacts.
-            let own_records =
-                unsafe { std::slice::from_raw_parts_mut(self.sub_records.get().add(range.start), range.len()) };
-            let step = update_contact(
-                p,
-                reference,
-                own,
-                own_records,
-                (&a.state, ra),
-                (&b.state, rb),
-                &self.laws[p.law as usize],
-                self.ctx,
-                if p.host_is_a { a.radius } else { b.radius },
-                !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok(),
-            );
-            *w = step.wrench;
-            sums.force_magnitude += step.wrench.force.length();
-            sums.work += step.work;
-            sums.dissipated += step.dissipated;
-            sums.dashpot_work += step.dashpot_work;
-            if step.impact {
-                let w2 = self.bounds[p.a as usize]
-                    .omega_squared
-                    .max(self.bounds[p.b as usize].omega_squared);
-                sums.impact = sums.impact.max(w2);
-                if (sums.fired_count as usize) < sums.fired.len() {
-                    sums.fired[sums.fired_count as usize] = (p.a, p.b);
-                }
-                sums.fired_count += 1;
-            }
-            sums.busy |= step.busy;
-        }
-    }
-
-    /// [`ContactPass::run`] compiled for AVX2: the same IEEE operations in the three-operand VEX
-    /// encoding, which saves the register copies of SSE2 (about a quarter of the instructions
-    /// of the sub-contact loop). No fused multiply-add is enabled, so the results are
-    /// bit-identical to [`ContactPass::run`].
-    ///
-    /// # Safety
-    /// The processor must support AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(
-        &self,
-        first: usize,
-        chunk: &mut [ContactPair],
-        wrenches: &mut [ContactWrench],
-        sums: &mut PairSums,
-    ) {
-        self.run(first, chunk, wrenches, sums);
-    }
-}
-
-/// Per-chunk sums of the contact pass.
-#[derive(Debug, Clone, Copy, Default)]
-struct PairSums {
-    /// Σ |resultant| (N), for the unbalanced-force ratio.
-    force_magnitude: Real,
-    work: Real,
-    /// Energy dissipated by the joint laws (J).
-    dissipated: Real,
-    dashpot_work: Real,
-    /// The largest squared frequency bound of the blocks of an impacting contact (0: none).
-    impact: Real,
-    /// The blocks of the first impacting contacts, and how many there were (all the chunk's
-    /// contacts count when they do not fit).
-    fired: [(u32, u32); 4],
-    fired_count: u32,
-    /// Whether a loaded impacting contact moves fast.
-    busy: bool,
-}
 
 /// Per-chunk sums of the block passes.
 #[derive(Debug, Clone, Copy, Default)]
@@ -347,28 +237,6 @@ fn is_finite_state(s: &crate::block::BlockState) -> bool {
         && is_finite_vector(s.angular_velocity)
         && is_finite_vector(s.pose.translation)
         && s.pose.rotation.is_finite()
-}
-
-/// The start of the sub-contact vector, shared with the tasks of the contact loop, each of which
-/// touches only its own contact's range.
-struct SubsPtr<S>(*mut S);
-
-impl<S> Clone for SubsPtr<S> {
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<S> Copy for SubsPtr<S> {}
-// SAFETY: used only in `compute_forces`, where each task dereferences a disjoint range.
-unsafe impl<S: Send> Send for SubsPtr<S> {}
-// SAFETY: as above; the pointer itself is only read.
-unsafe impl<S: Send> Sync for SubsPtr<S> {}
-
-impl<S> SubsPtr<S> {
-    fn get(self) -> *mut S {
-        self.0
-    }
 }
 
 impl<L: ConstitutiveLaw> Model<L> {
@@ -879,13 +747,14 @@ impl<L: ConstitutiveLaw> Model<L> {
             mode: self.params.mode,
         };
         // The records run index for index with the sub-contacts (kept so by detection and
-        // checkpoint load); the pass's range check relies on it.
+        // checkpoint load).
         assert_eq!(
             self.sub_records.len(),
             self.subs.len(),
             "sub-contact records out of step"
         );
         assert_eq!(self.rotations.len(), self.blocks.len(), "rotation matrices out of step");
+        assert_eq!(self.wrenches.len(), self.pairs.len(), "contact wrenches out of step");
         let pass = ContactPass {
             blocks: &self.blocks,
             rotations: &self.rotations,
@@ -893,33 +762,27 @@ impl<L: ConstitutiveLaw> Model<L> {
             laws: self.joints.laws(),
             bounds: &self.bounds,
             refining: &self.refining,
-            subs: SubsPtr(self.subs.as_mut_ptr()),
-            sub_records: SubsPtr(self.sub_records.as_mut_ptr()),
-            total_subs: self.subs.len(),
             ctx,
         };
-        let avx2 = crate::dispatch::has_avx2();
         // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed
         // per fixed chunk of contacts, so that the totals do not depend on the thread count.
         self.pair_sums.clear();
         self.pair_sums
             .resize(self.pairs.len().div_ceil(CONTACT_CHUNK), PairSums::default());
-        assert_eq!(self.wrenches.len(), self.pairs.len(), "contact wrenches out of step");
-        self.pairs
-            .par_chunks_mut(CONTACT_CHUNK)
-            .zip(self.wrenches.par_chunks_mut(CONTACT_CHUNK))
-            .zip(self.pair_sums.par_iter_mut())
-            .enumerate()
-            .for_each(|(k, ((chunk, wrenches), sums))| {
-                let first = k * CONTACT_CHUNK;
-                #[cfg(target_arch = "x86_64")]
-                if avx2 {
-                    // SAFETY: the processor has AVX2 (checked by `dispatch::has_avx2`).
-                    unsafe { pass.run_avx2(first, chunk, wrenches, sums) };
-                    return;
-                }
-                pass.run(first, chunk, wrenches, sums);
-            });
+        if !self.pairs.is_empty() {
+            let first_sub = self.pairs[0].first as usize;
+            pass.run_all(
+                ContactSlices {
+                    first: 0,
+                    pairs: &mut self.pairs,
+                    wrenches: &mut self.wrenches,
+                    sums: &mut self.pair_sums,
+                    subs: &mut self.subs[first_sub..],
+                    records: &mut self.sub_records[first_sub..],
+                },
+                crate::dispatch::has_avx2(),
+            );
+        }
         (
             self.pair_sums.iter().map(|s| s.impact).fold(0.0, Real::max),
             self.pair_sums.iter().any(|s| s.busy),
