@@ -880,6 +880,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 mod tests {
     use super::*;
     use crate::constitutive::JointStatus;
+    use crate::contact::update_contact;
 
     /// The AVX2 builds of the contact pass and the integrator and the portable ones give
     /// bit-identical results (no
