@@ -271,7 +271,7 @@ where
             refine_until: self.refine_until,
             refine_omega2: self.refine_omega2,
             refining: self.refining.clone(),
-            pending_detection: self.scratch.force_full_detection,
+            pending_detection: self.changes.need_full_detection(),
         };
         serde_json::to_string(&snap).map_err(|e| Error::Io {
             path: "(checkpoint)".into(),
@@ -453,7 +453,10 @@ where
             r.reaction = reaction;
             r.damping = damping;
         }
-        model.scratch.force_full_detection = !model.started || snap.pending_detection;
+        model.changes.clear();
+        if !model.started || snap.pending_detection {
+            model.changes.insert(super::changes::Changes::DETECTION);
+        }
         model.rebuild_block_index();
         Ok(model)
     }

@@ -11,13 +11,13 @@ use crate::contact::{
 };
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, NarrowPhaseScratch, SubcontactSeed};
+use super::changes::Changes;
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
 use crate::math::{Matrix, Real, Rotation, Vector};
 
 /// Buffers reused from one detection to the next.
 #[derive(Debug, Clone)]
 pub(crate) struct DetectionScratch<S> {
-    pub force_full_detection: bool,
     /// Set by the fused block pass ([`Model::advance_blocks`]) after it moved the blocks and
     /// took their rotation matrices and movement check for the next step: whether any block
     /// moved beyond the re-detection trigger. Taken (reset) by the next step.
@@ -37,7 +37,6 @@ pub(crate) struct DetectionScratch<S> {
 impl<S> Default for DetectionScratch<S> {
     fn default() -> Self {
         Self {
-            force_full_detection: true,
             prepared: None,
             broad: BroadPhase::default(),
             narrow: NarrowPhaseScratch::default(),
@@ -50,16 +49,6 @@ impl<S> Default for DetectionScratch<S> {
             subs: Vec::new(),
             records: Vec::new(),
         }
-    }
-}
-
-impl<S> DetectionScratch<S> {
-    /// Asks the next step for a full detection (after a change of blocks, laws, parameters or
-    /// fixity) and drops the block pass's rotation matrices and movement check, which that
-    /// change may have made stale.
-    pub fn request_full_detection(&mut self) {
-        self.force_full_detection = true;
-        self.prepared = None;
     }
 }
 
@@ -84,7 +73,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// with sub-contact history carried over by key; other pairs are kept as they are.
     pub(super) fn detect(&mut self) -> Result<()> {
         let params = self.params.contact;
-        let full = self.scratch.force_full_detection || self.params.mode == DisplacementMode::Small;
+        let full = self.changes.need_full_detection() || self.params.mode == DisplacementMode::Small;
         let trigger = params.redetect_fraction * params.tolerance;
         let sc = &mut self.scratch;
         sc.moved.clear();
@@ -255,10 +244,10 @@ impl<L: ConstitutiveLaw> Model<L> {
         // is set (or stays set) if that fails, so the error repeats rather than the run going on
         // with an unstable step.
         if stiffer || full || self.critical.is_none() {
-            self.scratch.force_full_detection = true;
+            self.changes.insert(Changes::DETECTION);
             self.refresh_time_step()?;
         }
-        self.scratch.force_full_detection = false;
+        self.changes.clear();
         Ok(())
     }
 

@@ -1,6 +1,7 @@
 //! The model: blocks, joint laws, gravity and loads; stepping and runs.
 
 mod benchmark;
+mod changes;
 mod checkpoint;
 mod contact_pass;
 mod detection;
@@ -25,6 +26,7 @@ use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, Ste
 use crate::math::{is_finite_vector, Matrix, Pose, Real, Vector};
 use crate::monitor::{History, Monitor, MonitorId};
 
+use changes::Changes;
 use contact_pass::{ContactPass, ContactSlices, PairSums, CONTACT_CHUNK};
 use detection::DetectionScratch;
 
@@ -152,6 +154,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     time: Real,
     energy: Energies,
     started: bool,
+    /// What the setters changed since the last step (read first by [`Model::step`]).
+    changes: Changes,
     unbalanced_ratio: Real,
     detections: u64,
     scratch: DetectionScratch<L::State>,
@@ -275,6 +279,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             time: 0.0,
             energy: Energies::default(),
             started: false,
+            changes: Changes::DETECTION,
             unbalanced_ratio: Real::INFINITY,
             detections: 0,
             scratch: DetectionScratch::default(),
@@ -300,7 +305,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.forces.push(Wrench::default());
         self.records.push(StepRecord::default());
         self.bounds.push(StiffnessBound::default());
-        self.scratch.request_full_detection();
+        self.changes.insert(Changes::BLOCKS);
         Ok(id)
     }
 
@@ -310,7 +315,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The law's validation error.
     pub fn set_joint_law(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
         self.joints.insert(a, b, law)?;
-        self.scratch.request_full_detection();
+        self.changes.insert(Changes::LAWS);
         Ok(())
     }
 
@@ -342,7 +347,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn set_parameters(&mut self, params: ModelParameters) -> Result<()> {
         params.validate()?;
         self.params = params;
-        self.scratch.request_full_detection();
+        self.changes.insert(Changes::PARAMETERS);
         Ok(())
     }
 
@@ -378,7 +383,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             return Err(e);
         }
         // A released block may touch blocks it had no contact with while both were fixed.
-        self.scratch.request_full_detection();
+        self.changes.insert(Changes::FIXITY);
         if let Err(e) = self.refresh_time_step() {
             let b = self.block_mut(id)?;
             *b = b.clone().with_fixity(old);
@@ -634,22 +639,23 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn step(&mut self) -> Result<()> {
         let started = std::time::Instant::now();
         let large = self.params.mode == DisplacementMode::Large;
+        // The changes since the last step come first: any of them asks for a full detection,
+        // and makes what the last block pass prepared possibly stale.
+        let changed = self.changes.need_full_detection();
         let moved = match self.scratch.prepared.take() {
-            // Valid unless something changed since the last block pass: every change of blocks,
-            // laws, parameters or fixity requests a full detection (and drops `prepared`).
-            Some(moved) if self.started && !self.scratch.force_full_detection => moved,
-            _ => self.prepare_blocks(large && self.started && !self.scratch.force_full_detection),
+            Some(moved) if self.started && !changed => moved,
+            _ => self.prepare_blocks(large && self.started && !changed),
         };
         if !self.started {
             self.start()?;
         } else if large {
-            if self.scratch.force_full_detection || moved {
+            if changed || moved {
                 self.detect()?;
             }
-        } else if self.scratch.force_full_detection {
+        } else if changed {
             // Small displacements keep the initial contact geometry: only the step is re-evaluated.
             self.refresh_time_step()?;
-            self.scratch.force_full_detection = false;
+            self.changes.clear();
         }
         if self.drift == 0.0 {
             // The first step: the initial velocities stand for those of the half step before.
@@ -681,7 +687,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     fn start(&mut self) -> Result<()> {
         self.params.validate()?;
         self.integrator.damping().validate()?;
-        self.scratch.request_full_detection();
+        self.changes.insert(Changes::DETECTION);
         self.detect()?;
         self.energy.initial_kinetic = self.blocks.iter().map(|b| b.kinetic_energy()).sum();
         self.energy.kinetic = self.energy.initial_kinetic;
@@ -1147,7 +1153,7 @@ mod tests {
             view.subcontacts().map(|s| (s.key(), s.shear_force())).collect()
         };
         let before = world_shears(&model);
-        model.scratch.request_full_detection();
+        model.changes.insert(Changes::DETECTION);
         model.detect().expect("re-detection");
         let after = world_shears(&model);
         assert_eq!(before.len(), after.len());
