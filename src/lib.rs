@@ -84,7 +84,9 @@ const _: fn(parry3d_f64::glamx::DPose3) -> parry3d_f64::math::Pose = |p| p;
 /// The names most programs need.
 pub mod prelude {
     pub use crate::block::{Block, BlockId, Dof, Fixity, RigidBlock, Wrench};
-    pub use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointStatus, JointTable, LinearElastic, MaterialId};
+    pub use crate::constitutive::{
+        AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, JointTable, LinearElastic, MaterialId,
+    };
     pub use crate::contact::{Contact, DisplacementMode};
     pub use crate::error::{Error, Result};
     pub use crate::geometry::{ContactParameters, SubcontactDensity};

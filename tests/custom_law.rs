@@ -13,6 +13,7 @@
 //! then softens to `N·tan φ` once it has slipped `u_soft`.
 
 use serde::{Deserialize, Serialize};
+use voussoir::constitutive::{conformance, AnyLaw, ElasticRegime};
 use voussoir::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus, JointStep, JointStiffness};
 use voussoir::math::Vector2;
 use voussoir::prelude::*;
@@ -489,4 +490,213 @@ fn law_state_survives_a_checkpoint() {
         model.block(block).unwrap().state(),
         restored.block(block).unwrap().state()
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// The law contract, checked by `voussoir::constitutive::conformance`.
+
+/// The softening law keeps the contract: its updates are deterministic, finite, force-free when
+/// open, no stiffer than `stiffness()`, with non-negative energies and dissipation on monotonic
+/// loading — also from states far along the softening that the checker's own histories do not
+/// reach. It offers neither shortcut (`elastic_regime`, `stays_open`), so the report shows none.
+#[test]
+fn softening_law_conforms() {
+    let law = SofteningCoulomb::new(1e9, 1e8, PHI_DEG, COHESION, U_SOFT).unwrap();
+    let report = conformance::check(&law).unwrap_or_else(|e| panic!("{e}"));
+    assert!(report.updates > 1000 && report.states > 100, "{report:?}");
+    assert_eq!((report.regime_stood, report.open_promised), (0, 0), "{report:?}");
+    let softened = [0.5, 1.0, 3.0].map(|k| SofteningState {
+        plastic_slip: k * U_SOFT,
+    });
+    conformance::check_with_states(&law, &softened).unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// The shipped laws keep the contract and offer their shortcuts, and `AnyLaw` forwards them:
+/// wrapped, each law gives the same report as alone (the same regime trials standing, the same
+/// open promises), and `elastic_regime` returns the inner law's.
+#[test]
+fn shipped_laws_and_any_law_conform() {
+    let laws: [AnyLaw; 4] = [
+        CoulombSlip::dry(4e9, 1.6e9, 30.0).unwrap().into(),
+        CoulombSlip::new(1e9, 4e8, 35.0, 25.0, 2e5, 0.0).unwrap().into(),
+        CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap().into(),
+        LinearElastic {
+            normal_stiffness: 3e9,
+            shear_stiffness: 1.2e9,
+        }
+        .into(),
+    ];
+    for law in laws {
+        let any = conformance::check(&law).unwrap_or_else(|e| panic!("{law:?}: {e}"));
+        let (alone, regime) = match law {
+            AnyLaw::Coulomb(inner) => (conformance::check(&inner), inner.elastic_regime()),
+            AnyLaw::Elastic(inner) => (conformance::check(&inner), inner.elastic_regime()),
+            _ => unreachable!(),
+        };
+        assert_eq!(Ok(any), alone, "{law:?}");
+        assert!(regime.is_some() && law.elastic_regime() == regime, "{law:?}");
+        assert!(any.regime_stood > 1000, "{law:?}: {any:?}");
+        if let AnyLaw::Coulomb(_) = law {
+            assert!(any.open_promised > 100, "{law:?}: {any:?}");
+        }
+    }
+}
+
+/// What a user's forwarding `enum` forwards: a shipped law and the softening law, each with its
+/// state, side by side.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct MixedState {
+    coulomb: voussoir::constitutive::CoulombState,
+    softening: SofteningState,
+}
+
+/// A forwarding `enum` written with care: every method forwarded, the shortcuts included.
+#[derive(Debug, Clone, Copy)]
+enum Mixed {
+    Coulomb(CoulombSlip),
+    Softening(SofteningCoulomb),
+}
+
+impl ConstitutiveLaw for Mixed {
+    type State = MixedState;
+    fn stiffness(&self) -> JointStiffness {
+        match self {
+            Mixed::Coulomb(l) => l.stiffness(),
+            Mixed::Softening(l) => l.stiffness(),
+        }
+    }
+    fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut MixedState) -> JointStatus {
+        match self {
+            Mixed::Coulomb(l) => l.update(step, force, &mut state.coulomb),
+            Mixed::Softening(l) => l.update(step, force, &mut state.softening),
+        }
+    }
+    fn stays_open(&self, area: f64, gap: f64, state: &MixedState) -> bool {
+        match self {
+            Mixed::Coulomb(l) => l.stays_open(area, gap, &state.coulomb),
+            Mixed::Softening(l) => l.stays_open(area, gap, &state.softening),
+        }
+    }
+    fn elastic_regime(&self) -> Option<ElasticRegime> {
+        match self {
+            Mixed::Coulomb(l) => l.elastic_regime(),
+            Mixed::Softening(l) => l.elastic_regime(),
+        }
+    }
+    fn elastic_energy(&self, area: f64, force: &JointForce, state: &MixedState) -> f64 {
+        match self {
+            Mixed::Coulomb(l) => l.elastic_energy(area, force, &state.coulomb),
+            Mixed::Softening(l) => l.elastic_energy(area, force, &state.softening),
+        }
+    }
+    fn is_failed(&self, state: &MixedState) -> bool {
+        match self {
+            Mixed::Coulomb(l) => l.is_failed(&state.coulomb),
+            Mixed::Softening(l) => l.is_failed(&state.softening),
+        }
+    }
+    fn validate(&self) -> Result<()> {
+        match self {
+            Mixed::Coulomb(l) => l.validate(),
+            Mixed::Softening(l) => l.validate(),
+        }
+    }
+}
+
+/// The same `enum` written in a hurry: `update` and the rest forwarded, the two shortcuts
+/// forgotten. Correct, but the contact kernel never takes its fast paths.
+#[derive(Debug, Clone, Copy)]
+enum Forgetful {
+    Coulomb(CoulombSlip),
+    Softening(SofteningCoulomb),
+}
+
+impl ConstitutiveLaw for Forgetful {
+    type State = MixedState;
+    fn stiffness(&self) -> JointStiffness {
+        match self {
+            Forgetful::Coulomb(l) => l.stiffness(),
+            Forgetful::Softening(l) => l.stiffness(),
+        }
+    }
+    fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut MixedState) -> JointStatus {
+        match self {
+            Forgetful::Coulomb(l) => l.update(step, force, &mut state.coulomb),
+            Forgetful::Softening(l) => l.update(step, force, &mut state.softening),
+        }
+    }
+    fn is_failed(&self, state: &MixedState) -> bool {
+        match self {
+            Forgetful::Coulomb(l) => l.is_failed(&state.coulomb),
+            Forgetful::Softening(l) => l.is_failed(&state.softening),
+        }
+    }
+}
+
+/// A forwarding `enum` that answers `stays_open` with "open whenever the joint opens" for
+/// every arm: true of the softening law and of a dry joint, a lie for a bonded joint, which
+/// carries tension and fails when it opens.
+#[derive(Debug, Clone, Copy)]
+struct OpensWhenOpen(Mixed);
+
+impl ConstitutiveLaw for OpensWhenOpen {
+    type State = MixedState;
+    fn stiffness(&self) -> JointStiffness {
+        self.0.stiffness()
+    }
+    fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut MixedState) -> JointStatus {
+        self.0.update(step, force, state)
+    }
+    fn stays_open(&self, _area: f64, gap: f64, _state: &MixedState) -> bool {
+        gap > 0.0
+    }
+    fn elastic_regime(&self) -> Option<ElasticRegime> {
+        self.0.elastic_regime()
+    }
+}
+
+/// The checker shows what a forwarding `enum` forwards.
+///
+/// * Careful: it conforms, and each arm's report equals the inner law's.
+/// * Forgetful: it conforms (skipping the shortcuts is always allowed), but its Coulomb arm's
+///   report differs from `CoulombSlip`'s: no elastic regime stood, no open promise. The report
+///   is how a user sees the lost fast path. (The softening law has no shortcut to lose.)
+#[test]
+fn conformance_shows_a_forgetful_forwarding_enum() {
+    let dry = CoulombSlip::dry(4e9, 1.6e9, 30.0).unwrap();
+    let bonded = CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap();
+    let softening = SofteningCoulomb::new(1e9, 1e8, PHI_DEG, COHESION, U_SOFT).unwrap();
+    for coulomb in [dry, bonded] {
+        let alone = conformance::check(&coulomb).unwrap();
+        assert!(alone.regime_stood > 0 && alone.open_promised > 0, "{alone:?}");
+        assert_eq!(conformance::check(&Mixed::Coulomb(coulomb)), Ok(alone));
+        let forgetful = conformance::check(&Forgetful::Coulomb(coulomb)).expect("correct, if slow");
+        assert_ne!(forgetful, alone, "the lost fast paths show in the report");
+        assert_eq!((forgetful.regime_stood, forgetful.open_promised), (0, 0));
+        assert_eq!(forgetful.states, alone.states);
+    }
+    let alone = conformance::check(&softening).unwrap();
+    assert_eq!(conformance::check(&Mixed::Softening(softening)), Ok(alone));
+    assert_eq!(conformance::check(&Forgetful::Softening(softening)), Ok(alone));
+}
+
+/// The checker catches a `stays_open` that lies: "open whenever the joint opens" for an intact
+/// bonded joint, which carries tension and fails when it opens; it names the clause and gives
+/// the step that shows it. The same rule is the truth for a dry joint and for the softening
+/// law, and passes there.
+#[test]
+fn conformance_catches_a_lying_stays_open() {
+    let bonded = CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap();
+    let error = conformance::check(&OpensWhenOpen(Mixed::Coulomb(bonded))).expect_err("a lie");
+    assert_eq!(error.clause, conformance::Clause::StaysOpen, "{error}");
+    assert!(
+        error.to_string().contains("stays_open") && error.detail.contains("Elastic"),
+        "{error}"
+    );
+    let dry = CoulombSlip::dry(4e9, 1.6e9, 30.0).unwrap();
+    let softening = SofteningCoulomb::new(1e9, 1e8, PHI_DEG, COHESION, U_SOFT).unwrap();
+    for honest in [Mixed::Coulomb(dry), Mixed::Softening(softening)] {
+        let report = conformance::check(&OpensWhenOpen(honest)).unwrap_or_else(|e| panic!("{honest:?}: {e}"));
+        assert!(report.open_promised > 0, "{report:?}");
+    }
 }

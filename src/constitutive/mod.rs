@@ -1,15 +1,19 @@
-//! Joint constitutive laws: the [`ConstitutiveLaw`] trait, the laws voussoir ships, and the table
-//! that assigns a law to each pair of block materials.
+//! Joint constitutive laws: the [`ConstitutiveLaw`] trait, the laws voussoir ships ([`AnyLaw`]
+//! to mix them), the table that assigns a law to each pair of block materials, and the
+//! [`conformance`] check of a law against the trait's contract.
 //!
 //! Sign conventions: the normal force is positive in compression; the shear force is the force on
 //! block `b` of the pair, in the joint plane; the normal displacement `u_n` is positive when the
 //! joint opens. Forces are stresses times the sub-contact area. See `docs/theory.md`.
 
+mod any;
+pub mod conformance;
 mod coulomb;
 mod elastic;
 
 use serde::{Deserialize, Serialize};
 
+pub use any::{AnyLaw, AnyState};
 pub use coulomb::{CoulombSlip, CoulombState};
 pub use elastic::LinearElastic;
 
@@ -180,7 +184,12 @@ pub enum JointStatus {
 /// the forces (damage, plastic slip, a bonded flag) lives in [`ConstitutiveLaw::State`], which
 /// voussoir stores contiguously next to each sub-contact and carries through re-detection and
 /// checkpoints. The model is generic over the law type, so calls are statically dispatched; to mix
-/// several laws in one model, implement the trait for an `enum` of them.
+/// the shipped laws in one model, use [`AnyLaw`]; to mix your own with them, implement the trait
+/// for an `enum` of them that forwards every method, the shortcuts [`ConstitutiveLaw::stays_open`]
+/// and [`ConstitutiveLaw::elastic_regime`] included.
+///
+/// [`conformance::check`] tests a law against the promises below (the shortcuts agree with
+/// `update`, energies are not negative, updates are deterministic); run it in your law's tests.
 ///
 /// See `docs/custom-law.md` for a walk-through. A minimal law, frictionless and no-tension:
 ///
@@ -228,7 +237,8 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     ///
     /// The contact kernel then skips the sub-contact's kinematics and update (separated parts
     /// of joints are common: a quarter of the sub-contacts of a settled running-bond wall). It
-    /// must agree exactly with `update`; the default, `false`, never skips.
+    /// must agree exactly with `update` ([`conformance::check`] tests it); the default, `false`,
+    /// never skips.
     #[inline]
     fn stays_open(&self, _area: Real, _normal_displacement: Real, _state: &Self::State) -> bool {
         false
@@ -242,13 +252,14 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     /// The contact kernel then updates such sub-contacts (in compression, below their strength:
     /// most of a masonry structure at rest) in a tight loop without calling `update`, and falls
     /// back to `update` for the others. The default, `None`, always calls `update`.
+    /// [`conformance::check`] tests the promise over a grid of steps.
     #[inline]
     fn elastic_regime(&self) -> Option<ElasticRegime> {
         None
     }
 
-    /// Elastic energy stored in the joint springs (J). The default assumes linear springs with the
-    /// stiffness of [`ConstitutiveLaw::stiffness`].
+    /// Elastic energy stored in the joint springs (J), never negative. The default assumes linear
+    /// springs with the stiffness of [`ConstitutiveLaw::stiffness`].
     fn elastic_energy(&self, area: Real, force: &JointForce, _state: &Self::State) -> Real {
         let k = self.stiffness();
         let mut e = 0.0;

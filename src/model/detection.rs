@@ -2,6 +2,7 @@
 
 use rayon::prelude::*;
 
+use super::changes::Changes;
 use super::{Model, BLOCK_CHUNK};
 use crate::block::{Block, BlockId};
 use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
@@ -11,7 +12,6 @@ use crate::contact::{
 };
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, NarrowPhaseScratch, SubcontactSeed};
-use super::changes::Changes;
 use crate::integrate::{critical_time_step, Damping, Stiffness6, TimeStep};
 use crate::math::{Matrix, Real, Rotation, Vector};
 

@@ -1,0 +1,803 @@
+//! Checks that a joint law keeps the contract of [`ConstitutiveLaw`]: for authors of custom laws,
+//! and for anyone wrapping laws in a forwarding `enum`.
+//!
+//! [`check`] drives the law through a fixed, deterministic set of kinematic histories and grids
+//! of steps, and checks every promise the contact kernel relies on:
+//!
+//! * **`elastic_regime`** ([`Clause::ElasticRegime`]): on a grid of areas, total normal
+//!   displacements (both zeros, and `1e-300`, 1, 2 and 5 per decade from `1e-12` to `5e-2`,
+//!   and `0.1` m, of both signs), shear increments, carried shear forces (from zero to several
+//!   times the normal force and the cohesion), carried normal forces, axes and time steps,
+//!   wherever [`ElasticRegime::trial`](super::ElasticRegime::trial) stands for a virgin
+//!   sub-contact, `update` returns [`JointStatus::Elastic`], exactly the trial's forces (the
+//!   same bits) and the virgin state.
+//! * **`stays_open`** ([`Clause::StaysOpen`]): for every state the histories reach (and any you
+//!   give to [`check_with_states`]), every area and normal displacement of the grid, wherever
+//!   `stays_open` promises, `update` from zero forces returns [`JointStatus::Open`], zero forces
+//!   and the same state, with several normal and shear increments, axes and time steps.
+//! * **Determinism** ([`Clause::Determinism`]): every call of `update` is made twice from the
+//!   same inputs and must give the same bits; `stiffness` and `elastic_regime` the same values.
+//! * **Forces** ([`Clause::NonFinite`], [`Clause::OpenWithForce`]): finite after every update,
+//!   and zero whenever the status is `Open` (an open joint carries nothing, see
+//!   [`JointStatus::Open`]).
+//! * **Stiffness** ([`Clause::Stiffness`]): `stiffness()` finite and not negative, and no
+//!   elastic step (from `Elastic` to `Elastic`, state unchanged) changes the normal or the shear
+//!   force faster than it says: it is the largest stiffness, which the critical time step uses.
+//! * **Energies** ([`Clause::ElasticEnergy`], [`Clause::Dissipation`]): `elastic_energy` finite
+//!   and not negative after every update; and the energy voussoir books as dissipated for a step
+//!   (see `docs/custom-law.md`, "Dissipation"; the same expression as the contact kernel) not
+//!   negative, beyond round-off, on monotonic loading: closing, opening, and sliding one way at
+//!   constant normal displacement. (Reversals are not checked: an explicit return mapping of a
+//!   softening law books a little negative work on the step after a reversal, made up by the
+//!   steps before.)
+//!
+//! The histories, from the virgin state, for each of four areas (`1e-4` to 4 m²) and two sets
+//! of axes and time steps: closing from 0.1 m open to 0.1 m of interpenetration and opening
+//! back through the displacement grid; at four compressions, sliding one way by growing
+//! increments (to about 1 cm), reversing twice as far, opening, closing again and sliding
+//! across; and under three small tensions, sliding, then opening fully.
+//!
+//! A law that passes is not proven right (only its own tests, against closed forms, do that),
+//! and a grid can miss a disagreement confined between its points; but a law that fails is
+//! wrong, and the error gives the step that shows it.
+//! The [`ConformanceReport`] says how much of the fast paths the law offered: a law without
+//! `elastic_regime` or `stays_open` passes, with `regime_stood` or `open_promised` zero. Two
+//! laws that behave alike give equal reports, so comparing the report of a wrapper with the
+//! inner law's shows whether it forwards the shortcuts.
+//!
+//! ```
+//! use voussoir::constitutive::conformance::{self, Clause};
+//! use voussoir::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
+//! use voussoir::math::Vector2;
+//!
+//! /// Frictionless, no tension; open when not compressed.
+//! #[derive(Debug, Clone)]
+//! struct Frictionless { kn: f64, lie: bool }
+//!
+//! impl ConstitutiveLaw for Frictionless {
+//!     type State = ();
+//!     fn stiffness(&self) -> JointStiffness { JointStiffness { normal: self.kn, shear: 0.0 } }
+//!     fn update(&self, s: &JointStep, f: &mut JointForce, _: &mut ()) -> JointStatus {
+//!         f.shear = Vector2::ZERO;
+//!         f.normal = (-self.kn * s.normal_displacement * s.area).max(0.0);
+//!         if f.normal > 0.0 { JointStatus::Sliding } else { JointStatus::Open }
+//!     }
+//!     fn stays_open(&self, area: f64, normal_displacement: f64, _: &()) -> bool {
+//!         // The honest answer is `update`'s own test; the lie: always open.
+//!         self.lie || -self.kn * normal_displacement * area <= 0.0
+//!     }
+//! }
+//!
+//! let report = conformance::check(&Frictionless { kn: 1e9, lie: false })?;
+//! assert!(report.open_promised > 0 && report.regime_stood == 0);
+//! let error = conformance::check(&Frictionless { kn: 1e9, lie: true }).unwrap_err();
+//! assert_eq!(error.clause, Clause::StaysOpen);
+//! # Ok::<(), conformance::ConformanceError>(())
+//! ```
+
+use super::{ConstitutiveLaw, JointAxes, JointForce, JointStatus, JointStep};
+use crate::math::{Real, Vector, Vector2};
+
+/// The promise of [`ConstitutiveLaw`] that a law broke (see the [module](self) documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, thiserror::Error)]
+#[non_exhaustive]
+pub enum Clause {
+    /// The law's own [`ConstitutiveLaw::validate`] rejects it; nothing else was checked.
+    #[error("the law's own `validate` rejects it")]
+    Validate,
+    /// `stiffness()` is not finite and non-negative, or an elastic step stiffens beyond it.
+    #[error("`stiffness` is not finite and non-negative, or an elastic step is stiffer")]
+    Stiffness,
+    /// The same inputs gave different results.
+    #[error("not deterministic")]
+    Determinism,
+    /// `update` returned a force that is not finite.
+    #[error("`update` returned a force that is not finite")]
+    NonFinite,
+    /// `update` returned [`JointStatus::Open`] with a force.
+    #[error("`update` returned `Open` with a force")]
+    OpenWithForce,
+    /// `elastic_energy` is negative or not finite.
+    #[error("`elastic_energy` is negative or not finite")]
+    ElasticEnergy,
+    /// A step of monotonic loading dissipated a negative energy.
+    #[error("negative dissipation on monotonic loading")]
+    Dissipation,
+    /// `update` does not do what [`ConstitutiveLaw::elastic_regime`] promises.
+    #[error("`elastic_regime` promises what `update` does not do")]
+    ElasticRegime,
+    /// `update` does not do what [`ConstitutiveLaw::stays_open`] promises.
+    #[error("`stays_open` promises what `update` does not do")]
+    StaysOpen,
+}
+
+/// A broken promise: which, and the first inputs that show it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{clause}: {detail}")]
+pub struct ConformanceError {
+    /// The promise broken.
+    pub clause: Clause,
+    /// The step, forces and state that show it, and what happened.
+    pub detail: String,
+}
+
+/// What [`check`] exercised. Laws that behave alike give equal reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub struct ConformanceReport {
+    /// Calls of `update` checked (each made twice).
+    pub updates: usize,
+    /// Distinct states the histories reached, with the virgin and any given state.
+    pub states: usize,
+    /// Grid points where the elastic regime's trial stood and `update` matched it bit for bit
+    /// (zero without [`ConstitutiveLaw::elastic_regime`]).
+    pub regime_stood: usize,
+    /// Grid points where the trial declined, left to `update`.
+    pub regime_declined: usize,
+    /// Cases where `stays_open` promised and `update` kept the promise, each over four steps
+    /// (zero without [`ConstitutiveLaw::stays_open`]).
+    pub open_promised: usize,
+    /// Cases where `stays_open` declined.
+    pub open_declined: usize,
+}
+
+/// Checks `law` against the contract of [`ConstitutiveLaw`] (see the [module](self)
+/// documentation for what is checked and how).
+///
+/// # Errors
+/// The first broken promise found, with the inputs that show it.
+pub fn check<L: ConstitutiveLaw>(law: &L) -> Result<ConformanceReport, ConformanceError> {
+    check_with_states(law, &[])
+}
+
+/// As [`check`], with `states` checked (by `stays_open`, `elastic_energy`) besides those the
+/// histories reach: for a law whose interesting states lie beyond those histories.
+///
+/// # Errors
+/// The first broken promise found, with the inputs that show it.
+pub fn check_with_states<L: ConstitutiveLaw>(
+    law: &L,
+    states: &[L::State],
+) -> Result<ConformanceReport, ConformanceError> {
+    if let Err(e) = law.validate() {
+        return fail(Clause::Validate, format!("{e}"));
+    }
+    let k = law.stiffness();
+    if !(k.normal.is_finite() && k.shear.is_finite() && k.normal >= 0.0 && k.shear >= 0.0) {
+        return fail(Clause::Stiffness, format!("stiffness() = {k:?}"));
+    }
+    let regime = law.elastic_regime();
+    if law.stiffness() != k || law.elastic_regime() != regime {
+        return fail(
+            Clause::Determinism,
+            "`stiffness` or `elastic_regime` changed between calls".into(),
+        );
+    }
+    let mut checker = Checker {
+        law,
+        report: ConformanceReport::default(),
+        states: vec![L::State::default()],
+    };
+    for state in states {
+        checker.remember(state);
+    }
+    checker.elastic_regime()?;
+    checker.histories()?;
+    checker.stays_open()?;
+    checker.report.states = checker.states.len();
+    Ok(checker.report)
+}
+
+fn fail<T>(clause: Clause, detail: String) -> Result<T, ConformanceError> {
+    Err(ConformanceError { clause, detail })
+}
+
+/// Sub-contact areas (m²).
+const AREAS: [Real; 4] = [1e-4, 0.01, 0.37, 4.0];
+
+/// At most this many of the states reached are checked by `stays_open` (evenly picked).
+const MAX_STATES: usize = 256;
+
+/// Total normal displacements (m), ascending: `0.1`, 1, 2 and 5 per decade from `1e-12` to
+/// `5e-2` and `1e-300`, both signs, and both zeros.
+fn gaps() -> Vec<Real> {
+    let mut magnitudes = vec![1e-300];
+    for decade in -12..=-2 {
+        for m in [1.0, 2.0, 5.0] {
+            magnitudes.push(m * Real::powi(10.0, decade));
+        }
+    }
+    magnitudes.push(0.1);
+    let mut gaps: Vec<Real> = magnitudes.iter().rev().map(|m| -m).collect();
+    gaps.extend([-0.0, 0.0]);
+    gaps.extend(magnitudes);
+    gaps
+}
+
+/// Sizes of the shear increments along a slide (m): 1, 2 and 5 per decade from `1e-12` to
+/// `5e-3` (about 1 cm in all).
+fn slide_increments() -> Vec<Real> {
+    (-12..=-3)
+        .flat_map(|decade| [1.0, 2.0, 5.0].map(|m| m * Real::powi(10.0, decade)))
+        .collect()
+}
+
+/// Two sets of joint axes and time steps: the world's `z` and a tilted normal.
+fn frames() -> [(JointAxes, Real); 2] {
+    [
+        (JointAxes::from_normal(Vector::Z), 1e-5),
+        (JointAxes::from_normal(Vector::new(0.36, -0.48, 0.8)), 3e-3),
+    ]
+}
+
+fn bits(f: &JointForce) -> [u64; 3] {
+    [f.normal.to_bits(), f.shear.x.to_bits(), f.shear.y.to_bits()]
+}
+
+fn is_finite(f: &JointForce) -> bool {
+    f.normal.is_finite() && f.shear.x.is_finite() && f.shear.y.is_finite()
+}
+
+struct Checker<'a, L: ConstitutiveLaw> {
+    law: &'a L,
+    report: ConformanceReport,
+    /// Distinct states met so far, the virgin one first.
+    states: Vec<L::State>,
+}
+
+/// Where a history stands between steps.
+struct Point<S> {
+    area: Real,
+    axes: JointAxes,
+    dt: Real,
+    gap: Real,
+    force: JointForce,
+    state: S,
+    status: JointStatus,
+}
+
+impl<L: ConstitutiveLaw> Checker<'_, L> {
+    fn remember(&mut self, state: &L::State) {
+        if !self.states.contains(state) {
+            self.states.push(state.clone());
+        }
+    }
+
+    /// `update` twice from the same inputs; the result if both agree bit for bit, with the
+    /// checks that hold for every update (finite forces, none when open, energy).
+    fn update(
+        &mut self,
+        step: &JointStep,
+        force: JointForce,
+        state: &L::State,
+    ) -> Result<(JointStatus, JointForce, L::State), ConformanceError> {
+        self.report.updates += 1;
+        let (mut f, mut s) = (force, state.clone());
+        let status = self.law.update(step, &mut f, &mut s);
+        let (mut g, mut t) = (force, state.clone());
+        let again = self.law.update(step, &mut g, &mut t);
+        let context = || format!("{step:?}, force before {force:?}, state before {state:?}");
+        if status != again || bits(&f) != bits(&g) || s != t {
+            return fail(
+                Clause::Determinism,
+                format!(
+                    "{}: once {status:?} {f:?} {s:?}, again {again:?} {g:?} {t:?}",
+                    context()
+                ),
+            );
+        }
+        if !is_finite(&f) {
+            return fail(Clause::NonFinite, format!("{}: {status:?} {f:?}", context()));
+        }
+        if status == JointStatus::Open && (f.normal != 0.0 || f.shear != Vector2::ZERO) {
+            return fail(Clause::OpenWithForce, format!("{}: {f:?}", context()));
+        }
+        let energy = self.law.elastic_energy(step.area, &f, &s);
+        if !(energy >= 0.0 && energy.is_finite()) {
+            return fail(
+                Clause::ElasticEnergy,
+                format!("{}: {status:?} {f:?} {s:?}, elastic energy {energy}", context()),
+            );
+        }
+        Ok((status, f, s))
+    }
+
+    /// The elastic regime's promise for a virgin sub-contact, over the grid.
+    fn elastic_regime(&mut self) -> Result<(), ConformanceError> {
+        let Some(regime) = self.law.elastic_regime() else {
+            return Ok(());
+        };
+        let virgin = L::State::default();
+        let mut increments = vec![Vector2::ZERO];
+        for m in [1e-12, 1e-9, 1e-7, 3e-6, 1e-5, 1e-4, 1e-3] {
+            increments.push(Vector2::new(m, 0.6 * m));
+            increments.push(Vector2::new(-0.3 * m, m));
+        }
+        let direction = Vector2::new(1.0, -0.3).normalize();
+        for &area in &AREAS {
+            for gap in gaps() {
+                let normal = -regime.normal_stiffness * gap * area;
+                let mut carried = vec![Vector2::ZERO];
+                for scale in [normal.abs(), regime.cohesion * area] {
+                    if scale > 0.0 && scale.is_finite() {
+                        for factor in [0.01, 0.5, 0.99, 1.0, 1.01, 3.0] {
+                            carried.push(direction * (factor * scale));
+                        }
+                    }
+                }
+                for &du in &increments {
+                    for &shear in &carried {
+                        let Some(trial) = regime.trial(area, gap, du, shear) else {
+                            self.report.regime_declined += 1;
+                            continue;
+                        };
+                        self.report.regime_stood += 1;
+                        for (axes, dt) in frames() {
+                            for (previous, normal_increment) in [(0.0, 0.0), (trial.normal, 0.0), (1.0, -1e-7)] {
+                                let step = JointStep {
+                                    area,
+                                    normal_displacement: gap,
+                                    normal_increment,
+                                    shear_increment: du,
+                                    axes,
+                                    dt,
+                                };
+                                let before = JointForce {
+                                    normal: previous,
+                                    shear,
+                                };
+                                let (status, force, state) = self.update(&step, before, &virgin)?;
+                                if status != JointStatus::Elastic || bits(&force) != bits(&trial) || state != virgin {
+                                    return fail(
+                                        Clause::ElasticRegime,
+                                        format!(
+                                            "{step:?} from {before:?} in the virgin state: the trial \
+                                             of {regime:?} stands with {trial:?}, but `update` returned \
+                                             {status:?}, {force:?}, state {state:?}"
+                                        ),
+                                    );
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The histories, from the virgin state.
+    fn histories(&mut self) -> Result<(), ConformanceError> {
+        let gaps = gaps();
+        let slides = slide_increments();
+        let (d1, d2) = (Vector2::new(0.8, 0.6), Vector2::new(-0.6, 0.8));
+        for &area in &AREAS {
+            for (axes, dt) in frames() {
+                let start = |gap: Real| Point {
+                    area,
+                    axes,
+                    dt,
+                    gap,
+                    force: JointForce::default(),
+                    state: L::State::default(),
+                    status: JointStatus::Open,
+                };
+                // Closing from wide open to deep interpenetration, and opening back.
+                let mut p = start(0.1);
+                self.walk(&mut p, &gaps, -0.1)?;
+                self.walk(&mut p, &gaps, 0.1)?;
+                // Sliding at four compressions: one way, back twice as far, opening, closing
+                // and sliding across.
+                for compression in [-1e-9, -1e-6, -1e-4, -1e-2] {
+                    let mut p = start(0.0);
+                    self.walk(&mut p, &gaps, compression)?;
+                    self.slide(&mut p, &slides, d1, true)?;
+                    self.slide(&mut p, &slides, -d1, false)?;
+                    self.slide(&mut p, &slides, -d1, false)?;
+                    self.walk(&mut p, &gaps, 1e-2)?;
+                    self.walk(&mut p, &gaps, compression)?;
+                    self.slide(&mut p, &slides, d2, false)?;
+                }
+                // Sliding under a small tension (a bonded joint carries some), then opening.
+                for tension in [1e-9, 1e-6, 2e-5] {
+                    let mut p = start(0.0);
+                    self.walk(&mut p, &gaps, tension)?;
+                    self.slide(&mut p, &slides, d2, true)?;
+                    self.walk(&mut p, &gaps, 0.1)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Moves the normal displacement to `to` through the grid values between, without shear.
+    fn walk(&mut self, p: &mut Point<L::State>, gaps: &[Real], to: Real) -> Result<(), ConformanceError> {
+        let from = p.gap;
+        let path: Vec<Real> = if to < from {
+            gaps.iter().rev().copied().filter(|&g| g < from && g >= to).collect()
+        } else {
+            gaps.iter().copied().filter(|&g| g > from && g <= to).collect()
+        };
+        for gap in path {
+            self.advance(p, gap, Vector2::ZERO, true)?;
+        }
+        Ok(())
+    }
+
+    /// Slides by `increments` along `direction` at constant normal displacement.
+    fn slide(
+        &mut self,
+        p: &mut Point<L::State>,
+        increments: &[Real],
+        direction: Vector2,
+        monotonic: bool,
+    ) -> Result<(), ConformanceError> {
+        for &du in increments {
+            self.advance(p, p.gap, direction * du, monotonic)?;
+        }
+        Ok(())
+    }
+
+    /// One step of a history: the update, the stiffness bound, and on monotonic loading the
+    /// dissipation.
+    fn advance(
+        &mut self,
+        p: &mut Point<L::State>,
+        gap: Real,
+        du_s: Vector2,
+        monotonic: bool,
+    ) -> Result<(), ConformanceError> {
+        let step = JointStep {
+            area: p.area,
+            normal_displacement: gap,
+            normal_increment: gap - p.gap,
+            shear_increment: du_s,
+            axes: p.axes,
+            dt: p.dt,
+        };
+        let (status, force, state) = self.update(&step, p.force, &p.state)?;
+        let before = p.force;
+        let context = || {
+            format!(
+                "{step:?}, force before {before:?}, state before {:?}, status before {:?}: {status:?}, \
+                 {force:?}, {state:?}",
+                p.state, p.status
+            )
+        };
+        if p.status == JointStatus::Elastic && status == JointStatus::Elastic && state == p.state {
+            let k = self.law.stiffness();
+            let exceeds = |change: Real, stiffness: Real, displacement: Real, scale: Real| {
+                change > stiffness * p.area * displacement * (1.0 + 1e-9) + 1e-12 * scale
+            };
+            let normal = exceeds(
+                (force.normal - before.normal).abs(),
+                k.normal,
+                step.normal_increment.abs(),
+                force.normal.abs() + before.normal.abs(),
+            );
+            let shear = exceeds(
+                (force.shear - before.shear).length(),
+                k.shear,
+                du_s.length(),
+                force.shear.length() + before.shear.length(),
+            );
+            if normal || shear {
+                return fail(
+                    Clause::Stiffness,
+                    format!("{}: stiffer than stiffness() = {k:?}", context()),
+                );
+            }
+        }
+        if monotonic {
+            let dissipated = booked_dissipation(self.law, p, &step, &force, &state, status);
+            let e = |f: &JointForce, s: &L::State| self.law.elastic_energy(p.area, f, s);
+            let scale = e(&before, &p.state)
+                + e(&force, &state)
+                + (before.normal.abs() + force.normal.abs()) * step.normal_increment.abs()
+                + (before.shear.length() + force.shear.length()) * du_s.length();
+            if dissipated < -1e-9 * scale {
+                return fail(Clause::Dissipation, format!("{}: dissipated {dissipated} J", context()));
+            }
+        }
+        self.remember(&state);
+        *p = Point {
+            gap,
+            force,
+            state,
+            status,
+            ..*p
+        };
+        Ok(())
+    }
+
+    /// The promise of `stays_open` at every state met, area and normal displacement.
+    fn stays_open(&mut self) -> Result<(), ConformanceError> {
+        let states: Vec<L::State> = if self.states.len() > MAX_STATES {
+            (0..MAX_STATES)
+                .map(|i| self.states[i * self.states.len() / MAX_STATES].clone())
+                .collect()
+        } else {
+            self.states.clone()
+        };
+        let [(z, slow), (tilted, fast)] = frames();
+        for state in &states {
+            for &area in &AREAS {
+                for gap in gaps() {
+                    let promised = self.law.stays_open(area, gap, state);
+                    if promised != self.law.stays_open(area, gap, state) {
+                        return fail(
+                            Clause::Determinism,
+                            format!("`stays_open({area}, {gap}, {state:?})` changed between calls"),
+                        );
+                    }
+                    if !promised {
+                        self.report.open_declined += 1;
+                        continue;
+                    }
+                    self.report.open_promised += 1;
+                    let rests = [
+                        (0.0, Vector2::ZERO, z, slow),
+                        (1e-6, Vector2::new(1e-3, -2e-4), tilted, fast),
+                        (-1e-6, Vector2::new(-1e-7, 0.0), z, fast),
+                        (gap, Vector2::new(0.0, 5e-5), tilted, slow),
+                    ];
+                    for (normal_increment, shear_increment, axes, dt) in rests {
+                        let step = JointStep {
+                            area,
+                            normal_displacement: gap,
+                            normal_increment,
+                            shear_increment,
+                            axes,
+                            dt,
+                        };
+                        let (status, force, after) = self.update(&step, JointForce::default(), state)?;
+                        if status != JointStatus::Open || force != JointForce::default() || after != *state {
+                            return fail(
+                                Clause::StaysOpen,
+                                format!(
+                                    "`stays_open` promised at {step:?} in state {state:?}, but `update` \
+                                     from zero forces returned {status:?}, {force:?}, state {after:?}"
+                                ),
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The energy the contact kernel books as dissipated by the law over a step from `p` (see
+/// `docs/custom-law.md`, "Dissipation"; the same expression as the kernel's `update_with_law`,
+/// keep them in step).
+fn booked_dissipation<L: ConstitutiveLaw>(
+    law: &L,
+    p: &Point<L::State>,
+    step: &JointStep,
+    force: &JointForce,
+    state: &L::State,
+    status: JointStatus,
+) -> Real {
+    let before = &p.force;
+    let du_s = step.shear_increment;
+    if *state != p.state {
+        let work = -0.5
+            * ((before.normal + force.normal) * (step.normal_displacement - p.gap)
+                + (before.shear + force.shear).dot(du_s));
+        work - (law.elastic_energy(p.area, force, state) - law.elastic_energy(p.area, before, &p.state))
+    } else if status == JointStatus::Sliding || (status == JointStatus::Open && before.shear != Vector2::ZERO) {
+        let work = -0.5 * (before.shear + force.shear).dot(du_s);
+        let ks_area = law.stiffness().shear * p.area;
+        if ks_area > 0.0 {
+            work - 0.5 * (force.shear.length_squared() - before.shear.length_squared()) / ks_area
+        } else {
+            work
+        }
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::constitutive::{AnyLaw, CoulombSlip, CoulombState, ElasticRegime, JointStiffness, LinearElastic};
+
+    fn coulomb_laws() -> [CoulombSlip; 4] {
+        [
+            CoulombSlip::dry(4e9, 1.6e9, 30.0).unwrap(),
+            CoulombSlip::new(4e9, 1.6e9, 35.0, 25.0, 2e5, 0.0).unwrap(),
+            CoulombSlip::new(1e9, 1e9, 30.0, 20.0, 1e5, 5e4).unwrap(),
+            CoulombSlip::new(1e9, 1e9, 0.0, 0.0, 0.0, 1e4).unwrap(),
+        ]
+    }
+
+    /// The grid of displacements is sorted, holds both zeros, and is symmetric.
+    #[test]
+    fn gap_grid() {
+        let g = gaps();
+        assert!(g.windows(2).all(|w| w[0] <= w[1]));
+        assert_eq!(g.len(), 2 * 35 + 2);
+        assert!(g.iter().any(|x| x.to_bits() == (-0.0f64).to_bits()));
+        assert!(g.iter().zip(g.iter().rev()).all(|(a, b)| *a == -*b));
+    }
+
+    /// The shipped laws conform, offer both shortcuts where they should, and `AnyLaw` gives the
+    /// same report as the law it wraps.
+    #[test]
+    fn shipped_laws_conform() {
+        for law in coulomb_laws() {
+            let report = check(&law).unwrap_or_else(|e| panic!("{law:?}: {e}"));
+            // Frictionless and cohesionless, the last stands only without shear.
+            let stood = if law.friction_angle() > 0.0 { 1000 } else { 100 };
+            assert!(
+                report.regime_stood > stood && report.regime_declined > 1000,
+                "{report:?}"
+            );
+            assert!(report.updates > 10_000, "{report:?}");
+            assert_eq!(check(&AnyLaw::from(law)), Ok(report));
+        }
+        // Dry with equal residual friction: nothing ever fails, open joints stay open.
+        let dry = check(&coulomb_laws()[0]).unwrap();
+        assert_eq!(dry.states, 1);
+        assert!(dry.open_promised > 0);
+        // Bonded: failure reached; open promised only once failed.
+        let bonded = check(&coulomb_laws()[2]).unwrap();
+        assert_eq!(bonded.states, 2);
+        assert!(bonded.open_promised > 0);
+        let elastic = LinearElastic {
+            normal_stiffness: 3e9,
+            shear_stiffness: 1.2e9,
+        };
+        let report = check(&elastic).unwrap();
+        assert!(report.regime_stood > 1000 && report.open_promised == 0, "{report:?}");
+        assert_eq!(check(&AnyLaw::from(elastic)), Ok(report));
+    }
+
+    /// A law that breaks one promise at a time, each on an otherwise correct `CoulombSlip`.
+    #[derive(Debug, Clone)]
+    struct Broken {
+        law: CoulombSlip,
+        flaw: Flaw,
+    }
+
+    #[derive(Debug, Clone, Copy, PartialEq)]
+    enum Flaw {
+        /// `stays_open` for any opening, forgetting that an intact bonded joint fails.
+        OpenIgnoresState,
+        /// Claims the regime of a stiffer spring.
+        StifferRegime,
+        /// The normal force reassociated: `−kn·(u_n·A)`, off by an ulp at times.
+        Reassociated,
+        /// `stiffness()` half the spring's.
+        SoftStiffness,
+        /// An open joint keeps its shear force.
+        OpenKeepsShear,
+        /// Elastic energy of the wrong sign.
+        NegativeEnergy,
+        /// Gives energy back while sliding: the shear force pushes along the slip.
+        ActiveSlip,
+        /// Returns a different force every other call.
+        Flaky,
+    }
+
+    impl ConstitutiveLaw for Broken {
+        type State = CoulombState;
+        fn stiffness(&self) -> JointStiffness {
+            let k = self.law.stiffness();
+            match self.flaw {
+                Flaw::SoftStiffness => JointStiffness {
+                    normal: 0.5 * k.normal,
+                    shear: k.shear,
+                },
+                _ => k,
+            }
+        }
+        fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut CoulombState) -> JointStatus {
+            let before = force.shear;
+            let status = self.law.update(step, force, state);
+            match self.flaw {
+                Flaw::Reassociated if status == JointStatus::Elastic => {
+                    force.normal = -self.law.normal_stiffness() * (step.normal_displacement * step.area);
+                }
+                Flaw::OpenKeepsShear if status == JointStatus::Open => force.shear = before,
+                Flaw::ActiveSlip if status == JointStatus::Sliding => force.shear = -force.shear,
+                Flaw::Flaky => {
+                    use std::sync::atomic::{AtomicU64, Ordering};
+                    static CALLS: AtomicU64 = AtomicU64::new(0);
+                    if CALLS.fetch_add(1, Ordering::Relaxed) % 2 == 1 {
+                        force.normal *= 1.0 + 1e-15;
+                    }
+                }
+                _ => {}
+            }
+            status
+        }
+        fn stays_open(&self, area: Real, gap: Real, state: &CoulombState) -> bool {
+            match self.flaw {
+                Flaw::OpenIgnoresState => gap > 0.0,
+                _ => self.law.stays_open(area, gap, state),
+            }
+        }
+        fn elastic_regime(&self) -> Option<ElasticRegime> {
+            let regime = self.law.elastic_regime()?;
+            Some(match self.flaw {
+                Flaw::StifferRegime => ElasticRegime {
+                    normal_stiffness: regime.normal_stiffness * 1.001,
+                    ..regime
+                },
+                _ => regime,
+            })
+        }
+        fn elastic_energy(&self, area: Real, force: &JointForce, state: &CoulombState) -> Real {
+            let e = self.law.elastic_energy(area, force, state);
+            if self.flaw == Flaw::NegativeEnergy {
+                -e
+            } else {
+                e
+            }
+        }
+    }
+
+    /// Each broken promise is caught, and named.
+    #[test]
+    fn broken_laws_are_caught() {
+        let bonded = coulomb_laws()[2];
+        let dry = coulomb_laws()[0];
+        for (law, flaw, clause) in [
+            (bonded, Flaw::OpenIgnoresState, Clause::StaysOpen),
+            (dry, Flaw::StifferRegime, Clause::ElasticRegime),
+            (dry, Flaw::Reassociated, Clause::ElasticRegime),
+            (dry, Flaw::SoftStiffness, Clause::Stiffness),
+            (bonded, Flaw::OpenKeepsShear, Clause::OpenWithForce),
+            (dry, Flaw::NegativeEnergy, Clause::ElasticEnergy),
+            (dry, Flaw::ActiveSlip, Clause::Dissipation),
+            (dry, Flaw::Flaky, Clause::Determinism),
+        ] {
+            let error = check(&Broken { law, flaw }).expect_err(&format!("{flaw:?} passed"));
+            assert_eq!(error.clause, clause, "{flaw:?}: {error}");
+        }
+        // An invalid law is refused before anything else.
+        let invalid = AnyLaw::Elastic(LinearElastic {
+            normal_stiffness: 0.0,
+            shear_stiffness: 1.0,
+        });
+        assert_eq!(check(&invalid).unwrap_err().clause, Clause::Validate);
+    }
+
+    /// Given states are checked too: a law that lies about one state only the caller knows.
+    #[test]
+    fn given_states_are_checked() {
+        #[derive(Debug, Clone)]
+        struct Counter;
+        impl ConstitutiveLaw for Counter {
+            type State = u32;
+            fn stiffness(&self) -> JointStiffness {
+                JointStiffness {
+                    normal: 1e9,
+                    shear: 0.0,
+                }
+            }
+            fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut u32) -> JointStatus {
+                force.shear = Vector2::ZERO;
+                force.normal = (-1e9 * step.normal_displacement * step.area).max(0.0);
+                if *state == 7 {
+                    *state = 8;
+                }
+                if force.normal > 0.0 {
+                    JointStatus::Sliding
+                } else {
+                    JointStatus::Open
+                }
+            }
+            fn stays_open(&self, area: Real, gap: Real, _: &u32) -> bool {
+                -1e9 * gap * area <= 0.0
+            }
+        }
+        assert!(check(&Counter).is_ok());
+        let error = check_with_states(&Counter, &[3, 7]).unwrap_err();
+        assert_eq!(error.clause, Clause::StaysOpen, "{error}");
+        assert!(error.detail.contains("state 7"), "{error}");
+    }
+}
