@@ -111,6 +111,12 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// An operation this model cannot do as set up, e.g. checkpointing a custom integrator.
+    #[error("unsupported: {what}")]
+    Unsupported {
+        /// What was asked and why it cannot be done.
+        what: String,
+    },
     /// A run reached its step budget before its stopping condition.
     #[error("{what} not reached after {steps} steps (last value {last})")]
     NotConverged {

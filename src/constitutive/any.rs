@@ -48,7 +48,7 @@ use crate::math::Real;
 /// )?;
 /// model.run_to_equilibrium(1e-4, 20_000)?;
 /// let weight = (2500.0 * 0.008 + 1200.0 * 0.002) * 9.81;
-/// let support: f64 = model.contacts().map(|c| c.pair.normal_force()).sum();
+/// let support: f64 = model.contacts().map(|c| c.normal_force()).sum();
 /// assert!((support - weight).abs() < 1e-3 * weight);
 ///
 /// // The fast paths are the inner law's.

@@ -1,9 +1,8 @@
 //! Central difference (paper eqs. 3–4) for rigid blocks with the full inertia tensor.
 
-use rayon::prelude::*;
-
-use super::{Damping, Integrator, StepRecord};
-use crate::block::{Block, Dof, Fixity, RigidBlock, Wrench};
+use super::{Damping, Integrator, StepDurations, StepRecord};
+use crate::block::{Block, BlockState, Dof, Fixity, RigidBlock, Wrench};
+use crate::geometry::MassProperties;
 use crate::math::{rotation_from_vector, Matrix, Real, Vector};
 
 /// Explicit central difference: velocities at half steps, positions at full steps.
@@ -27,59 +26,35 @@ impl CentralDifference {
     }
 }
 
-/// The two durations of a variable step (see [`Integrator::advance_variable`]).
-#[derive(Debug, Clone, Copy)]
-struct Steps {
-    kick: Real,
-    drift: Real,
-}
-
-/// Blocks per rayon task.
-const BLOCKS_PER_TASK: usize = 256;
-/// Up to this many blocks are advanced on the calling thread: a chunk of the model's block pass
-/// (512 blocks), which runs on a thread of its own already.
-const SERIAL_BLOCKS: usize = 512;
-
 impl Integrator for CentralDifference {
-    fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]) {
-        self.advance_variable(blocks, forces, dt, dt, records);
+    fn advance_block(
+        &self,
+        state: &mut BlockState,
+        mass: &MassProperties,
+        fixity: &Fixity,
+        wrench: &Wrench,
+        step: StepDurations,
+    ) -> StepRecord {
+        advance_block(state, mass, fixity, wrench, step, self.damping)
     }
 
-    /// Variable steps: the kick over `kick`, the drift (and the mid-step rotation) over `drift`.
-    fn advance_variable(
+    /// The blocks of the chunk in order, compiled for AVX2 where the processor has it (the
+    /// same IEEE operations, no fused multiply-add: bit-identical to
+    /// [`advance_block`](Integrator::advance_block)).
+    fn advance_chunk(
         &self,
         blocks: &mut [RigidBlock],
-        forces: &[Wrench],
-        kick: Real,
-        drift: Real,
+        wrenches: &[Wrench],
+        step: StepDurations,
         records: &mut [StepRecord],
     ) {
-        let dt = Steps { kick, drift };
-        let damping = self.damping;
-        let avx2 = crate::dispatch::has_avx2();
-        let run = |blocks: &mut [RigidBlock], loads: &[Wrench], records: &mut [StepRecord]| {
-            #[cfg(target_arch = "x86_64")]
-            if avx2 {
-                // SAFETY: the processor has AVX2 (checked by `dispatch::has_avx2`).
-                unsafe { advance_chunk_avx2(blocks, loads, records, dt, damping) };
-                return;
-            }
-            advance_chunk(blocks, loads, records, dt, damping);
-        };
-        if blocks.len() <= SERIAL_BLOCKS {
-            run(blocks, forces, records);
-        } else {
-            blocks
-                .par_chunks_mut(BLOCKS_PER_TASK)
-                .zip(forces.par_chunks(BLOCKS_PER_TASK))
-                .zip(records.par_chunks_mut(BLOCKS_PER_TASK))
-                .for_each(|((blocks, loads), records)| run(blocks, loads, records));
+        #[cfg(target_arch = "x86_64")]
+        if crate::dispatch::has_avx2() {
+            // SAFETY: the processor has AVX2 (checked by `dispatch::has_avx2`).
+            unsafe { advance_chunk_avx2(blocks, wrenches, records, step, self.damping) };
+            return;
         }
-    }
-
-    /// Each block is advanced on its own.
-    fn is_blockwise(&self) -> bool {
-        true
+        advance_chunk(blocks, wrenches, records, step, self.damping);
     }
 
     fn damping(&self) -> Damping {
@@ -89,12 +64,26 @@ impl Integrator for CentralDifference {
     fn boxed_clone(&self) -> Box<dyn Integrator> {
         Box::new(*self)
     }
+
+    fn checkpoint_damping(&self) -> Option<Damping> {
+        Some(self.damping)
+    }
 }
 
 #[inline(always)]
-fn advance_chunk(blocks: &mut [RigidBlock], loads: &[Wrench], records: &mut [StepRecord], dt: Steps, damping: Damping) {
+fn advance_chunk(
+    blocks: &mut [RigidBlock],
+    loads: &[Wrench],
+    records: &mut [StepRecord],
+    dt: StepDurations,
+    damping: Damping,
+) {
     for ((block, load), rec) in blocks.iter_mut().zip(loads).zip(records) {
-        *rec = advance_block(block, load, dt, damping);
+        // A free block's fixity is the constant (its own sits on a cache line the step need
+        // not read).
+        let fixity = if block.is_free() { Fixity::FREE } else { *block.fixity() };
+        let mass = block.mass_properties();
+        *rec = advance_block(&mut block.state, &mass, &fixity, load, dt, damping);
     }
 }
 
@@ -108,7 +97,7 @@ unsafe fn advance_chunk_avx2(
     blocks: &mut [RigidBlock],
     loads: &[Wrench],
     records: &mut [StepRecord],
-    dt: Steps,
+    dt: StepDurations,
     damping: Damping,
 ) {
     advance_chunk(blocks, loads, records, dt, damping);
@@ -137,18 +126,23 @@ fn sign(x: Real) -> Real {
 }
 
 #[inline(always)]
-fn advance_block(block: &mut RigidBlock, load: &Wrench, steps: Steps, damping: Damping) -> StepRecord {
+fn advance_block(
+    state: &mut BlockState,
+    mass_properties: &MassProperties,
+    fixity: &Fixity,
+    load: &Wrench,
+    steps: StepDurations,
+    damping: Damping,
+) -> StepRecord {
     // The impulse over the kick; the mid-step rotation and the move over the drift.
-    let Steps { kick, drift } = steps;
-    let mass = block.mass_properties().mass;
-    // A free block's fixity is the constant (its own sits on a cache line the step need not read).
-    let fixity = if block.is_free() { Fixity::FREE } else { *block.fixity() };
+    let StepDurations { kick, drift } = steps;
+    let mass = mass_properties.mass;
     let (alpha, a) = match damping {
         Damping::Local { alpha } => (alpha, 0.0),
         Damping::Rayleigh { mass, .. } => (0.0, mass),
         Damping::None => (0.0, 0.0),
     };
-    let s0 = block.state;
+    let s0 = *state;
     let (c1, c2) = (1.0 - 0.5 * a * kick, 1.0 / (1.0 + 0.5 * a * kick));
 
     // Translation.
@@ -169,7 +163,7 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, steps: Steps, damping: D
     // rotation update first order and pumps energy into a free asymmetric spinner.
     // Rotations as matrices (two products each, with the transpose for the inverse), the
     // principal inertia inverted once.
-    let inverse_inertia = Vector::ONE / block.mass_properties().principal_inertia;
+    let inverse_inertia = Vector::ONE / mass_properties.principal_inertia;
     let r0 = s0.pose.rotation;
     let inertia_inverse_times = |m: &Matrix, v: Vector| *m * ((m.transpose() * v) * inverse_inertia);
     // ω₀ = A₀·L with A₀ = R·I⁻¹·Rᵀ at R(t); then the first-order start: turning the frame by
@@ -198,7 +192,8 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, steps: Steps, damping: D
         }
     }
     if constrained {
-        l = block.world_inertia_times(w);
+        // The world inertia at the pose before the move: `R I Rᵀ ω`.
+        l = r0 * (mass_properties.principal_inertia * (r0.inverse() * w));
         for i in 0..3 {
             if fixity.rotation[i].prescribed().is_some() {
                 reaction.moment[i] = (l[i] - s0.angular_momentum[i]) / kick - load.moment[i];
@@ -225,7 +220,7 @@ fn advance_block(block: &mut RigidBlock, load: &Wrench, steps: Steps, damping: D
         }
     }
 
-    let st = &mut block.state;
+    let st = state;
     st.velocity = v;
     st.angular_velocity = w;
     st.angular_momentum = l;

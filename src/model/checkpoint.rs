@@ -240,17 +240,28 @@ where
 {
     /// The full state as JSON text (numbers round-trip exactly).
     ///
-    /// The integrator is stored as its damping model and restored as [`CentralDifference`]; a
-    /// custom integrator must be set again after [`Model::from_checkpoint_str`].
+    /// The integrator is stored as its damping model and restored as [`CentralDifference`];
+    /// a model with a custom integrator (one whose
+    /// [`Integrator::checkpoint_damping`](crate::Integrator::checkpoint_damping) is `None`)
+    /// is refused rather than restored with another.
     ///
     /// # Errors
-    /// [`Error::Io`] if serialisation fails (it does not for the shipped laws).
+    /// [`Error::Unsupported`] for a custom integrator; [`Error::Io`] if serialisation fails (it
+    /// does not for the shipped laws).
     pub fn to_checkpoint_string(&self) -> Result<String> {
+        let Some(damping) = self.integrator.checkpoint_damping() else {
+            return Err(Error::Unsupported {
+                what: format!(
+                    "checkpoint of a model with a custom integrator ({:?}), which a checkpoint cannot restore",
+                    self.integrator
+                ),
+            });
+        };
         let snap = Snapshot::<L> {
             format: FORMAT.into(),
             version: VERSION,
             params: self.params,
-            damping: self.integrator.damping(),
+            damping,
             blocks: self.blocks.clone(),
             joints: self.joints.clone(),
             contacts: (0..self.pairs.len()).map(|k| self.joint_entry(k)).collect(),

@@ -7,6 +7,7 @@ mod contact_pass;
 mod detection;
 mod energy;
 mod motion;
+mod time_step;
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -335,8 +336,17 @@ impl<L: ConstitutiveLaw> Model<L> {
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for bad coefficients; [`Error::TimeStepTooLarge`] if a fixed
-    /// step is no longer stable with the new damping.
+    /// step is no longer stable with the new damping; [`Error::Unsupported`] while a custom
+    /// integrator is set (which this would silently replace: use [`Model::set_integrator`]).
     pub fn set_damping(&mut self, damping: Damping) -> Result<()> {
+        if self.integrator.checkpoint_damping().is_none() {
+            return Err(Error::Unsupported {
+                what: format!(
+                    "set_damping would replace the custom integrator {:?}; set a new one with set_integrator",
+                    self.integrator
+                ),
+            });
+        }
         self.set_integrator(CentralDifference::new(damping))
     }
 

@@ -2,12 +2,11 @@
 //! wrenches, adds gravity and its load, and the integrator moves it; the energy terms due
 //! before and after the move are booked on the way (see [`Model::advance_blocks`]).
 //!
-//! For an integrator that treats each block on its own ([`Integrator::is_blockwise`], as
-//! [`CentralDifference`](crate::integrate::CentralDifference)) the three stages run chunk by
-//! chunk in one parallel pass, while the chunk's blocks are in cache, with the next step's
-//! rotation matrices and movement check: one sweep through the block array per step instead of
-//! four, which matters once the blocks no longer fit in the cache (43 MB of blocks for the
-//! 100,000-block wall).
+//! The integrator advances each block on its own ([`Integrator::advance_chunk`]), so the three
+//! stages run chunk by chunk in one parallel pass, while the chunk's blocks are in cache, with
+//! the next step's rotation matrices and movement check: one sweep through the block array per
+//! step instead of four, which matters once the blocks no longer fit in the cache (43 MB of
+//! blocks for the 100,000-block wall).
 
 use rayon::prelude::*;
 
@@ -16,7 +15,7 @@ use super::{diverged, BlockSums, Model, BLOCK_CHUNK};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::ConstitutiveLaw;
 use crate::contact::{ContactWrench, DisplacementMode};
-use crate::integrate::{Integrator, StepRecord};
+use crate::integrate::{Integrator, StepDurations, StepRecord};
 use crate::math::{Matrix, Real, Vector};
 
 /// What the per-block stages read besides the block itself.
@@ -131,8 +130,8 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// `½(F_{n−1} + F_n)·v_{n−½}·Δt` (a force that did not exist before the first step counts as
     /// zero), which together with the kinetic energy `½·m·v_{n−½}·v_{n+½}` makes the balance an
     /// exact identity of central difference for translation. Sums are taken per chunk of
-    /// [`BLOCK_CHUNK`] blocks in block order, then over the chunks in order, whichever path
-    /// runs: the results do not depend on the thread count, nor on whether the stages are fused.
+    /// [`BLOCK_CHUNK`] blocks in block order, then over the chunks in order: the results do not
+    /// depend on the thread count.
     pub(super) fn advance_blocks(&mut self, kick: Real, drift: Real) -> Option<usize> {
         let pass = BlockPass {
             wrenches: &self.wrenches,
@@ -150,46 +149,26 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.block_sums
             .resize(self.blocks.len().div_ceil(BLOCK_CHUNK), BlockSums::default());
         let integrator: &dyn Integrator = &*self.integrator;
-        if integrator.is_blockwise() {
-            // Also the next step's first stage, while the blocks are in cache: their rotation
-            // matrices and movement check (`prepare_blocks`).
-            self.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
-            self.blocks
-                .par_chunks_mut(BLOCK_CHUNK)
-                .zip(self.forces.par_chunks_mut(BLOCK_CHUNK))
-                .zip(self.records.par_chunks_mut(BLOCK_CHUNK))
-                .zip(self.rotations.par_chunks_mut(BLOCK_CHUNK))
-                .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
-                .zip(self.block_sums.par_iter_mut())
-                .enumerate()
-                .for_each(|(k, (((((blocks, forces), records), rotations), refs), sums))| {
-                    let first_block = k * BLOCK_CHUNK;
-                    pass.gather(first_block, blocks, forces, records, sums);
-                    integrator.advance_variable(blocks, forces, kick, drift, records);
-                    pass.settle(first_block, blocks, records, sums);
-                    sums.moved = prepare_chunk(rotations, blocks, refs, pass.trigger);
-                });
-            self.scratch.prepared = Some(self.block_sums.iter().any(|s| s.moved));
-        } else {
-            let blocks = &self.blocks;
-            self.forces
-                .par_chunks_mut(BLOCK_CHUNK)
-                .zip(self.records.par_chunks(BLOCK_CHUNK))
-                .zip(self.block_sums.par_iter_mut())
-                .enumerate()
-                .for_each(|(k, ((forces, records), sums))| {
-                    let first_block = k * BLOCK_CHUNK;
-                    let end = (first_block + BLOCK_CHUNK).min(blocks.len());
-                    pass.gather(first_block, &blocks[first_block..end], forces, records, sums);
-                });
-            integrator.advance_variable(&mut self.blocks, &self.forces, kick, drift, &mut self.records);
-            self.blocks
-                .par_chunks(BLOCK_CHUNK)
-                .zip(self.records.par_chunks(BLOCK_CHUNK))
-                .zip(self.block_sums.par_iter_mut())
-                .enumerate()
-                .for_each(|(k, ((blocks, records), sums))| pass.settle(k * BLOCK_CHUNK, blocks, records, sums));
-        }
+        let step = StepDurations { kick, drift };
+        // Also the next step's first stage, while the blocks are in cache: their rotation
+        // matrices and movement check (`prepare_blocks`).
+        self.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        self.blocks
+            .par_chunks_mut(BLOCK_CHUNK)
+            .zip(self.forces.par_chunks_mut(BLOCK_CHUNK))
+            .zip(self.records.par_chunks_mut(BLOCK_CHUNK))
+            .zip(self.rotations.par_chunks_mut(BLOCK_CHUNK))
+            .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
+            .zip(self.block_sums.par_iter_mut())
+            .enumerate()
+            .for_each(|(k, (((((blocks, forces), records), rotations), refs), sums))| {
+                let first_block = k * BLOCK_CHUNK;
+                pass.gather(first_block, blocks, forces, records, sums);
+                integrator.advance_chunk(blocks, forces, step, records);
+                pass.settle(first_block, blocks, records, sums);
+                sums.moved = prepare_chunk(rotations, blocks, refs, pass.trigger);
+            });
+        self.scratch.prepared = Some(self.block_sums.iter().any(|s| s.moved));
         self.gather_block_sums()
     }
 
@@ -227,201 +206,5 @@ impl<L: ConstitutiveLaw> Model<L> {
             Real::INFINITY
         };
         first_diverged
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::block::RigidBlock;
-    use crate::integrate::{CentralDifference, Damping};
-    use crate::model::ModelParameters;
-
-    /// Central difference called once with all the blocks: the three separate passes.
-    #[derive(Debug, Clone, Copy)]
-    struct Separate(CentralDifference);
-
-    impl Integrator for Separate {
-        fn advance(&self, blocks: &mut [RigidBlock], forces: &[Wrench], dt: Real, records: &mut [StepRecord]) {
-            self.0.advance(blocks, forces, dt, records);
-        }
-        fn advance_variable(
-            &self,
-            blocks: &mut [RigidBlock],
-            forces: &[Wrench],
-            kick: Real,
-            drift: Real,
-            records: &mut [StepRecord],
-        ) {
-            self.0.advance_variable(blocks, forces, kick, drift, records);
-        }
-        fn damping(&self) -> crate::integrate::Damping {
-            self.0.damping()
-        }
-        fn boxed_clone(&self) -> Box<dyn Integrator> {
-            Box::new(*self)
-        }
-    }
-
-    fn toppling_column() -> Model {
-        crate::model::tests::toppling_column(ModelParameters::default())
-    }
-
-    /// What the comparisons below compare: every block state, the energies, the detection,
-    /// sub-contact and step counts, the step and the unbalanced-force ratio.
-    type Fingerprint = (
-        Vec<crate::block::BlockState>,
-        crate::model::Energies,
-        u64,
-        usize,
-        u64,
-        Real,
-        Real,
-    );
-
-    fn fingerprint(m: &Model) -> Fingerprint {
-        (
-            m.blocks().iter().map(|b| *b.state()).collect(),
-            m.energies(),
-            m.detection_count(),
-            m.subcontact_count(),
-            m.step_count(),
-            m.dt(),
-            m.unbalanced_ratio,
-        )
-    }
-
-    /// A fused and a separate-passes copy of a model.
-    fn pair(make: &dyn Fn() -> Model, damping: Damping) -> (Model, Model) {
-        let (mut fused, mut separate) = (make(), make());
-        fused
-            .set_integrator(CentralDifference::new(damping))
-            .expect("integrator");
-        separate
-            .set_integrator(Separate(CentralDifference::new(damping)))
-            .expect("integrator");
-        assert!(fused.integrator.is_blockwise() && !separate.integrator.is_blockwise());
-        (fused, separate)
-    }
-
-    /// Steps both `n` times, comparing after every step; a step may fail, alike in both.
-    fn step_both(fused: &mut Model, separate: &mut Model, n: usize, what: &str) {
-        for k in 0..n {
-            assert_eq!(fused.step().is_ok(), separate.step().is_ok(), "{what}, step {k}");
-            assert_eq!(fingerprint(fused), fingerprint(separate), "{what}, step {k}");
-        }
-    }
-
-    /// The benchmark wall of 1,200 blocks (three chunks) under gravity tilted by 40° sideways:
-    /// blocks slide and topple all along the wall, beyond the re-detection trigger.
-    fn tilted_wall() -> Model {
-        let mut wall = crate::model::benchmark_wall(1200).expect("wall");
-        let t: Real = 40.0_f64.to_radians();
-        let params = ModelParameters {
-            gravity: Vector::new(0.0, t.sin(), -t.cos()) * 9.81,
-            ..*wall.parameters()
-        };
-        wall.set_parameters(params).expect("params");
-        assert!(wall.blocks().len() > 2 * BLOCK_CHUNK);
-        wall
-    }
-
-    /// The fused block pass (gather, integrator, energy and the next step's movement check
-    /// chunk by chunk) and the separate passes give bit-identical states, energies, detection
-    /// and sub-contact counts after every step: on a toppling column (re-detection triggered by
-    /// the fused pass's movement check) with local and Rayleigh damping, and on a tilted wall of
-    /// three chunks, where some re-detections are triggered by blocks of the later chunks only.
-    #[test]
-    fn fused_and_separate_block_passes_agree() {
-        for damping in [
-            Damping::Local { alpha: 0.1 },
-            Damping::Rayleigh {
-                mass: 5.0,
-                stiffness: 0.0,
-            },
-        ] {
-            let (mut fused, mut separate) = pair(&toppling_column, damping);
-            step_both(&mut fused, &mut separate, 1500, &format!("column, {damping:?}"));
-            assert!(
-                fused.detection_count() > 5,
-                "{damping:?}: {} detections",
-                fused.detection_count()
-            );
-        }
-        let (mut fused, mut separate) = pair(&tilted_wall, Damping::Local { alpha: 0.8 });
-        let mut later_chunks_only = 0;
-        for k in 0..300 {
-            step_both(&mut fused, &mut separate, 1, &format!("wall, step {k}"));
-            assert!(
-                fused.scratch.prepared.is_some(),
-                "the fused pass prepares the next step"
-            );
-            if fused.scratch.prepared == Some(true) && !fused.block_sums[0].moved {
-                later_chunks_only += 1;
-            }
-        }
-        assert!(
-            fused.detection_count() > 3 && later_chunks_only > 0,
-            "{} detections, {later_chunks_only} triggered by later chunks only",
-            fused.detection_count()
-        );
-    }
-
-    /// The fused pass over several chunks gives the same bits with one, two and three threads.
-    #[test]
-    fn fused_pass_is_independent_of_the_thread_count() {
-        let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().expect("pool");
-        let run = || {
-            let mut m = tilted_wall();
-            m.run_steps(300).expect("run");
-            fingerprint(&m)
-        };
-        let (one, two, three) = (pool(1).install(run), pool(2).install(run), pool(3).install(run));
-        assert!(one.2 > 2, "{} detections", one.2);
-        assert_eq!(one, two);
-        assert_eq!(one, three);
-    }
-
-    /// Changes between steps — switching the integrator both ways, adding a block, new
-    /// parameters, a checkpoint round trip, a divergence and recovery — keep the fused path
-    /// bit-identical to the separate passes (none may leave stale rotation matrices or a stale
-    /// movement check behind).
-    #[test]
-    fn changes_between_steps_keep_fused_and_separate_identical() {
-        let cd = CentralDifference::new(Damping::Local { alpha: 0.1 });
-        let (mut fused, mut separate) = pair(&toppling_column, cd.damping);
-        step_both(&mut fused, &mut separate, 200, "start");
-        // (Setting an integrator re-evaluates the step: set one on both.)
-        fused.set_integrator(Separate(cd)).expect("integrator");
-        separate.set_integrator(Separate(cd)).expect("integrator");
-        step_both(&mut fused, &mut separate, 50, "switched to separate");
-        fused.set_integrator(cd).expect("integrator");
-        separate.set_integrator(Separate(cd)).expect("integrator");
-        step_both(&mut fused, &mut separate, 50, "switched back");
-        for m in [&mut fused, &mut separate] {
-            let cube = RigidBlock::cuboid("new", Vector::new(0.5, 0.5, 0.0), Vector::new(0.6, 0.6, 0.1), 2500.0)
-                .expect("cube");
-            m.add_block(cube).expect("add");
-        }
-        step_both(&mut fused, &mut separate, 100, "add_block");
-        for m in [&mut fused, &mut separate] {
-            let mut p = *m.parameters();
-            p.contact.redetect_fraction = 0.05;
-            m.set_parameters(p).expect("parameters");
-        }
-        step_both(&mut fused, &mut separate, 100, "set_parameters");
-        fused = Model::from_checkpoint_str(&fused.to_checkpoint_string().expect("save")).expect("load");
-        separate = Model::from_checkpoint_str(&separate.to_checkpoint_string().expect("save")).expect("load");
-        fused.set_integrator(cd).expect("integrator");
-        separate.set_integrator(Separate(cd)).expect("integrator");
-        step_both(&mut fused, &mut separate, 100, "checkpoint");
-        for m in [&mut fused, &mut separate] {
-            let id = crate::block::BlockId(2);
-            m.set_velocity(id, Vector::new(2e3, 0.0, 0.0), Vector::ZERO)
-                .expect("velocity");
-            assert!(matches!(m.step(), Err(crate::Error::Diverged { .. })));
-            m.set_velocity(id, Vector::ZERO, Vector::ZERO).expect("velocity");
-        }
-        step_both(&mut fused, &mut separate, 100, "after divergence");
     }
 }

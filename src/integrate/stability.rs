@@ -1,0 +1,234 @@
+//! The stability limit of central difference on contact springs: each block's bound of its
+//! squared natural frequency, assembled from the stiffness of its joints (block Gershgorin), and
+//! the bound of a block in free flight. The integrator turns the bounds into its critical step
+//! ([`super::Integrator::critical_step`]).
+
+use super::{Stiffness6, StiffnessBound};
+use crate::block::{Block, RigidBlock};
+use crate::constitutive::JointStiffness;
+use crate::math::{Real, Rotation, Vector};
+
+/// What the stability bound needs of one contact: its blocks, normal, spring stiffness and the
+/// area moments of its sub-contact points about `origin` (world).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ContactStiffness {
+    pub a: usize,
+    pub b: usize,
+    pub normal: Vector,
+    pub stiffness: JointStiffness,
+    pub origin: Vector,
+    pub moments: AreaMoments,
+}
+
+/// Fills `bounds` (one per block): for a block in contact, the block Gershgorin bound
+/// `λ ≤ λ_max(A_bb) + Σ_c √(λ_b λ_c)` of its mass-normalised contact stiffness; for a block
+/// in free flight, that of a contact of stiffness `k_max` (`kn + 2 ks`, the stiffest law's) over
+/// its largest face, so that its step is sensible when it lands (the landing contact is detected
+/// before it loads, and the step is then re-evaluated from the real contacts); zero for a block
+/// whose every degree of freedom is prescribed.
+pub(crate) fn block_bounds(
+    blocks: &[RigidBlock],
+    contacts: &[ContactStiffness],
+    k_max: Real,
+    bounds: &mut [StiffnessBound],
+) {
+    // Mass scaling of each movable block: translations by 1/√m, rotations by R I^{-1/2} Rᵀ.
+    let scaling: Vec<Option<(Real, Rotation, Vector)>> = blocks
+        .iter()
+        .map(|b| {
+            (!all_constrained(b)).then(|| {
+                let mp = b.mass_properties();
+                (
+                    1.0 / mp.mass.sqrt(),
+                    b.state.pose.rotation,
+                    Vector::ONE / mp.principal_inertia.map(Real::sqrt),
+                )
+            })
+        })
+        .collect();
+    let n = blocks.len();
+    let mut own = vec![Stiffness6::default(); n];
+    let mut coupling = vec![0.0; n];
+    let mut in_contact = vec![false; n];
+    for c in contacts {
+        let k = c.stiffness;
+        let side = |i: usize| -> Option<Stiffness6> {
+            let (inv_sqrt_m, rot, inv_sqrt_i) = scaling[i]?;
+            let centre = blocks[i].state.pose.translation - c.origin;
+            Some(
+                c.moments
+                    .stiffness(centre, c.normal, k.normal, k.shear, inv_sqrt_m, rot, inv_sqrt_i),
+            )
+        };
+        let (a, b) = (c.a, c.b);
+        let (ka, kb) = (side(a), side(b));
+        let la = ka.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
+        let lb = kb.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
+        if let Some(m) = ka {
+            own[a].add(&m);
+        }
+        if let Some(m) = kb {
+            own[b].add(&m);
+        }
+        coupling[a] += (la * lb).sqrt();
+        coupling[b] += (la * lb).sqrt();
+        in_contact[a] = true;
+        in_contact[b] = true;
+    }
+    for (i, b) in blocks.iter().enumerate() {
+        bounds[i].omega_squared = if all_constrained(b) {
+            0.0
+        } else if in_contact[i] {
+            // Block Gershgorin: λ ≤ λ_max(A_bb) + Σ_c ‖A_bc‖, ‖A_bc‖ ≤ √(λ_b λ_c) per contact.
+            own[i].max_eigenvalue() + coupling[i]
+        } else {
+            let mp = b.mass_properties();
+            let face = b.shape().faces().iter().map(|f| f.area).fold(0.0, Real::max);
+            k_max * face * (1.0 / mp.mass + b.shape().radius().powi(2) / mp.principal_inertia.min_element())
+        };
+    }
+}
+
+fn all_constrained(b: &RigidBlock) -> bool {
+    let f = b.fixity();
+    f.translation
+        .iter()
+        .chain(&f.rotation)
+        .all(|d| d.prescribed().is_some())
+}
+
+/// Zeroth, first and second area moments of a contact's sub-contact points: enough to assemble
+/// the contact's 6×6 stiffness on either block exactly, since all its springs share `kn`, `ks`
+/// and the normal.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AreaMoments {
+    s0: Real,
+    s1: Vector,
+    s2: crate::math::Matrix,
+}
+
+impl Default for AreaMoments {
+    /// All zero (note: glam's `DMat3::default()` is the identity).
+    fn default() -> Self {
+        Self {
+            s0: 0.0,
+            s1: Vector::ZERO,
+            s2: crate::math::Matrix::ZERO,
+        }
+    }
+}
+
+impl AreaMoments {
+    pub(crate) fn add(&mut self, p: Vector, area: Real) {
+        self.s0 += area;
+        self.s1 += p * area;
+        self.s2 += crate::math::Matrix::from_cols(p * (p.x * area), p * (p.y * area), p * (p.z * area));
+    }
+
+    /// `M^{-1/2} K M^{-1/2}` of the contact's springs acting on a block with centroid `x`:
+    /// with `C = ks·I + (kn − ks)·n nᵀ` per unit area and `r = p − x`,
+    /// `K = Σ A [C, C[r]ᵀ; [r]C, [r] C [r]ᵀ]` (`[r]` the cross-product matrix).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn stiffness(
+        &self,
+        x: Vector,
+        n: Vector,
+        kn: Real,
+        ks: Real,
+        inv_sqrt_m: Real,
+        rot: Rotation,
+        inv_sqrt_i: Vector,
+    ) -> Stiffness6 {
+        use crate::math::Matrix;
+        let c = Matrix::from_diagonal(Vector::splat(ks)) + outer(n, n) * (kn - ks);
+        // Moments about the centroid.
+        let a0 = self.s0;
+        let a1 = self.s1 - x * a0;
+        let a2 = self.s2 - outer(self.s1, x) - outer(x, self.s1) + outer(x, x) * a0;
+        let cross = |v: Vector| {
+            Matrix::from_cols(
+                Vector::new(0.0, v.z, -v.y),
+                Vector::new(-v.z, 0.0, v.x),
+                Vector::new(v.y, -v.x, 0.0),
+            )
+        };
+        let k_tt = c * a0;
+        // Σ A [r] C = [a1] C (linear in r).
+        let k_rt = cross(a1) * c;
+        // Σ A [r] C [r]ᵀ: with [r] = Σ_i r_i E_i, it is Σ_ij (A r_i r_j) E_i C E_jᵀ.
+        let e = [cross(Vector::X), cross(Vector::Y), cross(Vector::Z)];
+        let mut k_rr = Matrix::ZERO;
+        for (i, ei) in e.iter().enumerate() {
+            for (j, ej) in e.iter().enumerate() {
+                k_rr += (*ei * c * ej.transpose()) * a2.col(j)[i];
+            }
+        }
+        // Scale: translations by 1/√m, rotations by S = R diag(I^{-1/2}) Rᵀ.
+        let r = Matrix::from_quat(rot);
+        let s = r * Matrix::from_diagonal(inv_sqrt_i) * r.transpose();
+        let m2 = inv_sqrt_m * inv_sqrt_m;
+        let tt = k_tt * m2;
+        let rt = s * k_rt * inv_sqrt_m;
+        let rr = s * k_rr * s;
+        let mut out = Stiffness6::default();
+        for i in 0..3 {
+            for j in 0..3 {
+                out.0[i][j] = tt.col(j)[i];
+                out.0[3 + i][j] = rt.col(j)[i];
+                out.0[j][3 + i] = rt.col(j)[i];
+                out.0[3 + i][3 + j] = rr.col(j)[i];
+            }
+        }
+        out
+    }
+}
+
+fn outer(a: Vector, b: Vector) -> crate::math::Matrix {
+    crate::math::Matrix::from_cols(a * b.x, a * b.y, a * b.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Rotation;
+
+    /// The moment-based assembly equals the sum of rank-one spring terms.
+    #[test]
+    fn area_moments_assemble_the_spring_stiffness() {
+        let n = Vector::new(0.3, -0.2, 0.9).normalize();
+        let (kn, ks) = (4e9, 1.6e9);
+        let rot = Rotation::from_scaled_axis(Vector::new(0.2, -0.4, 0.7));
+        let (inv_sqrt_m, inv_sqrt_i) = (1.0 / 3.0, Vector::new(2.0, 3.0, 5.0));
+        let x = Vector::new(0.1, 0.5, -0.2);
+        let pts = [
+            (Vector::new(0.3, 0.1, 0.4), 0.01),
+            (Vector::new(-0.2, 0.3, 0.1), 0.02),
+            (Vector::new(0.05, -0.3, 0.2), 0.005),
+        ];
+        let mut m = AreaMoments::default();
+        let mut direct = Stiffness6::default();
+        let (t1, t2) = crate::math::plane_basis(n);
+        let s = crate::math::Matrix::from_quat(rot)
+            * crate::math::Matrix::from_diagonal(inv_sqrt_i)
+            * crate::math::Matrix::from_quat(rot).transpose();
+        for (p, a) in pts {
+            m.add(p, a);
+            for (d, k) in [(n, kn), (t1, ks), (t2, ks)] {
+                let t = d * inv_sqrt_m;
+                let w = s * (p - x).cross(d);
+                direct.add_spring(&[t.x, t.y, t.z, w.x, w.y, w.z], k * a);
+            }
+        }
+        let assembled = m.stiffness(x, n, kn, ks, inv_sqrt_m, rot, inv_sqrt_i);
+        for i in 0..6 {
+            for j in 0..6 {
+                let (u, v) = (assembled.0[i][j], direct.0[i][j]);
+                assert!(
+                    (u - v).abs() <= 1e-9 * direct.0[i][i].abs().max(1.0),
+                    "({i},{j}): {u} vs {v}"
+                );
+            }
+        }
+        assert!((assembled.max_eigenvalue() - direct.max_eigenvalue()).abs() < 1e-6 * direct.max_eigenvalue());
+    }
+}
