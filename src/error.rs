@@ -167,3 +167,11 @@ pub(crate) fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'
         })
     }
 }
+
+/// [`Error::Io`] naming the file.
+pub(crate) fn io_error(path: &std::path::Path, e: &std::io::Error) -> Error {
+    Error::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}

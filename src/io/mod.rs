@@ -12,12 +12,7 @@ use std::path::Path;
 
 use crate::error::Error;
 
-pub(crate) fn io_error(path: &Path, e: &std::io::Error) -> Error {
-    Error::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    }
-}
+pub(crate) use crate::error::io_error;
 
 /// Writes any serialisable value as pretty JSON (for example an example's `summary.json`),
 /// creating the folder. Non-finite numbers become `null`.

@@ -13,10 +13,9 @@ use crate::constitutive::{JointForce, JointStatus};
 use crate::contact::{
     AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
 };
-use crate::error::{Error, Result};
+use crate::error::{io_error, Error, Result};
 use crate::geometry::{ContactKind, SubKey};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
-use crate::io::io_error;
 use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
 use crate::model::Energies;
 use crate::monitor::{History, Monitor};
