@@ -46,7 +46,7 @@
 //! | [`constitutive`] | the [`ConstitutiveLaw`] trait and the shipped laws |
 //! | [`integrate`] | the [`Integrator`] trait, central difference, damping, critical step |
 //! | [`model`] | the [`Model`]: stepping, runs, energies |
-//! | [`monitor`] | monitors and histories |
+//! | [`monitor`] | observation: the [`monitor::Probe`] trait, built-in monitors, the recorder and histories |
 //! | [`build`] | generators (walls, stacks) |
 //! | [`io`] | ParaView series, CSV histories, plots, scenes |
 //! | [`analysis`] | joint states and collapse mechanisms |
@@ -92,8 +92,8 @@ pub mod prelude {
     pub use crate::geometry::{ContactParameters, SubcontactDensity};
     pub use crate::integrate::{CentralDifference, Damping, Integrator, TimeStep};
     pub use crate::math::{Pose, Real, Rotation, Vector};
-    pub use crate::model::{Energies, Model, ModelParameters};
-    pub use crate::monitor::{Component, EnergyTerm, Monitor, MonitorId};
+    pub use crate::model::{Energies, Model, ModelParameters, Observer};
+    pub use crate::monitor::{Component, EnergyTerm, Monitor, MonitorId, Probe, Recorder};
 }
 
 /// The README's usage example, compiled and run as a doc-test.

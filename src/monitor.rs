@@ -1,5 +1,34 @@
-//! Monitors and their histories: displacements, velocities, reactions, contact forces, energies
-//! and the unbalanced-force ratio.
+//! Observation that users can extend: the [`Probe`] trait (one quantity sampled from a model),
+//! the built-in probes ([`Monitor`]: displacements, velocities, reactions, contact forces,
+//! energies, the unbalanced-force ratio), and the [`Recorder`] that samples probes into a
+//! [`History`] while a run goes, as the run's [`Observer`].
+//!
+//! ```
+//! use voussoir::monitor::{Probe, Recorder};
+//! use voussoir::prelude::*;
+//!
+//! /// The height of a block's centroid: a probe of one's own.
+//! struct Height(BlockId);
+//! impl<L: ConstitutiveLaw> Probe<L> for Height {
+//!     fn unit(&self) -> &str {
+//!         "m"
+//!     }
+//!     fn value(&self, model: &Model<L>) -> f64 {
+//!         model.blocks()[self.0.index()].state().pose.translation.z
+//!     }
+//! }
+//!
+//! let mut model: Model = Model::new(ModelParameters::default())?;
+//! let stone = model.add_block(RigidBlock::cuboid("stone", Vector::ZERO, Vector::splat(0.1), 2500.0)?)?;
+//! let mut recorder = Recorder::new(10); // every tenth step
+//! recorder.add_monitor(&model, "kinetic", Monitor::Energy(EnergyTerm::Kinetic))?;
+//! recorder.add_probe("height", Height(stone));
+//! model.run_steps_observed(100, &mut recorder)?;
+//! let history = recorder.history();
+//! assert_eq!(history.len(), 10);
+//! assert!(history.column(MonitorId(1))[9] < 0.05); // it fell
+//! # Ok::<(), voussoir::Error>(())
+//! ```
 
 use serde::{Deserialize, Serialize};
 
@@ -7,9 +36,10 @@ pub use crate::ids::MonitorId;
 
 use crate::block::Block;
 use crate::constitutive::ConstitutiveLaw;
+use crate::error::Result;
 use crate::ids::BlockId;
 use crate::math::{Real, Vector};
-use crate::model::Model;
+use crate::model::{Model, Observer};
 
 /// Component of a vector quantity.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -92,8 +122,9 @@ pub enum Monitor {
         component: Component,
     },
     /// Resultant force (N) of the joint between two blocks, on the second one (zero when they
-    /// are not in contact).
-    JointForce {
+    /// are not in contact). Scene files written before the rename say `JointForce`.
+    #[serde(alias = "JointForce")]
+    JointResultant {
         /// First block.
         a: BlockId,
         /// Second block: the force is the one acting on it.
@@ -114,7 +145,7 @@ impl Monitor {
             | Monitor::Velocity { block, .. }
             | Monitor::Reaction { block, .. }
             | Monitor::ContactForce { block, .. } => vec![block],
-            Monitor::JointForce { a, b, .. } => vec![a, b],
+            Monitor::JointResultant { a, b, .. } => vec![a, b],
             _ => Vec::new(),
         }
     }
@@ -124,7 +155,7 @@ impl Monitor {
         match self {
             Monitor::Displacement { .. } => "m",
             Monitor::Velocity { .. } => "m/s",
-            Monitor::Reaction { .. } | Monitor::ContactForce { .. } | Monitor::JointForce { .. } => "N",
+            Monitor::Reaction { .. } | Monitor::ContactForce { .. } | Monitor::JointResultant { .. } => "N",
             Monitor::Energy(_) => "J",
             Monitor::UnbalancedRatio => "-",
         }
@@ -154,7 +185,7 @@ impl Monitor {
             Monitor::ContactForce { block: id, component } => {
                 component.of(model.contact_wrench(id).map(|w| w.force).unwrap_or_default())
             }
-            Monitor::JointForce { a, b, component } => {
+            Monitor::JointResultant { a, b, component } => {
                 let f = model.contact_between(a, b).map(|c| c.resultant()).unwrap_or_default();
                 // The stored resultant acts on the higher-numbered block.
                 component.of(if b.0 > a.0 { f } else { -f })
@@ -177,6 +208,140 @@ impl Monitor {
             }
             Monitor::UnbalancedRatio => model.unbalanced_force_ratio(),
         }
+    }
+}
+
+/// One quantity sampled from a model: what a [`Recorder`] column holds. The built-in
+/// [`Monitor`]s are probes; implement it for quantities of your own.
+pub trait Probe<L: ConstitutiveLaw> {
+    /// SI unit of the quantity (for the history's header).
+    fn unit(&self) -> &str;
+    /// The quantity in the model's current state.
+    fn value(&self, model: &Model<L>) -> Real;
+}
+
+impl<L: ConstitutiveLaw> Probe<L> for Monitor {
+    fn unit(&self) -> &str {
+        Monitor::unit(self)
+    }
+    fn value(&self, model: &Model<L>) -> Real {
+        self.evaluate(model)
+    }
+}
+
+/// A column of a [`Recorder`]: a built-in monitor (which scene files can store) or a probe of
+/// the user's.
+enum Column<L> {
+    Monitor(Monitor),
+    Probe(Box<dyn Probe<L>>),
+}
+
+/// Samples probes into a [`History`] every `interval` steps of the runs it observes
+/// ([`Model::run_steps_observed`], [`Model::run_observed`]), or when asked
+/// ([`Recorder::record`]).
+pub struct Recorder<L: ConstitutiveLaw> {
+    columns: Vec<(String, Column<L>)>,
+    interval: u64,
+    history: History,
+}
+
+impl<L: ConstitutiveLaw> std::fmt::Debug for Recorder<L> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Recorder")
+            .field("columns", &self.history.names())
+            .field("interval", &self.interval)
+            .field("samples", &self.history.len())
+            .finish()
+    }
+}
+
+impl<L: ConstitutiveLaw> Recorder<L> {
+    /// A recorder that samples every `interval` steps (at least 1).
+    pub fn new(interval: u64) -> Self {
+        Self {
+            columns: Vec::new(),
+            interval: interval.max(1),
+            history: History::default(),
+        }
+    }
+
+    /// Adds a built-in monitor as the next column.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`] if the monitor refers to a block `model` does not have.
+    pub fn add_monitor(&mut self, model: &Model<L>, name: &str, monitor: Monitor) -> Result<MonitorId> {
+        for id in monitor.blocks() {
+            model.block(id)?;
+        }
+        Ok(self.push(name, Column::Monitor(monitor)))
+    }
+
+    /// Adds a probe of one's own as the next column.
+    pub fn add_probe(&mut self, name: &str, probe: impl Probe<L> + 'static) -> MonitorId {
+        self.push(name, Column::Probe(Box::new(probe)))
+    }
+
+    fn push(&mut self, name: &str, column: Column<L>) -> MonitorId {
+        let id = MonitorId(self.columns.len() as u32);
+        let unit = match &column {
+            Column::Monitor(m) => m.unit().to_owned(),
+            Column::Probe(p) => p.unit().to_owned(),
+        };
+        self.history.add_column(name, unit);
+        self.columns.push((name.to_owned(), column));
+        id
+    }
+
+    /// Steps between samples.
+    pub fn interval(&self) -> u64 {
+        self.interval
+    }
+
+    /// Samples every column now.
+    pub fn record(&mut self, model: &Model<L>) {
+        let columns = &self.columns;
+        self.history.push(
+            model.step_count(),
+            model.time(),
+            columns.iter().map(|(_, c)| match c {
+                Column::Monitor(m) => m.evaluate(model),
+                Column::Probe(p) => p.value(model),
+            }),
+        );
+    }
+
+    /// The built-in monitors with their names, in column order (probes of one's own left out).
+    pub fn monitors(&self) -> impl Iterator<Item = (&str, &Monitor)> + '_ {
+        self.columns.iter().filter_map(|(n, c)| match c {
+            Column::Monitor(m) => Some((n.as_str(), m)),
+            Column::Probe(_) => None,
+        })
+    }
+
+    /// The samples so far.
+    pub fn history(&self) -> &History {
+        &self.history
+    }
+
+    /// Takes the samples so far, leaving the columns with no rows.
+    pub fn take_history(&mut self) -> History {
+        let empty = History {
+            names: self.history.names.clone(),
+            units: self.history.units.clone(),
+            columns: vec![Vec::new(); self.history.names.len()],
+            ..History::default()
+        };
+        std::mem::replace(&mut self.history, empty)
+    }
+}
+
+impl<L: ConstitutiveLaw> Observer<L> for Recorder<L> {
+    /// Samples after every `interval`-th step of the model.
+    fn after_step(&mut self, model: &Model<L>) -> Result<std::ops::ControlFlow<()>> {
+        if model.step_count().is_multiple_of(self.interval) {
+            self.record(model);
+        }
+        Ok(std::ops::ControlFlow::Continue(()))
     }
 }
 
@@ -212,9 +377,9 @@ mod nullable_columns {
 }
 
 impl History {
-    pub(crate) fn add_column(&mut self, name: &str, unit: &'static str) {
+    pub(crate) fn add_column(&mut self, name: &str, unit: String) {
         self.names.push(name.to_owned());
-        self.units.push(unit.to_owned());
+        self.units.push(unit);
         // A column added late is padded with NaN for the samples it missed.
         self.columns.push(vec![Real::NAN; self.steps.len()]);
     }

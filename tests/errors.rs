@@ -466,7 +466,11 @@ fn unknown_block_id() {
         block: BlockId(99),
         component: Component::Z,
     };
-    check(model.add_monitor("ghost", monitor).unwrap_err());
+    check(
+        voussoir::monitor::Recorder::new(1)
+            .add_monitor(&model, "ghost", monitor)
+            .unwrap_err(),
+    );
     // The model is intact and runs.
     model.run_steps(5).unwrap();
     assert_eq!(model.blocks().len(), 2);

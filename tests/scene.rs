@@ -12,8 +12,11 @@ fn example() -> Result<Scene<CoulombSlip>> {
 
 #[test]
 fn documented_example_builds_and_reaches_equilibrium() -> Result<()> {
-    let mut model = example()?.build()?;
+    let scene = example()?;
+    let mut model = scene.build()?;
+    let mut recorder = scene.recorder(&model)?;
     assert_eq!(model.blocks().len(), 2);
+    model.run_steps_observed(100, &mut recorder)?;
     model.run_to_equilibrium(1e-6, 50_000)?;
     // The 50 N push is below μW = tan 30.5° × 2446.5 × 0.008 × 9.81 = 113 N: the stone sticks,
     // and the support carries its weight.
@@ -24,15 +27,20 @@ fn documented_example_builds_and_reaches_equilibrium() -> Result<()> {
         (support - weight).abs() < 1e-4 * weight,
         "support {support} vs weight {weight}"
     );
-    assert_eq!(model.history().names(), ["stone x", "support z"]);
+    assert_eq!(recorder.history().names(), ["stone x", "support z"]);
+    assert_eq!(recorder.history().len(), 100 / recorder.interval() as usize);
     Ok(())
 }
 
 #[test]
 fn model_round_trips_through_a_scene() -> Result<()> {
-    let model = example()?.build()?;
-    let text = Scene::from_model(&model).to_json()?;
-    let again = Scene::<CoulombSlip>::from_json(&text)?.build()?;
+    let scene = example()?;
+    let model = scene.build()?;
+    let recorder = scene.recorder(&model)?;
+    let text = Scene::from_model(&model).with_recorder(&recorder).to_json()?;
+    let scene_again = Scene::<CoulombSlip>::from_json(&text)?;
+    let again = scene_again.build()?;
+    let recorder_again = scene_again.recorder(&again)?;
     for (a, b) in model.blocks().iter().zip(again.blocks()) {
         assert_eq!(a.name(), b.name());
         assert!((a.mass_properties().mass - b.mass_properties().mass).abs() < 1e-12 * a.mass_properties().mass);
@@ -41,7 +49,8 @@ fn model_round_trips_through_a_scene() -> Result<()> {
         assert_eq!(a.load(), b.load());
     }
     assert_eq!(model.joints().laws(), again.joints().laws());
-    assert_eq!(model.monitors(), again.monitors());
+    assert!(recorder.monitors().eq(recorder_again.monitors()));
+    assert_eq!(recorder.interval(), recorder_again.interval());
     Ok(())
 }
 
@@ -79,8 +88,9 @@ fn bad_fields_are_reported_with_their_path() -> Result<()> {
     for (from, to, expected) in cases {
         let bad = text.replacen(from, to, 1);
         assert_ne!(bad, text, "test case {from:?} does not apply");
+        // The model and its recorder (whose monitors name blocks of the model).
         let err = Scene::<CoulombSlip>::from_json(&bad)
-            .and_then(|s| s.build())
+            .and_then(|s| s.build().and_then(|m| s.recorder(&m)))
             .expect_err(expected);
         assert!(err.to_string().contains(expected), "{expected:?} not in {err}");
     }

@@ -15,9 +15,10 @@ use crate::monitor::History;
 /// let mut model: Model = Model::new(ModelParameters::default())?;
 /// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
 /// model.add_block(RigidBlock::cuboid("b", Vector::ZERO, Vector::splat(0.1), 2000.0)?)?;
-/// model.add_monitor("kinetic", Monitor::Energy(EnergyTerm::Kinetic))?;
-/// model.run_steps(3)?;
-/// let csv = voussoir::io::csv::history_to_csv(model.history());
+/// let mut recorder = voussoir::monitor::Recorder::new(1);
+/// recorder.add_monitor(&model, "kinetic", Monitor::Energy(EnergyTerm::Kinetic))?;
+/// model.run_steps_observed(3, &mut recorder)?;
+/// let csv = voussoir::io::csv::history_to_csv(recorder.history());
 /// assert!(csv.starts_with("time [s],step,kinetic [J]\n"));
 /// assert_eq!(csv.lines().count(), 4);
 /// # Ok::<(), voussoir::Error>(())

@@ -15,7 +15,7 @@ use crate::integrate::Damping;
 use crate::io::io_error;
 use crate::math::Vector;
 use crate::model::{Model, ModelParameters};
-use crate::monitor::Monitor;
+use crate::monitor::{Monitor, Recorder};
 
 /// A block as written in a scene: world vertices (convex hull) or vertices and faces.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -141,7 +141,8 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
         std::fs::write(path, text).map_err(|e| io_error(path, &e))
     }
 
-    /// The definition of a model in its current pose (velocities and loads included).
+    /// The definition of a model in its current pose (velocities and loads included), without
+    /// monitors (see [`Scene::with_recorder`]).
     pub fn from_model(model: &Model<L>) -> Self {
         let blocks = model
             .blocks()
@@ -182,19 +183,44 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                 })
                 .collect(),
             blocks,
-            monitors: model
-                .monitors()
-                .iter()
-                .map(|(name, m)| MonitorSpec {
-                    name: name.clone(),
-                    monitor: *m,
-                })
-                .collect(),
-            monitor_interval: model.monitor_interval(),
+            monitors: Vec::new(),
+            monitor_interval: 1,
         }
     }
 
-    /// Builds the model, validating everything; errors name the path of the bad entry.
+    /// This scene with the built-in monitors of `recorder` and its interval (probes of one's
+    /// own cannot be written to a file and are left out).
+    pub fn with_recorder(mut self, recorder: &Recorder<L>) -> Self {
+        self.monitors = recorder
+            .monitors()
+            .map(|(name, m)| MonitorSpec {
+                name: name.to_owned(),
+                monitor: *m,
+            })
+            .collect();
+        self.monitor_interval = recorder.interval();
+        self
+    }
+
+    /// A recorder of the scene's monitors for `model` (built by [`Scene::build`]).
+    ///
+    /// # Errors
+    /// [`Error::Checkpoint`] with the path (`monitors[k]`) of a monitor naming a missing block.
+    pub fn recorder(&self, model: &Model<L>) -> Result<Recorder<L>> {
+        let mut recorder = Recorder::new(self.monitor_interval);
+        for (k, m) in self.monitors.iter().enumerate() {
+            recorder
+                .add_monitor(model, &m.name, m.monitor)
+                .map_err(|e| Error::Checkpoint {
+                    path: format!("monitors[{k}]"),
+                    message: e.to_string(),
+                })?;
+        }
+        Ok(recorder)
+    }
+
+    /// Builds the model, validating everything but the monitors (see [`Scene::recorder`]);
+    /// errors name the path of the bad entry.
     ///
     /// # Errors
     /// [`Error::Checkpoint`] with the path (for example `blocks[3]`) and the underlying error.
@@ -226,12 +252,6 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
             let id = model.add_block(block).map_err(at(path.clone()))?;
             model.set_load(id, b.load).map_err(at(path))?;
         }
-        for (k, m) in self.monitors.iter().enumerate() {
-            model
-                .add_monitor(&m.name, m.monitor)
-                .map_err(at(format!("monitors[{k}]")))?;
-        }
-        model.set_monitor_interval(self.monitor_interval);
         Ok(model)
     }
 }

@@ -1,5 +1,6 @@
 //! Checkpoint and restart: the full state of a model (blocks, contacts, sub-contact history, law
-//! state, energies, monitors) as JSON, restored so that the run continues bit-identically.
+//! state, energies) as JSON, restored so that the run continues bit-identically. Recorders are
+//! the caller's: their [`crate::monitor::History`] serialises on its own.
 
 use std::path::Path;
 
@@ -18,7 +19,6 @@ use crate::geometry::{ContactKind, SubKey};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
 use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
 use crate::model::Energies;
-use crate::monitor::{History, Monitor};
 
 const FORMAT: &str = "voussoir-checkpoint";
 /// Version 9 stores joints through [`JointEntry`], apart from the step's storage layout, so
@@ -55,9 +55,6 @@ struct Snapshot<L: ConstitutiveLaw> {
     started: bool,
     unbalanced_ratio: Option<Real>,
     detections: u64,
-    monitors: Vec<(String, Monitor)>,
-    history: History,
-    monitor_interval: u64,
     /// Last step's reaction and damping wrench per block: the energy bookkeeping books each of
     /// them half in the next step.
     #[serde(default)]
@@ -273,9 +270,6 @@ where
             started: self.started,
             unbalanced_ratio: self.unbalanced_ratio.is_finite().then_some(self.unbalanced_ratio),
             detections: self.detections,
-            monitors: self.monitors.clone(),
-            history: self.history.clone(),
-            monitor_interval: self.monitor_interval,
             last_forces: self.records.iter().map(|r| (r.reaction, r.damping)).collect(),
             drift: self.drift,
             refine_until: self.refine_until,
@@ -403,11 +397,6 @@ where
                 "negative area",
             ));
         }
-        for (name, m) in &snap.monitors {
-            if m.blocks().iter().any(|b| b.index() >= n) {
-                return Err(corrupt(&format!("monitors.{name}"), "refers to a missing block"));
-            }
-        }
         let mut model = Model::new(snap.params)?;
         for (i, mut b) in snap.blocks.into_iter().enumerate() {
             b.restore()
@@ -456,9 +445,6 @@ where
         model.started = snap.started;
         model.unbalanced_ratio = snap.unbalanced_ratio.unwrap_or(Real::INFINITY);
         model.detections = snap.detections;
-        model.monitors = snap.monitors;
-        model.history = snap.history;
-        model.monitor_interval = snap.monitor_interval.max(1);
         for (r, &(reaction, damping)) in model.records.iter_mut().zip(&snap.last_forces) {
             r.reaction = reaction;
             r.damping = damping;

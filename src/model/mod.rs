@@ -7,6 +7,7 @@ mod contact_pass;
 mod detection;
 mod energy;
 mod motion;
+mod observe;
 mod time_step;
 
 use rayon::prelude::*;
@@ -14,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 pub use benchmark::{benchmark_wall, benchmark_wall_with_spacing, BENCHMARK_SPACING};
 pub use energy::Energies;
+pub use observe::Observer;
 
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
@@ -25,7 +27,6 @@ use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
 use crate::math::{is_finite_vector, Matrix, Pose, Real, Vector};
-use crate::monitor::{History, Monitor, MonitorId};
 
 use changes::Changes;
 use contact_pass::{ContactPass, ContactSlices, PairSums, CONTACT_CHUNK};
@@ -160,9 +161,6 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     unbalanced_ratio: Real,
     detections: u64,
     scratch: DetectionScratch<L::State>,
-    monitors: Vec<(String, Monitor)>,
-    history: History,
-    monitor_interval: u64,
     timings: Timings,
 }
 
@@ -284,9 +282,6 @@ impl<L: ConstitutiveLaw> Model<L> {
             unbalanced_ratio: Real::INFINITY,
             detections: 0,
             scratch: DetectionScratch::default(),
-            monitors: Vec::new(),
-            history: History::default(),
-            monitor_interval: 1,
             timings: Timings::default(),
         })
     }
@@ -586,35 +581,6 @@ impl<L: ConstitutiveLaw> Model<L> {
         motion::add_contact_wrenches(Wrench::default(), entries, &self.wrenches)
     }
 
-    /// Adds a monitor sampled every [`Model::set_monitor_interval`] steps.
-    ///
-    /// # Errors
-    /// [`Error::UnknownBlock`] if the monitor refers to a missing block.
-    pub fn add_monitor(&mut self, name: &str, monitor: Monitor) -> Result<MonitorId> {
-        for id in monitor.blocks() {
-            self.block(id)?;
-        }
-        let id = MonitorId(self.monitors.len() as u32);
-        self.history.add_column(name, monitor.unit());
-        self.monitors.push((name.to_owned(), monitor));
-        Ok(id)
-    }
-
-    /// Samples monitors every `n` steps (default 1).
-    pub fn set_monitor_interval(&mut self, n: u64) {
-        self.monitor_interval = n.max(1);
-    }
-
-    /// The monitors, with their names, in column order.
-    pub fn monitors(&self) -> &[(String, Monitor)] {
-        &self.monitors
-    }
-
-    /// Steps between monitor samples.
-    pub fn monitor_interval(&self) -> u64 {
-        self.monitor_interval
-    }
-
     /// Time spent per stage (wall clock).
     pub fn timings(&self) -> &Timings {
         &self.timings
@@ -628,16 +594,6 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The integrator's damping model.
     pub fn damping(&self) -> Damping {
         self.integrator.damping()
-    }
-
-    /// The sampled histories.
-    pub fn history(&self) -> &History {
-        &self.history
-    }
-
-    /// Evaluates a monitor now.
-    pub fn evaluate(&self, monitor: &Monitor) -> Real {
-        monitor.evaluate(self)
     }
 
     /// One step.
@@ -687,9 +643,6 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.time += drift;
         if let Some(i) = diverged {
             return Err(self.divergence_error(i));
-        }
-        if self.step.is_multiple_of(self.monitor_interval) && !self.monitors.is_empty() {
-            self.sample();
         }
         Ok(())
     }
@@ -823,16 +776,6 @@ impl<L: ConstitutiveLaw> Model<L> {
                 "position or velocity is not finite".into()
             },
         }
-    }
-
-    fn sample(&mut self) {
-        let mut history = std::mem::take(&mut self.history);
-        history.push(
-            self.step,
-            self.time,
-            self.monitors.iter().map(|(_, m)| m.evaluate(self)),
-        );
-        self.history = history;
     }
 
     /// Runs `n` steps.
