@@ -268,7 +268,7 @@ impl<L: ConstitutiveLaw> Recorder<L> {
     /// Adds a built-in monitor as the next column.
     ///
     /// # Errors
-    /// [`Error::UnknownBlock`] if the monitor refers to a block `model` does not have.
+    /// [`crate::Error::UnknownBlock`] if the monitor refers to a block `model` does not have.
     pub fn add_monitor(&mut self, model: &Model<L>, name: &str, monitor: Monitor) -> Result<MonitorId> {
         for id in monitor.blocks() {
             model.block(id)?;
