@@ -162,3 +162,12 @@ pub(crate) fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'
         })
     }
 }
+
+/// An [`Error::Io`] naming `path` (for checkpoints and `io`).
+#[cfg(feature = "serde")]
+pub(crate) fn io_error(path: &std::path::Path, e: &std::io::Error) -> Error {
+    Error::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}

@@ -1,6 +1,7 @@
 //! Monitors and their histories: displacements, velocities, reactions, contact forces, energies
 //! and the unbalanced-force ratio.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Block, BlockId};
@@ -9,11 +10,13 @@ use crate::math::{Real, Vector};
 use crate::model::Model;
 
 /// Typed index of a monitor (its column in the [`History`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct MonitorId(pub u32);
 
 /// Component of a vector quantity.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum Component {
     /// World x.
     X,
@@ -37,7 +40,8 @@ impl Component {
 }
 
 /// Which energy term to record.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum EnergyTerm {
     /// Kinetic energy.
     Kinetic,
@@ -58,7 +62,8 @@ pub enum EnergyTerm {
 }
 
 /// A quantity sampled during a run.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum Monitor {
     /// Displacement (m) of the material point that was at `point` (world) when the block was built.
     Displacement {
@@ -182,17 +187,19 @@ impl Monitor {
 }
 
 /// Sampled histories: one row per sample, one column per monitor.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct History {
     names: Vec<String>,
     units: Vec<String>,
     steps: Vec<u64>,
     times: Vec<Real>,
-    #[serde(with = "nullable_columns")]
+    #[cfg_attr(feature = "serde", serde(with = "nullable_columns"))]
     columns: Vec<Vec<Real>>,
 }
 
 /// JSON has no NaN: missing samples (NaN) are written as `null` and read back as NaN.
+#[cfg(feature = "serde")]
 mod nullable_columns {
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 

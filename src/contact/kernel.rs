@@ -418,7 +418,8 @@ pub(crate) struct Lever {
 /// the moment about the host centroid, `Σ rᵢ × Fᵢ = R o × F + R u × F_x + R v × F_y`, and the work
 /// over a displacement field affine in the plane coordinates,
 /// `Σ Fᵢ·(w_o + xᵢ w_x + yᵢ w_y) = F·w_o + F_x·w_x + F_y·w_y`.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub(crate) struct ForceMoments {
     pub force: Vector,
     pub per_x: Vector,
@@ -475,6 +476,7 @@ impl ForceMoments {
 
     /// Whether `self` and `other` agree to round-off (relative 1e-9 of the largest entry):
     /// the same moments summed in another order.
+    #[cfg(feature = "serde")]
     pub fn matches(&self, other: &Self) -> bool {
         let entries = |m: &Self| [m.force, m.per_x, m.per_y];
         let scale = entries(self)

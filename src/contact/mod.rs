@@ -4,6 +4,7 @@
 mod kernel;
 mod lanes;
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 pub(crate) use kernel::{update_contact, ForceMoments, KernelContext};
@@ -16,11 +17,13 @@ use crate::math::{Pose, Real, Rotation, Vector, Vector2};
 
 /// Typed index of a contact in the model's current contact list (valid until the next
 /// re-detection).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ContactId(pub u32);
 
 /// Whether contact geometry follows the blocks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum DisplacementMode {
     /// Contact planes, points and lever arms follow the blocks; contacts are re-detected as they
     /// move.
@@ -50,7 +53,8 @@ pub trait Contact {
 /// Layout: what a step reads and writes; the reference geometry of small-displacement mode and
 /// the detection bookkeeping sit in a parallel internal list, which a large-displacement
 /// step does not read.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 #[repr(C)]
 pub struct ContactPair {
     pub(crate) a: u32,
@@ -75,14 +79,14 @@ pub struct ContactPair {
     /// block's body frame — the other face of a face-face contact, the plane of a point
     /// contact. Cached from the shapes (or the kind) at detection and on checkpoint load, so
     /// that the step loop does not visit the polyhedra.
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) plane_normal: Vector,
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) plane_offset: Real,
     /// Whether the sub-contacts may hold dashpot forces (Rayleigh damping in the last step, or
     /// history carried over at detection); only saves reading them when not. Checkpointed: it
     /// selects the sub-contact loop, and with it the order of the sums.
-    #[serde(default = "always")]
+    #[cfg_attr(feature = "serde", serde(default = "always"))]
     pub(crate) dashpots: bool,
     /// Sum of normal forces (N, compression positive).
     pub(crate) normal_force: Real,
@@ -93,6 +97,7 @@ pub struct ContactPair {
     pub(crate) springs: ForceMoments,
 }
 
+#[cfg(feature = "serde")]
 fn always() -> bool {
     true
 }
@@ -100,7 +105,8 @@ fn always() -> bool {
 /// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
 /// its geometry at detection, which small-displacement mode steps with, and the areas the
 /// critical-step bookkeeping compares.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub(crate) struct ContactReference {
     /// Centroids at detection (lever arms in small-displacement mode).
     pub(crate) ref_a: Vector,
@@ -281,7 +287,8 @@ impl ContactPair {
 ///     assert!((plane.point(plane.coordinates(p)) - p).length() < 1e-15);
 /// }
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct AnchorPlane {
     /// A point of the plane (body frame, m).
     pub origin: Vector,
@@ -369,7 +376,8 @@ impl AnchorPlane {
 /// joint's tangents ([`JointAxes`]). Its identity, dashpot force and gap offset sit in a parallel
 /// [`SubContactRecord`]; its world position and forces follow from the contact, see
 /// [`ContactView::point`], [`ContactView::shear_force`] and [`ContactView::total_force`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct SubContact<S> {
     /// Coordinates of the material point on the host block, on the contact's anchor plane (m).
     pub(crate) plane: Vector2,
@@ -429,12 +437,13 @@ impl<S> SubContact<S> {
 /// force. Stored in a parallel array (same index as the sub-contact), so that the step
 /// streams only the [`SubContact`]s and touches a record only while the sub-contact carries a
 /// dashpot force.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct SubContactRecord {
     pub(crate) key: SubKey,
     /// Stiffness-proportional (Rayleigh) dashpot force on `b` (world) of the last step; zero
     /// without Rayleigh damping.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub(crate) dashpot: Vector,
 }
 
@@ -476,7 +485,8 @@ pub struct ContactView<'a, S> {
 
 /// What one contact applies to its two blocks: the resultant force on `b` (`−force` on `a`) and
 /// the moments about the blocks' centroids (N, N·m, world).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ContactWrench {
     /// Resultant force on `b` (N).
     pub force: Vector,

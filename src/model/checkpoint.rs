@@ -1,5 +1,6 @@
 //! Checkpoint and restart: the full state of a model (blocks, contacts, sub-contact history, law
 //! state, energies, monitors) as JSON, restored so that the run continues bit-identically.
+//! Compiled with the `serde` feature.
 
 use std::path::Path;
 
@@ -10,9 +11,8 @@ use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::constitutive::{ConstitutiveLaw, JointTable};
 use crate::contact::{ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord};
-use crate::error::{Error, Result};
+use crate::error::{io_error, Error, Result};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
-use crate::io::io_error;
 use crate::math::{is_finite_vector, Pose, Real, Vector};
 use crate::model::Energies;
 use crate::monitor::{History, Monitor};
@@ -80,6 +80,8 @@ struct Snapshot<L: ConstitutiveLaw> {
     refining: Vec<(u32, u32)>,
 }
 
+/// Checkpoints need the `serde` feature (on by default).
+#[cfg_attr(docsrs, doc(cfg(feature = "serde")))]
 impl<L> Model<L>
 where
     L: ConstitutiveLaw + Serialize + DeserializeOwned,

@@ -1,11 +1,13 @@
 //! The model: blocks, joint laws, gravity and loads; stepping and runs.
 
+#[cfg(feature = "serde")]
 mod checkpoint;
 mod detection;
 mod energy;
 mod motion;
 
 use rayon::prelude::*;
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 pub use energy::Energies;
@@ -25,8 +27,9 @@ use crate::monitor::{History, Monitor, MonitorId};
 use detection::DetectionScratch;
 
 /// Global parameters of a model, with documented defaults.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct ModelParameters {
     /// Gravitational acceleration (m/s²). Default `(0, 0, −9.81)`.
     pub gravity: Vector,
@@ -158,7 +161,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
 }
 
 /// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Timings {
     /// Broad and narrow phase, sub-contact history transfer and the critical step (and the
     /// blocks' rotation matrices and movement check, when the last step's block pass did not
