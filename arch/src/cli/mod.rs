@@ -3,12 +3,10 @@
 //! `main` and its error report, the progress bar over the parallel cases, the ParaView series,
 //! the output folder and its files.
 //!
-//! An entry point is one line:
+//! An entry point's `main` is one line, as in `arch/examples/arch_impact.rs`:
 //!
 //! ```no_run
-//! fn main() {
-//!     voussoir_arch::cli::main::<voussoir_arch::cli::arch_impact::ImpactOptions>();
-//! }
+//! voussoir_arch::cli::main::<voussoir_arch::cli::arch_impact::ImpactOptions>();
 //! ```
 
 pub mod arch_impact;
