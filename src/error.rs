@@ -169,6 +169,7 @@ pub(crate) fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'
 }
 
 /// [`Error::Io`] naming the file.
+#[cfg(feature = "serde")]
 pub(crate) fn io_error(path: &std::path::Path, e: &std::io::Error) -> Error {
     Error::Io {
         path: path.display().to_string(),

@@ -48,9 +48,23 @@
 //! | [`model`] | the [`Model`]: stepping, runs, energies |
 //! | [`monitor`] | observation: the [`monitor::Probe`] trait, built-in monitors, the recorder and histories |
 //! | [`build`] | generators (walls, stacks) |
-//! | [`io`] | ParaView series, CSV histories, plots, scenes |
+//! | [`io`] | ParaView series, CSV histories, scenes (feature `io`) |
 //! | [`analysis`] | joint states and collapse mechanisms |
-//! | [`scenarios`] | reproductions of published tests (the reference arch) |
+//!
+//! The reproduction of the reference arch's tests (Pulatsu, Gonen & Lourenço 2021), with its
+//! command line, plots and progress bars, is the repository's unpublished `voussoir-arch` crate
+//! (`arch/`), built on this crate's public API.
+//!
+//! ## Features
+//!
+//! Both are on by default; `default-features = false` builds the solver alone (parry, glam,
+//! rayon, thiserror, approx).
+//!
+//! | feature | gives | brings in |
+//! |---|---|---|
+//! | `serde` | `Serialize`/`Deserialize` on the public types (parameters, laws and their states, blocks, monitors, histories, joint states); checkpoints: [`Model::to_checkpoint_string`], [`Model::from_checkpoint_str`], [`Model::save_checkpoint`], [`Model::load_checkpoint`] | serde, serde_json, serde_path_to_error, glam's and parry's serde support |
+//! | `io` | the `io` module: ParaView series, CSV histories, scene files, `write_json` | `serde` |
+#![cfg_attr(docsrs, feature(doc_cfg))]
 #![warn(missing_docs)]
 
 pub mod analysis;
@@ -63,11 +77,12 @@ pub mod error;
 pub mod geometry;
 pub mod ids;
 pub mod integrate;
+#[cfg(feature = "io")]
+#[cfg_attr(docsrs, doc(cfg(feature = "io")))]
 pub mod io;
 pub mod math;
 pub mod model;
 pub mod monitor;
-pub mod scenarios;
 
 pub use block::{Block, BlockId, RigidBlock};
 pub use constitutive::ConstitutiveLaw;

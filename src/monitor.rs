@@ -30,6 +30,8 @@
 //! # Ok::<(), voussoir::Error>(())
 //! ```
 
+#[cfg(feature = "serde")]
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 pub use crate::ids::MonitorId;
@@ -42,7 +44,8 @@ use crate::math::{Real, Vector};
 use crate::model::{Model, Observer};
 
 /// Component of a vector quantity.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum Component {
     /// World x.
     X,
@@ -66,7 +69,8 @@ impl Component {
 }
 
 /// Which energy term to record.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum EnergyTerm {
     /// Kinetic energy.
     Kinetic,
@@ -87,7 +91,8 @@ pub enum EnergyTerm {
 }
 
 /// A quantity sampled during a run.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum Monitor {
     /// Displacement (m) of the material point that was at `point` (world) when the block was built.
     Displacement {
@@ -123,7 +128,7 @@ pub enum Monitor {
     },
     /// Resultant force (N) of the joint between two blocks, on the second one (zero when they
     /// are not in contact). Scene files written before the rename say `JointForce`.
-    #[serde(alias = "JointForce")]
+    #[cfg_attr(feature = "serde", serde(alias = "JointForce"))]
     JointResultant {
         /// First block.
         a: BlockId,
@@ -346,17 +351,19 @@ impl<L: ConstitutiveLaw> Observer<L> for Recorder<L> {
 }
 
 /// Sampled histories: one row per sample, one column per monitor.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct History {
     names: Vec<String>,
     units: Vec<String>,
     steps: Vec<u64>,
     times: Vec<Real>,
-    #[serde(with = "nullable_columns")]
+    #[cfg_attr(feature = "serde", serde(with = "nullable_columns"))]
     columns: Vec<Vec<Real>>,
 }
 
 /// JSON has no NaN: missing samples (NaN) are written as `null` and read back as NaN.
+#[cfg(feature = "serde")]
 mod nullable_columns {
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 

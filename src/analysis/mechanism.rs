@@ -13,6 +13,7 @@
 //! * it is **sliding** when the area-weighted mean accumulated slip of its sub-contacts exceeds
 //!   [`MechanismCriteria::slip`].
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Block, BlockId, RigidBlock};
@@ -22,7 +23,8 @@ use crate::math::{Real, Vector};
 use crate::model::Model;
 
 /// A joint to classify.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct JointRef {
     /// A label (for an arch: the joint number).
     pub index: usize,
@@ -35,7 +37,8 @@ pub struct JointRef {
 }
 
 /// Thresholds of the classifier, with documented defaults.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct MechanismCriteria {
     /// Minimum open fraction of a hinge. Default 0.5.
     pub open_fraction: Real,
@@ -57,8 +60,9 @@ impl Default for MechanismCriteria {
 }
 
 /// Which edge a hinge turns about.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum HingeSide {
     /// The intrados edge (the joint opens at the extrados).
     Intrados,
@@ -67,7 +71,8 @@ pub enum HingeSide {
 }
 
 /// A hinge at a joint.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Hinge {
     /// Joint label.
     pub joint: usize,
@@ -76,7 +81,8 @@ pub struct Hinge {
 }
 
 /// Measured state of one joint.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct JointState {
     /// Joint label.
     pub joint: usize,
@@ -96,7 +102,8 @@ pub struct JointState {
 }
 
 /// Hinges and sliding joints.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Mechanism {
     /// Hinges, in joint order.
     pub hinges: Vec<Hinge>,

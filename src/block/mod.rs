@@ -1,5 +1,6 @@
 //! Blocks: the [`Block`] trait, typed ids, per-degree-of-freedom fixity and the rigid polyhedral block.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::error::{positive, Error, Result};
@@ -9,7 +10,8 @@ use crate::ids::MaterialId;
 use crate::math::{is_finite_vector, Pose, Real, Vector};
 
 /// What a single degree of freedom does.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum Dof {
     /// Moves under the forces.
     #[default]
@@ -43,7 +45,8 @@ impl Dof {
 /// };
 /// assert!(!plate.is_free());
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Fixity {
     /// Translations along world x, y, z.
     pub translation: [Dof; 3],
@@ -100,7 +103,8 @@ impl Fixity {
 }
 
 /// Kinematic state of a block. Velocities are at the last half step of central difference.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct BlockState {
     /// Pose of the principal frame (translation = centroid).
     pub pose: Pose,
@@ -113,7 +117,8 @@ pub struct BlockState {
 }
 
 /// A force and a moment about the block centroid, world frame.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Wrench {
     /// Force (N).
     pub force: Vector,
@@ -170,7 +175,8 @@ pub trait Block {
 /// and together, in 232 bytes (four cache lines); the fixity (96 bytes, read only for a
 /// constrained block) and the rest follow, and the shape sits behind a pointer
 /// (`docs/performance.md`).
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 #[repr(C)]
 pub struct RigidBlock {
     pub(crate) state: BlockState,
@@ -178,10 +184,10 @@ pub struct RigidBlock {
     pub(crate) load: Wrench,
     /// `shape.radius()`, kept next to the state for the per-step movement and speed checks
     /// (set on construction, by `Model::add_block` and on restore).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     pub(crate) radius: Real,
     /// `fixity.is_free()`, kept with the state (set with the fixity and on restore).
-    #[serde(skip)]
+    #[cfg_attr(feature = "serde", serde(skip))]
     free: bool,
     fixity: Fixity,
     material: MaterialId,
@@ -358,6 +364,8 @@ impl RigidBlock {
     }
 }
 
+// For checkpoints.
+#[cfg(feature = "serde")]
 impl RigidBlock {
     pub(crate) fn shape_face_count(&self) -> usize {
         self.shape.faces().len()

@@ -3,6 +3,7 @@
 //! Coordinates: `x` along the span (origin at midspan on the springing line), `y` up, `z` across
 //! the width (`0 ≤ z ≤ width`). Gravity must be set along `−y` for these models.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Fixity, RigidBlock};
@@ -11,7 +12,8 @@ use crate::error::{positive, Error, Result};
 use crate::math::{Real, Vector};
 
 /// The shape of the two (mirrored) abutment blocks.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct AbutmentShape {
     /// Horizontal extent beyond the springing extrados point (m).
     pub outer_width: Real,
@@ -30,7 +32,8 @@ impl Default for AbutmentShape {
 }
 
 /// Geometry of an arch ring. Intrados dimensions, as surveyed.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ArchSpec {
     /// Clear span at the intrados (m).
     pub span: Real,
@@ -132,7 +135,8 @@ impl ArchSpec {
 
 /// A joint of the ring: its index, the blocks on either side (as indices into [`Arch::blocks`])
 /// and its intrados and extrados points at mid-width.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ArchJoint {
     /// Joint number `j` (0 = left springing).
     pub index: usize,

@@ -3,6 +3,7 @@
 //! Coordinates: `y` up; a barrel vault spans along `x` and runs along `z`; a dome is centred on
 //! the `y` axis with its springing on `y = 0`.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Fixity, RigidBlock};
@@ -13,7 +14,8 @@ use crate::math::{Real, Vector};
 /// A semicircular barrel vault: `rings` arch rings side by side along `z`, each of `voussoirs`
 /// equal-angle voussoirs, on two fixed springer beams. Alternate rings are shifted by half a
 /// voussoir (a bonded vault), closed at the springings with half voussoirs.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct BarrelVaultSpec {
     /// Intrados radius (m).
     pub radius: Real,
@@ -112,7 +114,8 @@ pub fn barrel_vault(spec: &BarrelVaultSpec) -> Result<Vec<RigidBlock>> {
 /// **horizontal planes** (at the heights where the intrados reaches the course's latitudes), so
 /// that courses of different voussoir counts share plane bed faces. Alternate courses are
 /// staggered by half a voussoir.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct DomeSpec {
     /// Intrados radius (m).
     pub radius: Real,

@@ -1,5 +1,6 @@
 //! Dry-stacked running-bond walls.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Fixity, RigidBlock};
@@ -9,7 +10,8 @@ use crate::math::{Real, Vector};
 
 /// A running-bond wall: courses of bricks along x, stacked in z, one brick thick in y, on a fixed
 /// base slab. Odd courses are shifted by half a brick and closed with half bricks at both ends.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct WallSpec {
     /// Bricks per course (full bricks on even courses).
     pub bricks_per_course: usize,
@@ -110,7 +112,8 @@ pub fn running_bond_wall(spec: &WallSpec) -> Result<Vec<RigidBlock>> {
 /// A multi-leaf wall: `leaves` running-bond leaves side by side across the thickness (along `y`),
 /// each with its own brick size, on one fixed base; the joints between leaves are plain
 /// (collar joints, no through-stones).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct MultiLeafSpec {
     /// Length of the wall (m), along `x`.
     pub length: Real,

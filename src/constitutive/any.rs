@@ -1,5 +1,6 @@
 //! [`AnyLaw`]: the shipped laws as one type, to mix them in one model.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use super::{
@@ -57,7 +58,8 @@ use crate::math::Real;
 /// assert_eq!(conformance::check(&law)?, conformance::check(&pad)?);
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 #[non_exhaustive]
 pub enum AnyLaw {
     /// Coulomb slip with tension cut-off, cohesion and residual friction.
@@ -86,8 +88,9 @@ pub enum AnyLaw {
 /// assert!(law.is_failed(&state));
 /// # Ok::<(), voussoir::Error>(())
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
 #[non_exhaustive]
 pub struct AnyState {
     /// The state of [`AnyLaw::Coulomb`].
@@ -276,6 +279,7 @@ mod tests {
     /// `AnyLaw` and its state round-trip through JSON, variant and bits included, and a
     /// `CoulombSlip` is validated as it is read.
     #[test]
+    #[cfg(feature = "io")]
     fn serde_round_trip() {
         let laws = [AnyLaw::from(coulomb_laws()[2]), AnyLaw::from(elastic_law())];
         let text = serde_json::to_string(&laws).unwrap();

@@ -1,5 +1,6 @@
 //! Coulomb slip with tension cut-off, cohesion and residual friction (3DEC's joint model).
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use super::{ConstitutiveLaw, ElasticRegime, JointForce, JointStatus, JointStep, JointStiffness};
@@ -16,8 +17,9 @@ use crate::math::{Real, Vector2};
 ///
 /// The constructors take angles in degrees and validate every parameter; the accessors return
 /// radians.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "CoulombSpec", into = "CoulombSpec")]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "CoulombSpec", into = "CoulombSpec"))]
 pub struct CoulombSlip {
     normal_stiffness: Real,
     shear_stiffness: Real,
@@ -32,8 +34,9 @@ pub struct CoulombSlip {
 }
 
 /// The serialised form of [`CoulombSlip`]: angles in degrees, validated on load.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 struct CoulombSpec {
     /// Pa/m.
     normal_stiffness: Real,
@@ -42,10 +45,10 @@ struct CoulombSpec {
     friction_deg: Real,
     residual_friction_deg: Real,
     /// Pa.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     cohesion: Real,
     /// Pa.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     tensile_strength: Real,
 }
 
@@ -77,7 +80,8 @@ impl From<CoulombSlip> for CoulombSpec {
 }
 
 /// Per-sub-contact history of [`CoulombSlip`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct CoulombState {
     /// Cohesion and tensile strength lost, residual friction active.
     pub failed: bool,

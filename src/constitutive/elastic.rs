@@ -1,12 +1,14 @@
 //! Linear elastic joint: springs with no strength limit (tension and shear unbounded).
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use super::{ConstitutiveLaw, ElasticRegime, JointForce, JointStatus, JointStep, JointStiffness};
 use crate::error::{positive, Result};
 
 /// Linear normal and shear springs with no limit: `σ = -kn·u_n`, `τ̇ = -ks·u̇_s`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct LinearElastic {
     /// Normal stiffness (Pa/m).
     pub normal_stiffness: f64,

@@ -11,6 +11,7 @@ pub mod conformance;
 mod coulomb;
 mod elastic;
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 pub use any::{AnyLaw, AnyState};
@@ -23,7 +24,8 @@ use crate::error::Result;
 use crate::math::{plane_basis, Real, Vector, Vector2};
 
 /// Elastic stiffness of a joint per unit area.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct JointStiffness {
     /// Normal stiffness `kn` (Pa/m).
     pub normal: Real,
@@ -103,7 +105,8 @@ pub struct JointStep {
 }
 
 /// The forces a law maintains at a sub-contact.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct JointForce {
     /// Normal force (N), positive in compression.
     pub normal: Real,
@@ -166,7 +169,8 @@ impl ElasticRegime {
 }
 
 /// State of a sub-contact after an update, for monitors and output.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum JointStatus {
     /// In contact, below the strength.
     #[default]
@@ -298,7 +302,8 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
 /// assert!(joints.get(steel, stone).is_some());
 /// # Ok::<(), voussoir::Error>(())
 /// ```
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct JointTable<L> {
     laws: Vec<L>,
     /// `((min material, max material), law index)`, sorted.
@@ -356,6 +361,7 @@ impl<L: ConstitutiveLaw> JointTable<L> {
     }
 
     /// Checks the table's internal indices (after deserialisation).
+    #[cfg(feature = "serde")]
     pub(crate) fn check(&self) -> bool {
         self.index.iter().all(|e| (e.1 as usize) < self.laws.len()) && self.index.windows(2).all(|w| w[0].0 < w[1].0)
     }

@@ -7,6 +7,7 @@ mod law_update;
 mod moments;
 mod view;
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 pub(crate) use kernel::{update_contact, KernelContext};
@@ -21,7 +22,8 @@ use crate::geometry::{ContactKind, SubKey};
 use crate::math::{Pose, Real, Rotation, Vector, Vector2};
 
 /// Whether contact geometry follows the blocks.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum DisplacementMode {
     /// Contact planes, points and lever arms follow the blocks; contacts are re-detected as they
     /// move.
@@ -233,7 +235,8 @@ impl ContactPair {
 ///     assert!((plane.point(plane.coordinates(p)) - p).length() < 1e-15);
 /// }
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct AnchorPlane {
     /// A point of the plane (body frame, m).
     pub origin: Vector,
@@ -358,7 +361,8 @@ impl SubContactRecord {
 
 /// What one contact applies to its two blocks: the resultant force on `b` (`−force` on `a`) and
 /// the moments about the blocks' centroids (N, N·m, world).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ContactWrench {
     /// Resultant force on `b` (N).
     pub force: Vector,

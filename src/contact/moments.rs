@@ -78,6 +78,7 @@ impl ForceMoments {
 
     /// Whether `self` and `other` agree to round-off (relative 1e-9 of the largest entry):
     /// the same moments summed in another order.
+    #[cfg_attr(not(feature = "serde"), allow(dead_code))]
     pub fn matches(&self, other: &Self) -> bool {
         let entries = |m: &Self| [m.force, m.per_x, m.per_y];
         let scale = entries(self)

@@ -5,6 +5,7 @@
 //! face-to-face polygon and the sub-contact grid are built here. See `docs/theory.md`, "Contact geometry".
 
 use glam::DVec2;
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use super::clip::{area_centroid, clip_convex, clip_rect};
@@ -13,7 +14,8 @@ use crate::error::{in_range, positive, Result};
 use crate::math::{plane_basis, Pose, Real, Vector};
 
 /// How densely joint faces are covered with sub-contacts.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum SubcontactDensity {
     /// `n` sub-contacts along each edge of the host face's bounding rectangle (`n × n` cells);
     /// the reference paper uses 15.
@@ -37,8 +39,9 @@ const MAX_FACE_ANGLE: Real = 5.0 * std::f64::consts::PI / 12.0;
 const MAX_NODES_PER_EDGE: u32 = 65_535;
 
 /// Parameters of contact detection and discretisation.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct ContactParameters {
     /// Blocks closer than this (m) are in contact; contacts whose gap grows beyond it are dropped.
     /// Default `1e-3` m.
@@ -103,7 +106,8 @@ impl ContactParameters {
 
 /// Stable identity of a sub-contact within its block pair: used to carry history across
 /// re-detection.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct SubKey(pub u64);
 
 impl SubKey {
@@ -116,7 +120,8 @@ impl SubKey {
 }
 
 /// The kind of a detected contact.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum ContactKind {
     /// Two nearly parallel faces: a polygon covered with a grid of sub-contacts anchored to the
     /// host face. Faces are indices into each block's [`Polyhedron::faces`].

@@ -2,13 +2,15 @@
 
 use parry3d_f64::shape::{ConvexPolyhedron, Shape};
 use parry3d_f64::transformation::try_convex_hull;
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector};
 
 /// One planar face of a [`Polyhedron`], in the body frame.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Face {
     /// Outward unit normal (Newell's method over the whole vertex loop).
     pub normal: Vector,
@@ -21,7 +23,8 @@ pub struct Face {
 }
 
 /// Mass properties of a block: mass and principal moments about the centroid.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct MassProperties {
     /// Mass (kg).
     pub mass: Real,
@@ -36,7 +39,8 @@ pub struct MassProperties {
 ///
 /// Build one with [`Polyhedron::from_hull`] or [`Polyhedron::from_faces`]; both return the pose
 /// that places the body frame in the world.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Polyhedron {
     vertices: Vec<Vector>,
     faces: Vec<Face>,
@@ -48,10 +52,11 @@ pub struct Polyhedron {
     volume: Real,
     /// Inertia about the centroid per unit density (m⁵), principal axes.
     unit_inertia: Vector,
-    #[serde(skip, default = "empty_parry")]
+    #[cfg_attr(feature = "serde", serde(skip, default = "empty_parry"))]
     parry: Option<ConvexPolyhedron>,
 }
 
+#[cfg(feature = "serde")]
 fn empty_parry() -> Option<ConvexPolyhedron> {
     None
 }
@@ -270,6 +275,7 @@ impl Polyhedron {
     }
 
     /// Rebuilds parry's shape after deserialisation and checks the stored topology.
+    #[cfg(feature = "serde")]
     pub(crate) fn restore(&mut self) -> Result<()> {
         let bad = |reason: &str| Error::DegenerateGeometry {
             block: "(restored)".into(),

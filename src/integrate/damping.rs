@@ -1,5 +1,6 @@
 //! Damping models.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::error::{in_range, non_negative, positive, Result};
@@ -12,7 +13,8 @@ use crate::math::Real;
 /// * `Rayleigh`: `C = a·M + b·K`; the mass part is a viscous body force `−a·m·v`, `−a·I·ω`; the
 ///   stiffness part is a dashpot `b·kn·A·u̇_n` (and `b·ks·A·u̇_s` while not sliding) at every
 ///   sub-contact in contact.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum Damping {
     /// No damping.
     None,

@@ -1,12 +1,14 @@
 //! Critical time step of central difference for a block system on contact springs.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::block::BlockId;
 use crate::math::Real;
 
 /// How the model chooses its time step.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub enum TimeStep {
     /// `safety × critical step`, re-evaluated whenever contacts are re-detected.
     Auto {
@@ -39,7 +41,8 @@ pub struct StiffnessBound {
 }
 
 /// The critical step and the block that sets it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct CriticalStep {
     /// Critical time step with the damping correction (s).
     pub dt: Real,

@@ -1,18 +1,17 @@
-//! Outputs users expect: ParaView series ([`vtk`]), CSV histories ([`csv`]), SVG plots ([`plot`])
-//! progress bars ([`progress`]) and scene files ([`scene`]). Checkpoints are methods of
-//! [`crate::Model`] (`save_checkpoint`, `load_checkpoint`).
+//! Outputs users expect: ParaView series ([`vtk`]), CSV histories ([`csv`]) and scene files
+//! ([`scene`]). Checkpoints are methods of [`crate::Model`] (`save_checkpoint`,
+//! `load_checkpoint`).
+//!
+//! Needs the `io` feature (on by default), which turns on `serde`.
 
 pub mod csv;
-pub mod plot;
-pub mod progress;
 pub mod scene;
 pub mod vtk;
 
 use std::path::Path;
 
-use crate::error::Error;
-
 pub(crate) use crate::error::io_error;
+use crate::error::Error;
 
 /// Writes any serialisable value as pretty JSON (for example an example's `summary.json`),
 /// creating the folder. Non-finite numbers become `null`.

@@ -1,6 +1,7 @@
 //! Checkpoint and restart: the full state of a model (blocks, contacts, sub-contact history, law
 //! state, energies) as JSON, restored so that the run continues bit-identically. Recorders are
 //! the caller's: their [`crate::monitor::History`] serialises on its own.
+//! Compiled with the `serde` feature.
 
 use std::path::Path;
 

@@ -1,6 +1,7 @@
 //! Energy bookkeeping: every term is accumulated independently so that their balance tests the
 //! whole engine.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::math::Real;
@@ -17,7 +18,8 @@ use crate::math::Real;
 /// change of their elastic energy. Elastic and open steps dissipate nothing, so with a
 /// frictionless law `friction` stays zero, and `balance_error` measures what the time
 /// integration and the discretisation of the joints did not conserve.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Energies {
     /// Kinetic energy (J).
     pub kinetic: Real,

@@ -2,6 +2,7 @@
 
 mod benchmark;
 mod changes;
+#[cfg(feature = "serde")]
 mod checkpoint;
 mod contact_pass;
 mod detection;
@@ -11,6 +12,7 @@ mod observe;
 mod time_step;
 
 use rayon::prelude::*;
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 pub use benchmark::{benchmark_wall, benchmark_wall_with_spacing, BENCHMARK_SPACING};
@@ -33,8 +35,9 @@ use contact_pass::{ContactPass, ContactSlices, PairSums, CONTACT_CHUNK};
 use detection::DetectionScratch;
 
 /// Global parameters of a model, with documented defaults.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct ModelParameters {
     /// Gravitational acceleration (m/s²). Default `(0, 0, −9.81)`.
     pub gravity: Vector,
@@ -165,7 +168,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
 }
 
 /// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Timings {
     /// Broad and narrow phase, sub-contact history transfer and the critical step (and the
     /// blocks' rotation matrices and movement check, when the last step's block pass did not

@@ -5,13 +5,13 @@
 pub mod arch_impact;
 pub mod arch_static;
 
-use crate::build::arch::{Arch, ArchSpec};
-use crate::constitutive::{CoulombSlip, MaterialId};
-use crate::contact::DisplacementMode;
-use crate::error::Result;
-use crate::geometry::{ContactParameters, SubcontactDensity};
-use crate::math::{Real, Vector};
-use crate::model::{Model, ModelParameters};
+use voussoir::build::arch::{Arch, ArchSpec};
+use voussoir::constitutive::{CoulombSlip, MaterialId};
+use voussoir::contact::DisplacementMode;
+use voussoir::error::{Error, Result};
+use voussoir::geometry::{ContactParameters, SubcontactDensity};
+use voussoir::math::{Real, Vector};
+use voussoir::model::{Model, ModelParameters};
 
 /// Material of the stones.
 pub const STONE: MaterialId = MaterialId(0);
@@ -53,4 +53,45 @@ pub(crate) fn reference_arch_model(j: ArchJoints) -> Result<(Model, Arch)> {
         model.add_block(b.clone())?;
     }
     Ok((model, arch))
+}
+
+// The core's parameter checks are crate-private; the impact scenario's copies, same messages.
+
+/// Checks that `value` is finite and positive.
+pub(crate) fn positive(name: &str, value: Real) -> Result<Real> {
+    if value.is_finite() && value > 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.to_owned(),
+            value,
+            expected: "must be positive and finite",
+        })
+    }
+}
+
+/// Checks that `value` is finite and not negative.
+pub(crate) fn non_negative(name: &str, value: Real) -> Result<Real> {
+    if value.is_finite() && value >= 0.0 {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.to_owned(),
+            value,
+            expected: "must be finite and not negative",
+        })
+    }
+}
+
+/// Checks that `value` lies in `[lo, hi)`.
+pub(crate) fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'static str) -> Result<Real> {
+    if value.is_finite() && value >= lo && value < hi {
+        Ok(value)
+    } else {
+        Err(Error::InvalidParameter {
+            name: name.to_owned(),
+            value,
+            expected,
+        })
+    }
 }

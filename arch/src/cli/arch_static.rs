@@ -9,65 +9,59 @@
 //! Writes `summary.json`, `force_displacement.csv`, `force_displacement.svg`,
 //! `capacity_vs_friction.svg` and a ParaView series of the baseline under `out/arch_static/`.
 
-use std::path::PathBuf;
-use std::time::Instant;
-
-use rayon::prelude::*;
+use clap::{ArgAction, Args};
 use serde::Serialize;
 use voussoir::contact::DisplacementMode;
-use voussoir::io::plot::{Curve, LinePlot, Reference};
-use voussoir::io::{progress, vtk, write_json};
-use voussoir::scenarios::arch_static::{run, StaticCase, StaticResult};
+
+use super::{finite, BoxError, Outputs, Run};
+use crate::plot::{Curve, LinePlot, Reference};
+use crate::scenarios::arch_static::{run, StaticCase, StaticResult};
 
 /// Peak load of the test (kN).
 const EXPERIMENT_PEAK_KN: f64 = 2.71;
 
-struct Options {
-    out: PathBuf,
-    baseline_only: bool,
-    friction: Vec<f64>,
-    sweep: bool,
+/// Options of the quasi-static run.
+#[derive(Debug, Clone, Args)]
+pub struct StaticOptions {
+    /// Run the baseline only
+    #[arg(long)]
+    pub baseline_only: bool,
+    /// Leave out the capacity-versus-friction sweep (25° to 40° by 1°)
+    #[arg(long)]
+    pub no_sweep: bool,
+    /// Friction angles (°) of the study, plotted in force_displacement.svg
+    #[arg(
+        long,
+        value_name = "DEG[,DEG]",
+        value_delimiter = ',',
+        action = ArgAction::Set,
+        value_parser = finite,
+        allow_hyphen_values = true,
+        default_value = "27,30,30.5,35"
+    )]
+    pub friction: Vec<f64>,
 }
 
-fn parse() -> Result<Options, String> {
-    let mut o = Options {
-        out: PathBuf::from("out/arch_static"),
-        baseline_only: false,
-        friction: vec![27.0, 30.0, 30.5, 35.0],
-        sweep: true,
-    };
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--out" => o.out = args.next().ok_or("--out needs a folder")?.into(),
-            "--baseline-only" => o.baseline_only = true,
-            "--no-sweep" => o.sweep = false,
-            "--friction" => {
-                let list = args.next().ok_or("--friction needs a list such as 27,30.5")?;
-                o.friction = list
-                    .split(',')
-                    .map(|x| x.trim().parse().map_err(|_| format!("bad angle {x:?}")))
-                    .collect::<Result<_, _>>()?;
-            }
-            "-h" | "--help" => {
-                println!("arch_static [--out DIR] [--baseline-only] [--no-sweep] [--friction 27,30,30.5,35]");
-                std::process::exit(0);
-            }
-            other => return Err(format!("unknown argument {other:?} (try --help)")),
-        }
+impl Run for StaticOptions {
+    const NAME: &'static str = "arch_static";
+    const OUT: &'static str = "out/arch_static";
+    const ABOUT: &'static str = "The quasi-static test of the reference arch (Pulatsu, Gonen & Lourenço 2021) \
+and the paper's parameter studies, in parallel";
+
+    fn run(&self, out: &Outputs) -> Result<(), BoxError> {
+        run_static(self, out)
     }
-    Ok(o)
 }
 
 /// The study cases of the paper, plus the capacity-versus-friction sweep.
-fn cases(o: &Options) -> Vec<StaticCase> {
+fn cases(o: &StaticOptions) -> Vec<StaticCase> {
     let base = StaticCase::baseline();
     let mut cases = vec![base.clone()];
     if o.baseline_only {
         return cases;
     }
     let mut angles: Vec<f64> = o.friction.clone();
-    if o.sweep {
+    if !o.no_sweep {
         angles.extend((25..=40).map(f64::from));
     }
     angles.sort_by(f64::total_cmp);
@@ -190,17 +184,8 @@ fn summarise(r: &StaticResult) -> CaseSummary {
     }
 }
 
-fn main() {
-    if let Err(e) = try_main() {
-        eprintln!("arch_static: {e}");
-        std::process::exit(1);
-    }
-}
-
-fn try_main() -> Result<(), Box<dyn std::error::Error>> {
-    let o = parse()?;
-    let started = Instant::now();
-    let cases = cases(&o);
+fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
+    let cases = cases(o);
     let base = StaticCase::baseline();
     println!(
         "Quasi-static test of the reference arch (Pulatsu et al. 2021), {} cases",
@@ -223,23 +208,11 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         base.max_displacement * 1e3,
         base.stop_fraction * 100.0
     );
-    let bar = progress::bar(cases.len() as u64, "cases");
-    let frames_dir = o.out.join("paraview");
-    let results: Vec<StaticResult> = cases
-        .par_iter()
-        .enumerate()
-        .map(|(k, case)| {
-            let result = if k == 0 {
-                let mut series = vtk::Series::new(&frames_dir, "baseline");
-                run(case, Some(5e-4), |m| series.write_frame(m))
-            } else {
-                run(case, None, |_| Ok(()))
-            };
-            bar.inc(1);
-            result
+    let results: Vec<StaticResult> = out.run_all(&cases, "cases", |k, case| {
+        out.with_frames((k == 0).then_some("baseline"), 5e-4, |every, frame| {
+            run(case, every, frame)
         })
-        .collect::<Result<_, _>>()?;
-    bar.finish_and_clear();
+    })?;
 
     println!();
     println!(
@@ -274,7 +247,6 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
     );
 
     // Outputs.
-    std::fs::create_dir_all(&o.out)?;
     let summary = Summary {
         experiment: Experiment {
             peak_load_kn: EXPERIMENT_PEAK_KN,
@@ -282,9 +254,9 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         },
         adopted: serde_json::to_value(&base)?,
         cases: results.iter().map(summarise).collect(),
-        total_wall_s: started.elapsed().as_secs_f64(),
+        total_wall_s: out.elapsed(),
     };
-    write_json(&o.out.join("summary.json"), &summary)?;
+    out.json("summary.json", &summary)?;
     let mut csv = String::from(
         "case,displacement [mm],load [kN],load 1 mm average [kN],left support dx [mm],right support dx [mm]\n",
     );
@@ -301,7 +273,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             ));
         }
     }
-    std::fs::write(o.out.join("force_displacement.csv"), csv)?;
+    out.text("force_displacement.csv", &csv)?;
     let by_friction: Vec<&StaticResult> = results
         .iter()
         .filter(|r| {
@@ -309,7 +281,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
                 && (r.case.label == "baseline" || r.case.label.starts_with("friction"))
         })
         .collect();
-    LinePlot {
+    let force_displacement = LinePlot {
         title: "Arch under a quarter-span load: load–displacement".into(),
         x_label: "plate displacement [mm]".into(),
         y_label: "load [kN]".into(),
@@ -337,15 +309,15 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             y: EXPERIMENT_PEAK_KN,
         }],
         ..Default::default()
-    }
-    .write_svg(&o.out.join("force_displacement.svg"))?;
+    };
+    out.svg("force_displacement.svg", &force_displacement)?;
     let mut sweep: Vec<(f64, f64)> = results
         .iter()
         .filter(|r| r.case.label == "baseline" || r.case.label.starts_with("friction"))
         .map(|r| (r.case.friction_deg, r.peak_load / 1e3))
         .collect();
     sweep.sort_by(|a, b| a.0.total_cmp(&b.0));
-    LinePlot {
+    let capacity = LinePlot {
         title: "Capacity versus joint friction angle".into(),
         x_label: "friction angle [°]".into(),
         y_label: "peak load [kN]".into(),
@@ -359,12 +331,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             y: EXPERIMENT_PEAK_KN,
         }],
         ..Default::default()
-    }
-    .write_svg(&o.out.join("capacity_vs_friction.svg"))?;
-    println!(
-        "outputs in {} ({:.1} s wall)",
-        o.out.display(),
-        started.elapsed().as_secs_f64()
-    );
+    };
+    out.svg("capacity_vs_friction.svg", &capacity)?;
     Ok(())
 }

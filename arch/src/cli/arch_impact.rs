@@ -16,121 +16,125 @@
 //! the energy terms), `displacement_time.svg`, `max_disp_vs_experiment.svg`, a ParaView series per
 //! setup (and `sensitivity.svg` with `--study`) under `out/arch_impact/`.
 
-use std::path::PathBuf;
-use std::time::Instant;
-
-use rayon::prelude::*;
+use clap::{ArgAction, Args, ValueEnum};
 use serde::Serialize;
-use voussoir::io::plot::{Curve, LegendPosition, LinePlot, Reference};
-use voussoir::io::{progress, vtk, write_json};
-use voussoir::scenarios::arch_impact::{
+
+use super::{finite, BoxError, Outputs, Run};
+use crate::plot::{Curve, LegendPosition, LinePlot, Reference};
+use crate::scenarios::arch_impact::{
     run, setups, ImpactCase, ImpactResult, ImpactSetup, ImpactorBase, ImpactorGuide, Release,
 };
 
-struct Options {
-    out: PathBuf,
-    setups: Option<Vec<String>>,
-    kn: Option<f64>,
-    damping: Option<f64>,
-    width: Option<f64>,
-    duration: Option<f64>,
-    guide: ImpactorGuide,
-    base: ImpactorBase,
-    release: Release,
-    offsets_mm: Vec<f64>,
-    study: bool,
-    compare_release: bool,
-    paraview: bool,
+/// Options of the impact runs. Unset numbers keep the scenario's values
+/// ([`ImpactCase::baseline`]).
+#[derive(Debug, Clone, Args)]
+pub struct ImpactOptions {
+    /// Setups to run, of M60H20, M60H25, M60H30, M75H20, M75H45, M80H45 [default: all six]
+    #[arg(long = "setup", value_name = "NAME[,NAME]", value_delimiter = ',', action = ArgAction::Set)]
+    pub setups: Option<Vec<String>>,
+    /// Joint normal stiffness (Pa/m), ks scaled with it [default: 4e9]
+    #[arg(long, value_name = "PA_PER_M", value_parser = finite, allow_hyphen_values = true)]
+    pub kn: Option<f64>,
+    /// Rayleigh damping ratio [default: 0.01]
+    #[arg(long, value_name = "RATIO", value_parser = finite, allow_hyphen_values = true)]
+    pub damping: Option<f64>,
+    /// Width of the arch (m) [default: 0.15]
+    #[arg(long, value_name = "M", value_parser = finite, allow_hyphen_values = true)]
+    pub width: Option<f64>,
+    /// Duration of each run after release (s) [default: 1.0]
+    #[arg(long, value_name = "S", value_parser = finite, allow_hyphen_values = true)]
+    pub duration: Option<f64>,
+    /// How the impactor is guided
+    #[arg(long, value_enum, default_value_t = Guide::Frame)]
+    pub guide: Guide,
+    /// The impactor's striking face
+    #[arg(long, value_enum, default_value_t = Base::Sloped)]
+    pub base: Base,
+    /// Where the impactor is released
+    #[arg(long, value_enum, default_value_t = ReleaseAt::Above)]
+    pub release: ReleaseAt,
+    /// Drop-height perturbations (mm); every setup runs at each, the central one reported
+    #[arg(
+        long = "offsets",
+        value_name = "MM[,MM]",
+        value_delimiter = ',',
+        action = ArgAction::Set,
+        value_parser = finite,
+        allow_hyphen_values = true,
+        default_value = "-0.5,-0.25,0,0.25,0.5"
+    )]
+    pub offsets_mm: Vec<f64>,
+    /// Add the paper's Fig. 14 study (kn and damping, M60 setups)
+    #[arg(long)]
+    pub study: bool,
+    /// Add the other release (full height or just above) for each setup's central run
+    #[arg(long)]
+    pub compare_release: bool,
 }
 
-const HELP: &str = "arch_impact [--setup M60H20,..] [--kn 4e9] [--damping 0.01] [--width 0.15] [--duration 1.0] \
-[--guide frame|seat] [--base sloped|flat] [--release above|full] [--offsets -0.5,-0.25,0,0.25,0.5] \
-[--out DIR] [--study] [--compare-release] [--no-paraview]";
+/// `--guide`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Guide {
+    /// A free impactor between fixed frame blocks (contacts only)
+    Frame,
+    /// A steel seat on voussoir 5, the impactor guided by constrained DOFs
+    Seat,
+}
 
-fn parse() -> Result<Options, String> {
-    let mut o = Options {
-        out: PathBuf::from("out/arch_impact"),
-        setups: None,
-        kn: None,
-        damping: None,
-        width: None,
-        duration: None,
-        guide: ImpactorGuide::Frame,
-        base: ImpactorBase::Sloped,
-        release: Release::JustAbove,
-        offsets_mm: vec![-0.5, -0.25, 0.0, 0.25, 0.5],
-        study: false,
-        compare_release: false,
-        paraview: true,
-    };
-    let mut args = std::env::args().skip(1);
-    let number = |name: &str, v: Option<String>| -> Result<f64, String> {
-        let v = v.ok_or(format!("{name} needs a value"))?;
-        let x: f64 = v.parse().map_err(|_| format!("{name}: not a number: {v:?}"))?;
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(format!("{name}: not finite: {v:?}"))
-        }
-    };
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--out" => o.out = args.next().ok_or("--out needs a folder")?.into(),
-            "--setup" => {
-                o.setups = Some(
-                    args.next()
-                        .ok_or("--setup needs a name")?
-                        .split(',')
-                        .map(str::to_owned)
-                        .collect(),
-                )
-            }
-            "--kn" => o.kn = Some(number("--kn", args.next())?),
-            "--damping" => o.damping = Some(number("--damping", args.next())?),
-            "--width" => o.width = Some(number("--width", args.next())?),
-            "--duration" => o.duration = Some(number("--duration", args.next())?),
-            "--guide" => {
-                o.guide = match args.next().as_deref() {
-                    Some("frame") => ImpactorGuide::Frame,
-                    Some("seat") => ImpactorGuide::SeatConstrained,
-                    other => return Err(format!("--guide: frame or seat, not {other:?}")),
-                }
-            }
-            "--base" => {
-                o.base = match args.next().as_deref() {
-                    Some("sloped") => ImpactorBase::Sloped,
-                    Some("flat") => ImpactorBase::Flat,
-                    other => return Err(format!("--base: sloped or flat, not {other:?}")),
-                }
-            }
-            "--release" => {
-                o.release = match args.next().as_deref() {
-                    Some("above") => Release::JustAbove,
-                    Some("full") => Release::FullHeight,
-                    other => return Err(format!("--release: above or full, not {other:?}")),
-                }
-            }
-            "--offsets" => {
-                let list = args.next().ok_or("--offsets needs a list of millimetres")?;
-                o.offsets_mm = list
-                    .split(',')
-                    .map(|v| number("--offsets", Some(v.to_owned())))
-                    .collect::<Result<_, _>>()?;
-                if o.offsets_mm.is_empty() {
-                    return Err("--offsets: empty list".into());
-                }
-            }
-            "--study" => o.study = true,
-            "--compare-release" => o.compare_release = true,
-            "--no-paraview" => o.paraview = false,
-            "-h" | "--help" => {
-                println!("{HELP}");
-                std::process::exit(0);
-            }
-            other => return Err(format!("unknown argument {other:?} (try --help)")),
+/// `--base`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Base {
+    /// Parallel to the extrados of voussoir 5 (20.7°)
+    Sloped,
+    /// Horizontal
+    Flat,
+}
+
+/// `--release`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ReleaseAt {
+    /// Just above the arch, at the speed of the fall
+    Above,
+    /// At the full drop height, at rest
+    Full,
+}
+
+impl From<Guide> for ImpactorGuide {
+    fn from(g: Guide) -> Self {
+        match g {
+            Guide::Frame => ImpactorGuide::Frame,
+            Guide::Seat => ImpactorGuide::SeatConstrained,
         }
     }
-    Ok(o)
+}
+
+impl From<Base> for ImpactorBase {
+    fn from(b: Base) -> Self {
+        match b {
+            Base::Sloped => ImpactorBase::Sloped,
+            Base::Flat => ImpactorBase::Flat,
+        }
+    }
+}
+
+impl From<ReleaseAt> for Release {
+    fn from(r: ReleaseAt) -> Self {
+        match r {
+            ReleaseAt::Above => Release::JustAbove,
+            ReleaseAt::Full => Release::FullHeight,
+        }
+    }
+}
+
+impl Run for ImpactOptions {
+    const NAME: &'static str = "arch_impact";
+    const OUT: &'static str = "out/arch_impact";
+    const ABOUT: &'static str = "The six drop-weight impact tests of the reference arch \
+(Pulatsu, Gonen & Lourenço 2021), each at five drop heights, in parallel";
+
+    fn run(&self, out: &Outputs) -> Result<(), BoxError> {
+        run_impact(self, out)
+    }
 }
 
 /// A group of runs that differ only by the drop-height perturbation.
@@ -142,7 +146,7 @@ struct Group {
     base: ImpactCase,
 }
 
-fn groups(o: &Options) -> Result<Vec<Group>, String> {
+fn groups(o: &ImpactOptions) -> Result<Vec<Group>, String> {
     let all = setups();
     let chosen: Vec<ImpactSetup> = match &o.setups {
         None => all.clone(),
@@ -158,9 +162,9 @@ fn groups(o: &Options) -> Result<Vec<Group>, String> {
     };
     let configure = |s: &ImpactSetup| {
         let mut c = ImpactCase::baseline(s.clone());
-        c.guide = o.guide;
-        c.base = o.base;
-        c.release = o.release;
+        c.guide = o.guide.into();
+        c.base = o.base.into();
+        c.release = o.release.into();
         if let Some(kn) = o.kn {
             c.ks = kn * c.ks / c.kn;
             c.kn = kn;
@@ -220,7 +224,7 @@ fn groups(o: &Options) -> Result<Vec<Group>, String> {
         }
     }
     if o.compare_release {
-        let other = match o.release {
+        let other = match Release::from(o.release) {
             Release::JustAbove => Release::FullHeight,
             Release::FullHeight => Release::JustAbove,
         };
@@ -353,7 +357,7 @@ impl Outcome<'_> {
         let c = &r.case;
         let s = &c.setup;
         let last = r.samples.last().copied();
-        let e = |f: fn(&voussoir::scenarios::arch_impact::ImpactSample) -> f64| last.map_or(0.0, |x| f(&x));
+        let e = |f: fn(&crate::scenarios::arch_impact::ImpactSample) -> f64| last.map_or(0.0, |x| f(&x));
         GroupSummary {
             name: s.name.clone(),
             label: self.group.label.clone(),
@@ -419,13 +423,6 @@ impl Outcome<'_> {
                 max_accel_m_per_s2: s.max_accel,
             },
         }
-    }
-}
-
-fn main() {
-    if let Err(e) = try_main() {
-        eprintln!("arch_impact: {e}");
-        std::process::exit(1);
     }
 }
 
@@ -527,10 +524,8 @@ fn markdown(outcomes: &[Outcome], agree: usize, main_count: usize) -> String {
     md
 }
 
-fn try_main() -> Result<(), Box<dyn std::error::Error>> {
-    let o = parse()?;
-    let started = Instant::now();
-    let groups = groups(&o)?;
+fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
+    let groups = groups(o)?;
     // Every group runs at every drop-height perturbation (the central one first).
     let mut offsets: Vec<f64> = o.offsets_mm.iter().map(|mm| mm * 1e-3).collect();
     offsets.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
@@ -589,22 +584,13 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         base.duration
     );
     println!("  collapse rule: a voussoir's centroid drops by more than half the ring thickness (0.1 m).");
-    let bar = progress::bar(cases.len() as u64, "impact runs");
-    let results: Vec<(usize, ImpactResult)> = cases
-        .par_iter()
-        .map(|(k, case)| {
-            let g = &groups[*k];
-            let result = if o.paraview && g.kind == "main" && case.height_offset == 0.0 {
-                let mut series = vtk::Series::new(o.out.join("paraview"), &case.setup.name);
-                run(case, Some(0.01), |m| series.write_frame(m))
-            } else {
-                run(case, None, |_| Ok(()))
-            };
-            bar.inc(1);
-            result.map(|r| (*k, r))
+    let results: Vec<(usize, ImpactResult)> = out.run_all(&cases, "impact runs", |_, (k, case)| {
+        let central = groups[*k].kind == "main" && case.height_offset == 0.0;
+        out.with_frames(central.then_some(case.setup.name.as_str()), 0.01, |every, frame| {
+            run(case, every, frame)
         })
-        .collect::<Result<_, _>>()?;
-    bar.finish_and_clear();
+        .map(|r| (*k, r))
+    })?;
     let outcomes: Vec<Outcome> = groups
         .iter()
         .enumerate()
@@ -678,7 +664,6 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         wall.iter().sum::<f64>() / wall.len() as f64
     );
 
-    std::fs::create_dir_all(&o.out)?;
     let summary = serde_json::json!({
         "parameters": base,
         "height_offsets_m": offsets,
@@ -687,15 +672,15 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         "setups": main.iter().map(|x| x.summary()).collect::<Vec<_>>(),
         "study": outcomes.iter().filter(|x| x.group.kind == "study").map(|x| x.summary()).collect::<Vec<_>>(),
         "release_comparison": outcomes.iter().filter(|x| x.group.kind == "release").map(|x| x.summary()).collect::<Vec<_>>(),
-        "total_wall_s": started.elapsed().as_secs_f64(),
+        "total_wall_s": out.elapsed(),
     });
-    write_json(&o.out.join("summary.json"), &summary)?;
-    std::fs::write(o.out.join("tables.md"), markdown(&outcomes, agree, main.len()))?;
+    out.json("summary.json", &summary)?;
+    out.text("tables.md", &markdown(&outcomes, agree, main.len()))?;
     for x in &outcomes {
         let file = format!("history_{}.csv", x.group.label.replace([' ', '%', '/'], "_"));
-        std::fs::write(o.out.join(file), history_csv(x.central))?;
+        out.text(&file, &history_csv(x.central))?;
     }
-    LinePlot {
+    let displacement_time = LinePlot {
         title: "Quarter-span vertical displacement".into(),
         x_label: "time after release [s]".into(),
         y_label: "displacement [mm]".into(),
@@ -708,8 +693,8 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             .collect(),
         references: Vec::new(),
         legend: LegendPosition::Auto,
-    }
-    .write_svg(&o.out.join("displacement_time.svg"))?;
+    };
+    out.svg("displacement_time.svg", &displacement_time)?;
     let standing: Vec<&&Outcome> = main
         .iter()
         .filter(|x| x.central.case.setup.max_disp.is_some())
@@ -729,7 +714,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             .map(|x| (x.central.kinetic_energy, f(x) * 1e3))
             .collect(),
     };
-    LinePlot {
+    let max_disp = LinePlot {
         title: "Maximum quarter-span displacement: model vs test (cf. paper Fig. 13)".into(),
         x_label: "impact energy [J]".into(),
         y_label: "max displacement [mm]".into(),
@@ -740,8 +725,8 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         ],
         references: refs,
         legend: LegendPosition::Auto,
-    }
-    .write_svg(&o.out.join("max_disp_vs_experiment.svg"))?;
+    };
+    out.svg("max_disp_vs_experiment.svg", &max_disp)?;
     if o.study {
         let mut curves = Vec::new();
         for s in ["M60H20", "M60H25", "M60H30"] {
@@ -764,20 +749,15 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
                 points: pick(&|c| (c.kn == base.kn).then_some(c.damping_ratio * 100.0)),
             });
         }
-        LinePlot {
+        let sensitivity = LinePlot {
             title: "Sensitivity of the maximum displacement (cf. paper Fig. 14)".into(),
             x_label: "kn [GPa/m] or damping ratio [%]".into(),
             y_label: "max displacement [mm]".into(),
             curves,
             references: Vec::new(),
             legend: LegendPosition::Auto,
-        }
-        .write_svg(&o.out.join("sensitivity.svg"))?;
+        };
+        out.svg("sensitivity.svg", &sensitivity)?;
     }
-    println!(
-        "outputs in {} ({:.1} s wall)",
-        o.out.display(),
-        started.elapsed().as_secs_f64()
-    );
     Ok(())
 }

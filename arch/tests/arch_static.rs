@@ -5,7 +5,7 @@
 
 use rayon::prelude::*;
 use voussoir::contact::DisplacementMode;
-use voussoir::scenarios::arch_static::{run, StaticCase, StaticResult};
+use voussoir_arch::scenarios::arch_static::{run, StaticCase, StaticResult};
 
 fn case(label: &str, change: impl Fn(&mut StaticCase)) -> StaticCase {
     let mut c = StaticCase {

@@ -2,7 +2,7 @@
 //!
 //! Default model ([`ImpactorGuide::Frame`], as the paper's §4.2: "new rigid blocks are added to
 //! simulate the frame and the free-falling object … noncohesive bonds between the falling object
-//! and frame-blocks"): the arch of [`crate::build::arch::ArchSpec::reference`]; a rigid impactor
+//! and frame-blocks"): the arch of [`voussoir::build::arch::ArchSpec::reference`]; a rigid impactor
 //! of the test's mass, 0.10 m along the span × the arch width, that is a **free** block (no
 //! constrained degree of freedom); four **fixed frame blocks** around it, two along the span and
 //! two across the width, each [`ImpactCase::guide_clearance`] away from its faces, in contact
@@ -30,13 +30,14 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::block::{Block, BlockId, Dof, Fixity, RigidBlock};
-use crate::build::arch::Arch;
-use crate::constitutive::CoulombSlip;
-use crate::error::{in_range, non_negative, positive, Error, Result};
-use crate::integrate::Damping;
-use crate::math::{Real, Vector};
-use crate::model::Model;
+use super::{in_range, non_negative, positive};
+use voussoir::block::{Block, BlockId, Dof, Fixity, RigidBlock};
+use voussoir::build::arch::Arch;
+use voussoir::constitutive::CoulombSlip;
+use voussoir::error::{Error, Result};
+use voussoir::integrate::Damping;
+use voussoir::math::{Real, Vector};
+use voussoir::model::Model;
 
 /// Gravitational acceleration of the scenario (m/s², along −y).
 pub const GRAVITY: Real = 9.81;
@@ -404,7 +405,7 @@ pub fn build(case: &ImpactCase) -> Result<ImpactModel> {
         kn: case.kn,
         ks: case.ks,
         friction_deg: case.friction_deg,
-        mode: crate::contact::DisplacementMode::Large,
+        mode: voussoir::contact::DisplacementMode::Large,
     })?;
     let (steel, frame) = (super::STEEL, super::FRAME);
     let stone_law = CoulombSlip::dry(case.kn, case.ks, case.friction_deg)?;

@@ -6,7 +6,7 @@ pub use indicatif::{MultiProgress, ProgressBar};
 /// A progress bar of `len` units with a message, an elapsed time and an estimate of the time left.
 ///
 /// ```
-/// let bar = voussoir::io::progress::bar(100, "settling");
+/// let bar = voussoir_arch::progress::bar(100, "settling");
 /// bar.inc(10);
 /// bar.finish_and_clear();
 /// ```

@@ -1,7 +1,7 @@
 //! The quasi-static test of the reference arch (`BENCHMARKS.md` §3): a displacement-controlled
 //! vertical load on voussoir 5 through a plate that does not restrain it horizontally.
 //!
-//! Model: the arch of [`crate::build::arch::ArchSpec::reference`]; a steel plate seated on the extrados of voussoir 5
+//! Model: the arch of [`voussoir::build::arch::ArchSpec::reference`]; a steel plate seated on the extrados of voussoir 5
 //! (footprint 0.10 m along the span, full width), whose **vertical velocity only** is prescribed:
 //! it is free to translate horizontally and to rotate in the plane of the arch (the roller and
 //! bearing of the test), so the load it transmits is vertical. The plate–stone joint has the
@@ -13,14 +13,14 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::{classify_joints, JointRef, JointState, Mechanism, MechanismCriteria};
-use crate::block::{BlockId, Dof, Fixity, RigidBlock};
-use crate::build::arch::Arch;
-use crate::contact::DisplacementMode;
-use crate::error::Result;
-use crate::integrate::Damping;
-use crate::math::{Pose, Real, Rotation, Vector};
-use crate::model::Model;
+use voussoir::analysis::{classify_joints, JointRef, JointState, Mechanism, MechanismCriteria};
+use voussoir::block::{BlockId, Dof, Fixity, RigidBlock};
+use voussoir::build::arch::Arch;
+use voussoir::contact::DisplacementMode;
+use voussoir::error::Result;
+use voussoir::integrate::Damping;
+use voussoir::math::{Pose, Real, Rotation, Vector};
+use voussoir::model::Model;
 
 /// One analysis case. [`StaticCase::baseline`] holds the paper's values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -5,8 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::error::{Error, Result};
-use crate::io::io_error;
+use voussoir::error::{Error, Result};
 
 /// One named curve.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,7 +57,7 @@ pub enum LegendPosition {
 /// A line plot: title, axis labels (with units), curves and references.
 ///
 /// ```
-/// use voussoir::io::plot::{Curve, LegendPosition, LinePlot, Reference};
+/// use voussoir_arch::plot::{Curve, LegendPosition, LinePlot, Reference};
 /// let plot = LinePlot {
 ///     title: "load–displacement".into(),
 ///     x_label: "displacement [mm]".into(),
@@ -88,6 +87,13 @@ pub struct LinePlot {
 }
 
 const SIZE: (u32, u32) = (800, 560);
+
+fn io_error(path: &Path, e: &std::io::Error) -> Error {
+    Error::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
 
 impl LinePlot {
     /// Renders the plot as an SVG document.

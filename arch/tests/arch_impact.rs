@@ -2,7 +2,9 @@
 
 use rayon::prelude::*;
 use voussoir::block::Block;
-use voussoir::scenarios::arch_impact::{build, run, setups, ImpactCase, ImpactResult, ImpactorGuide, Release, GRAVITY};
+use voussoir_arch::scenarios::arch_impact::{
+    build, run, setups, ImpactCase, ImpactResult, ImpactorGuide, Release, GRAVITY,
+};
 
 fn pick(name: &str) -> ImpactCase {
     ImpactCase::baseline(setups().into_iter().find(|s| s.name == name).expect("setup"))

@@ -1,0 +1,315 @@
+//! One command line for the arch runs ([`arch_static`], [`arch_impact`]): the options every run
+//! takes ([`CommonOptions`]), flattened beside the run's own, and the parts every run shares:
+//! `main` and its error report, the progress bar over the parallel cases, the ParaView series,
+//! the output folder and its files.
+//!
+//! An entry point's `main` is one line, as in `arch/examples/arch_impact.rs`:
+//!
+//! ```no_run
+//! voussoir_arch::cli::main::<voussoir_arch::cli::arch_impact::ImpactOptions>();
+//! ```
+
+pub mod arch_impact;
+pub mod arch_static;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::{Args, CommandFactory, FromArgMatches, Parser};
+use rayon::prelude::*;
+use serde::Serialize;
+use voussoir::io::{vtk, write_json};
+use voussoir::Model;
+
+use crate::plot::LinePlot;
+use crate::progress;
+
+/// The error type of a run.
+pub type BoxError = Box<dyn std::error::Error>;
+
+/// Options every run takes.
+#[derive(Debug, Clone, Args)]
+pub struct CommonOptions {
+    /// Folder for the outputs; each run has its default, [`Run::OUT`].
+    #[arg(long, value_name = "DIR", help = "Folder for the outputs")]
+    pub out: PathBuf,
+    /// Do not write the ParaView series
+    #[arg(long)]
+    pub no_paraview: bool,
+}
+
+/// A run of the command line: its options (flattened beside [`CommonOptions`]) and what it does.
+pub trait Run: Args {
+    /// Name of the program (the example's).
+    const NAME: &'static str;
+    /// Default output folder.
+    const OUT: &'static str;
+    /// One line for `--help`.
+    const ABOUT: &'static str;
+    /// Runs with the parsed options, writing under `out`.
+    ///
+    /// # Errors
+    /// Whatever stops the run; `main` reports it and exits with status 1.
+    fn run(&self, out: &Outputs) -> Result<(), BoxError>;
+}
+
+#[derive(Debug, Parser)]
+struct Cli<R: Run> {
+    #[command(flatten)]
+    common: CommonOptions,
+    #[command(flatten)]
+    run: R,
+}
+
+/// Parses the command line into `R` and [`CommonOptions`], runs, reports the output folder and
+/// the wall time; on an error prints `NAME: error` and exits with status 1.
+pub fn main<R: Run>() {
+    let (common, run) = parse::<R>(std::env::args_os()).unwrap_or_else(|e| e.exit());
+    let out = Outputs::new(&common);
+    if let Err(e) = run.run(&out) {
+        eprintln!("{}: {e}", R::NAME);
+        std::process::exit(1);
+    }
+    println!("outputs in {} ({:.1} s wall)", out.dir().display(), out.elapsed());
+}
+
+/// The command of run `R`: name, description, `--out`'s default; a repeated option keeps its
+/// last value.
+pub fn command<R: Run>() -> clap::Command {
+    Cli::<R>::command()
+        .name(R::NAME)
+        .bin_name(R::NAME)
+        .about(R::ABOUT)
+        .args_override_self(true)
+        .mut_arg("out", |a| a.required(false).default_value(R::OUT))
+}
+
+/// Parses `args` (program name first) for run `R`.
+///
+/// # Errors
+/// clap's, for a bad or unknown option or for `--help`.
+pub fn parse<R: Run>(
+    args: impl IntoIterator<Item = impl Into<std::ffi::OsString> + Clone>,
+) -> Result<(CommonOptions, R), clap::Error> {
+    let matches = command::<R>().try_get_matches_from(args)?;
+    let cli = Cli::<R>::from_arg_matches(&matches)?;
+    Ok((cli.common, cli.run))
+}
+
+/// A number that must be finite (spaces around it allowed).
+///
+/// # Errors
+/// A message for clap when it is not a number or not finite.
+pub fn finite(s: &str) -> Result<f64, String> {
+    let x: f64 = s.trim().parse().map_err(|_| format!("not a number: {s:?}"))?;
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(format!("not finite: {s:?}"))
+    }
+}
+
+/// Where a run writes, and since when it runs.
+#[derive(Debug)]
+pub struct Outputs {
+    dir: PathBuf,
+    paraview: bool,
+    started: Instant,
+}
+
+impl Outputs {
+    /// The output folder of `common`, timing from now.
+    pub fn new(common: &CommonOptions) -> Self {
+        Self {
+            dir: common.out.clone(),
+            paraview: !common.no_paraview,
+            started: Instant::now(),
+        }
+    }
+
+    /// The output folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Seconds since the run started.
+    pub fn elapsed(&self) -> f64 {
+        self.started.elapsed().as_secs_f64()
+    }
+
+    /// Runs `cases` in parallel behind a progress bar labelled `message`; `f` gets each case's
+    /// index. The results come in the order of the cases; the first error stops the run.
+    ///
+    /// # Errors
+    /// The first error of `f`.
+    pub fn run_all<C: Sync, T: Send>(
+        &self,
+        cases: &[C],
+        message: &str,
+        f: impl Fn(usize, &C) -> voussoir::Result<T> + Sync,
+    ) -> voussoir::Result<Vec<T>> {
+        let bar = progress::bar(cases.len() as u64, message);
+        let results = cases
+            .par_iter()
+            .enumerate()
+            .map(|(k, case)| {
+                let result = f(k, case);
+                bar.inc(1);
+                result
+            })
+            .collect::<voussoir::Result<Vec<T>>>()?;
+        bar.finish_and_clear();
+        Ok(results)
+    }
+
+    /// Runs `run` with a ParaView series `name` under `<out>/paraview`, a frame every `every`
+    /// (s), when `name` is given and `--no-paraview` is not; otherwise without frames. `run`
+    /// gets the frame interval and the frame callback, as the scenarios' `run` take them.
+    ///
+    /// # Errors
+    /// `run`'s.
+    pub fn with_frames<T>(
+        &self,
+        name: Option<&str>,
+        every: f64,
+        run: impl FnOnce(Option<f64>, &mut dyn FnMut(&Model) -> voussoir::Result<()>) -> voussoir::Result<T>,
+    ) -> voussoir::Result<T> {
+        match name.filter(|_| self.paraview) {
+            Some(name) => {
+                let mut series = vtk::Series::new(self.dir.join("paraview"), name);
+                run(Some(every), &mut |m| series.write_frame(m))
+            }
+            None => run(None, &mut |_| Ok(())),
+        }
+    }
+
+    /// Writes `value` as pretty JSON to `file` in the output folder.
+    ///
+    /// # Errors
+    /// [`voussoir::Error::Io`] naming the file.
+    pub fn json(&self, file: &str, value: &impl Serialize) -> voussoir::Result<()> {
+        write_json(&self.dir.join(file), value)
+    }
+
+    /// Writes `text` to `file` in the output folder, creating the folder.
+    ///
+    /// # Errors
+    /// The file system's.
+    pub fn text(&self, file: &str, text: &str) -> std::io::Result<()> {
+        std::fs::create_dir_all(&self.dir)?;
+        std::fs::write(self.dir.join(file), text)
+    }
+
+    /// Writes `plot` as SVG to `file` in the output folder.
+    ///
+    /// # Errors
+    /// [`voussoir::Error::Io`] naming the file.
+    pub fn svg(&self, file: &str, plot: &LinePlot) -> voussoir::Result<()> {
+        plot.write_svg(&self.dir.join(file))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::arch_impact::{Base, Guide, ImpactOptions, ReleaseAt};
+    use super::arch_static::StaticOptions;
+    use super::*;
+
+    fn impact(args: &[&str]) -> (CommonOptions, ImpactOptions) {
+        parse::<ImpactOptions>(std::iter::once("arch_impact").chain(args.iter().copied())).expect("parses")
+    }
+
+    fn statics(args: &[&str]) -> (CommonOptions, StaticOptions) {
+        parse::<StaticOptions>(std::iter::once("arch_static").chain(args.iter().copied())).expect("parses")
+    }
+
+    /// The defaults of the hand-written parsers that the front end replaced.
+    #[test]
+    fn defaults_are_the_old_ones() {
+        let (c, o) = impact(&[]);
+        assert_eq!(c.out, PathBuf::from("out/arch_impact"));
+        assert!(!c.no_paraview);
+        assert_eq!(o.setups, None);
+        assert_eq!((o.kn, o.damping, o.width, o.duration), (None, None, None, None));
+        assert_eq!(
+            (o.guide, o.base, o.release),
+            (Guide::Frame, Base::Sloped, ReleaseAt::Above)
+        );
+        assert_eq!(o.offsets_mm, [-0.5, -0.25, 0.0, 0.25, 0.5]);
+        assert!(!o.study && !o.compare_release);
+        let (c, o) = statics(&[]);
+        assert_eq!(c.out, PathBuf::from("out/arch_static"));
+        assert!(!c.no_paraview && !o.baseline_only && !o.no_sweep);
+        assert_eq!(o.friction, [27.0, 30.0, 30.5, 35.0]);
+    }
+
+    #[test]
+    fn options_parse_as_before() {
+        let (c, o) = impact(&[
+            "--out",
+            "x",
+            "--setup",
+            "M60H20,M75H45",
+            "--kn",
+            "8e9",
+            "--damping",
+            "0.02",
+            "--width",
+            "0.2",
+            "--duration",
+            "0.5",
+            "--guide",
+            "seat",
+            "--base",
+            "flat",
+            "--release",
+            "full",
+            "--offsets",
+            "-0.5,0",
+            "--study",
+            "--compare-release",
+            "--no-paraview",
+        ]);
+        assert_eq!(c.out, PathBuf::from("x"));
+        assert!(c.no_paraview);
+        assert_eq!(o.setups, Some(vec!["M60H20".to_owned(), "M75H45".to_owned()]));
+        assert_eq!(
+            (o.kn, o.damping, o.width, o.duration),
+            (Some(8e9), Some(0.02), Some(0.2), Some(0.5))
+        );
+        assert_eq!((o.guide, o.base, o.release), (Guide::Seat, Base::Flat, ReleaseAt::Full));
+        assert_eq!(o.offsets_mm, [-0.5, 0.0]);
+        assert!(o.study && o.compare_release);
+        // A repeated option keeps its last value, as the old parsers did.
+        let (_, o) = statics(&[
+            "--friction",
+            "27",
+            "--friction",
+            "30.5,35",
+            "--baseline-only",
+            "--no-sweep",
+        ]);
+        assert_eq!(o.friction, [30.5, 35.0]);
+        assert!(o.baseline_only && o.no_sweep);
+        let (_, o) = impact(&["--kn", "1e9", "--kn", "2e9"]);
+        assert_eq!(o.kn, Some(2e9));
+    }
+
+    #[test]
+    fn bad_values_are_refused() {
+        let bad =
+            |args: &[&str]| parse::<ImpactOptions>(std::iter::once("arch_impact").chain(args.iter().copied())).is_err();
+        assert!(bad(&["--kn", "abc"]));
+        assert!(bad(&["--kn", "inf"]));
+        assert!(bad(&["--offsets", "0,NaN"]));
+        assert!(bad(&["--guide", "rail"]));
+        assert!(bad(&["--unknown"]));
+        assert!(parse::<StaticOptions>(["arch_static", "--friction", "x"]).is_err());
+    }
+
+    #[test]
+    fn the_command_is_consistent() {
+        command::<ImpactOptions>().debug_assert();
+        command::<StaticOptions>().debug_assert();
+    }
+}

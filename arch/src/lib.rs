@@ -1,0 +1,20 @@
+//! # voussoir-arch
+//!
+//! The reference arch of Pulatsu, Gonen & Lourenço (2021, Infrastructures 6(12):178) with
+//! [`voussoir`]: the paper's quasi-static load test and drop-weight impact tests, reproduced.
+//! Not published: this crate is the paper's data and tooling, kept apart from the library so that
+//! neither its dependencies (clap, plotters, indicatif) nor its values sit in the library's
+//! build and semver.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`scenarios`] | the runs as functions of their parameters, shared by the command line and the tests |
+//! | [`cli`] | one command line for the static and impact runs (`cargo run --release --example arch_static` / `arch_impact`) |
+//! | [`plot`] | SVG line plots |
+//! | [`progress`] | progress bars |
+#![warn(missing_docs)]
+
+pub mod cli;
+pub mod plot;
+pub mod progress;
+pub mod scenarios;
