@@ -43,7 +43,7 @@
 //! | [`geometry`] | polyhedra, mass properties, broad phase, contact polygon and sub-contacts |
 //! | [`block`] | the [`Block`] trait, ids, fixity, rigid blocks |
 //! | [`contact`] | the [`Contact`] trait, sub-contact state and kinematics |
-//! | [`constitutive`] | the [`ConstitutiveLaw`] trait and the shipped laws |
+//! | [`law`] | the [`ConstitutiveLaw`] trait and the shipped laws |
 //! | [`integrate`] | the [`Integrator`] trait, central difference, damping, critical step |
 //! | [`model`] | the [`Model`]: stepping, runs, energies |
 //! | [`monitor`] | observation: the [`monitor::Probe`] trait, built-in monitors, the recorder and histories |
@@ -70,7 +70,6 @@
 pub mod analysis;
 pub mod block;
 pub mod build;
-pub mod constitutive;
 pub mod contact;
 mod dispatch;
 pub mod error;
@@ -80,15 +79,16 @@ pub mod integrate;
 #[cfg(feature = "io")]
 #[cfg_attr(docsrs, doc(cfg(feature = "io")))]
 pub mod io;
+pub mod law;
 pub mod math;
 pub mod model;
 pub mod monitor;
 
 pub use block::{Block, BlockId, RigidBlock};
-pub use constitutive::ConstitutiveLaw;
 pub use contact::Contact;
 pub use error::{Error, Result};
 pub use integrate::Integrator;
+pub use law::ConstitutiveLaw;
 pub use model::{Model, ModelParameters};
 
 // Fails to compile if our glam and parry's glam ever diverge.
@@ -99,13 +99,11 @@ const _: fn(parry3d_f64::glamx::DPose3) -> parry3d_f64::math::Pose = |p| p;
 /// The names most programs need.
 pub mod prelude {
     pub use crate::block::{Block, BlockId, Dof, Fixity, RigidBlock, Wrench};
-    pub use crate::constitutive::{
-        AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, JointTable, LinearElastic, MaterialId,
-    };
     pub use crate::contact::{Contact, DisplacementMode};
     pub use crate::error::{Error, Result};
     pub use crate::geometry::{ContactParameters, SubcontactDensity};
     pub use crate::integrate::{CentralDifference, Damping, Integrator, TimeStep};
+    pub use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, JointTable, LinearElastic, MaterialId};
     pub use crate::math::{Pose, Real, Rotation, Vector};
     pub use crate::model::{Energies, Model, ModelParameters, Observer};
     pub use crate::monitor::{Component, EnergyTerm, Monitor, MonitorId, Probe, Recorder};

@@ -37,9 +37,9 @@ use serde::{Deserialize, Serialize};
 pub use crate::ids::MonitorId;
 
 use crate::block::Block;
-use crate::constitutive::ConstitutiveLaw;
 use crate::error::Result;
 use crate::ids::BlockId;
+use crate::law::ConstitutiveLaw;
 use crate::math::{Real, Vector};
 use crate::model::{Model, Observer};
 

@@ -13,8 +13,8 @@
 //! then softens to `N·tan φ` once it has slipped `u_soft`.
 
 use serde::{Deserialize, Serialize};
-use voussoir::constitutive::{conformance, AnyLaw, ElasticRegime};
-use voussoir::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus, JointStep, JointStiffness};
+use voussoir::law::{conformance, AnyLaw, ElasticRegime};
+use voussoir::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus, JointStep, JointStiffness};
 use voussoir::math::Vector2;
 use voussoir::prelude::*;
 
@@ -493,7 +493,7 @@ fn law_state_survives_a_checkpoint() {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The law contract, checked by `voussoir::constitutive::conformance`.
+// The law contract, checked by `voussoir::law::conformance`.
 
 /// The softening law keeps the contract: its updates are deterministic, finite, force-free when
 /// open, no stiffer than `stiffness()`, with non-negative energies and dissipation on monotonic
@@ -546,7 +546,7 @@ fn shipped_laws_and_any_law_conform() {
 /// state, side by side.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct MixedState {
-    coulomb: voussoir::constitutive::CoulombState,
+    coulomb: voussoir::law::CoulombState,
     softening: SofteningState,
 }
 

@@ -1,8 +1,8 @@
 //! Two kinds of law in one model through `AnyLaw`: each part of the scene moves, bit for bit, as
 //! it does in a model of its own law alone.
 
-use voussoir::constitutive::AnyLaw;
 use voussoir::integrate::TimeStep;
+use voussoir::law::AnyLaw;
 use voussoir::prelude::*;
 
 const STONE: MaterialId = MaterialId(0);

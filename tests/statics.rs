@@ -13,7 +13,7 @@
 //! Closed forms are written out from the geometry and the loads; nothing is read back from a
 //! previous run.
 
-use voussoir::constitutive::JointStatus;
+use voussoir::law::JointStatus;
 use voussoir::prelude::*;
 
 /// Gravity (m/s²), the model default, pointing along −z.

@@ -17,8 +17,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Block, BlockId, RigidBlock};
-use crate::constitutive::ConstitutiveLaw;
 use crate::contact::Contact;
+use crate::law::ConstitutiveLaw;
 use crate::math::{Real, Vector};
 use crate::model::Model;
 

@@ -7,8 +7,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Fixity, RigidBlock};
-use crate::constitutive::MaterialId;
 use crate::error::{positive, Error, Result};
+use crate::law::MaterialId;
 use crate::math::{Real, Vector};
 
 /// A semicircular barrel vault: `rings` arch rings side by side along `z`, each of `voussoirs`

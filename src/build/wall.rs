@@ -4,8 +4,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Fixity, RigidBlock};
-use crate::constitutive::MaterialId;
 use crate::error::{positive, Result};
+use crate::law::MaterialId;
 use crate::math::{Real, Vector};
 
 /// A running-bond wall: courses of bricks along x, stacked in z, one brick thick in y, on a fixed

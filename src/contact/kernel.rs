@@ -7,7 +7,7 @@ use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
 use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
-use crate::constitutive::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
+use crate::law::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
 use crate::math::{Matrix, Real, Vector, Vector2};
 
 /// What a contact's update returns besides what it stores in the contact: its wrench on the two

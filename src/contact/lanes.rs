@@ -13,7 +13,7 @@ use std::ops::{Add, Mul, Sub};
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::ForceMoments;
 use super::SubContact;
-use crate::constitutive::{ConstitutiveLaw, JointAxes};
+use crate::law::{ConstitutiveLaw, JointAxes};
 use crate::math::{Real, Vector, Vector2};
 
 /// Sub-contacts per group.

@@ -2,7 +2,7 @@
 //! goes through, with the energy it dissipates, and the skip test for open sub-contacts.
 
 use super::SubContact;
-use crate::constitutive::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
+use crate::law::{ConstitutiveLaw, JointAxes, JointStatus, JointStep};
 use crate::math::{Real, Vector2};
 
 /// Calls the law on one sub-contact with this step's gap and increments, and stores what it

@@ -16,9 +16,9 @@ pub use view::{Contact, ContactView, SubContactSample, SubContactView};
 
 pub use crate::ids::ContactId;
 
-use crate::constitutive::{JointAxes, JointForce, JointStatus};
 use crate::geometry::Polyhedron;
 use crate::geometry::{ContactKind, SubKey};
+use crate::law::{JointAxes, JointForce, JointStatus};
 use crate::math::{Pose, Real, Rotation, Vector, Vector2};
 
 /// Whether contact geometry follows the blocks.
@@ -140,7 +140,7 @@ mod tests {
     /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
     #[test]
     fn subcontact_is_72_bytes_with_coulomb_state() {
-        use crate::constitutive::CoulombState;
+        use crate::law::CoulombState;
         assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 72);
     }
 }
@@ -319,7 +319,7 @@ impl AnchorPlane {
 
 /// A sub-contact: a point of a joint with a tributary area, its spring forces, its accumulated
 /// slip and the law's state — what the step reads and writes for every sub-contact, and nothing
-/// else (72 bytes with [`crate::constitutive::CoulombSlip`]'s state). Its position is given by
+/// else (72 bytes with [`crate::law::CoulombSlip`]'s state). Its position is given by
 /// two coordinates on the contact's [`AnchorPlane`], its shear force by two components along the
 /// joint's tangents ([`JointAxes`]). Its identity, dashpot force and gap offset sit in a parallel
 /// [`SubContactRecord`]; its world position and forces follow from the contact, see

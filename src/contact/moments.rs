@@ -2,7 +2,7 @@
 //! resultant, moment and work without visiting the sub-contacts again.
 
 use super::SubContact;
-use crate::constitutive::{JointAxes, JointForce};
+use crate::law::{JointAxes, JointForce};
 use crate::math::{Real, Vector, Vector2};
 
 /// Three world vectors tied to a contact's anchor plane: a value at the plane origin and its

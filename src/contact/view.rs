@@ -7,9 +7,9 @@
 //! the law-free [`Contact`] trait.
 
 use super::{AnchorPlane, ContactPair, ContactWrench, SubContact, SubContactRecord};
-use crate::constitutive::{JointAxes, JointStatus};
 use crate::geometry::{ContactKind, SubKey};
 use crate::ids::BlockId;
+use crate::law::{JointAxes, JointStatus};
 use crate::math::{Pose, Real, Vector, Vector2};
 
 /// A law-free read interface of a joint between two blocks: what outputs and analyses need,
@@ -140,7 +140,7 @@ impl<'a, S> ContactView<'a, S> {
     pub fn normal_force(&self) -> Real {
         self.pair.normal_force
     }
-    /// Index of the joint law in the model's [`crate::constitutive::JointTable`].
+    /// Index of the joint law in the model's [`crate::law::JointTable`].
     pub fn law_index(&self) -> usize {
         self.pair.law as usize
     }

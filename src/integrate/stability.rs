@@ -5,7 +5,7 @@
 
 use super::{Stiffness6, StiffnessBound};
 use crate::block::{Block, RigidBlock};
-use crate::constitutive::JointStiffness;
+use crate::law::JointStiffness;
 use crate::math::{Real, Rotation, Vector};
 
 /// What the stability bound needs of one contact: its blocks, normal, spring stiffness and the

@@ -9,10 +9,10 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use crate::block::{Block, Fixity, RigidBlock, Wrench};
-use crate::constitutive::{ConstitutiveLaw, MaterialId};
 use crate::error::{Error, Result};
 use crate::integrate::Damping;
 use crate::io::io_error;
+use crate::law::{ConstitutiveLaw, MaterialId};
 use crate::math::Vector;
 use crate::model::{Model, ModelParameters};
 use crate::monitor::{Monitor, Recorder};

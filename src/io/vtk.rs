@@ -10,9 +10,9 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::block::Block;
-use crate::constitutive::{ConstitutiveLaw, JointStatus};
 use crate::error::Result;
 use crate::io::io_error;
+use crate::law::{ConstitutiveLaw, JointStatus};
 use crate::math::Real;
 use crate::model::Model;
 

@@ -1,7 +1,7 @@
 //! The ready-made model of the benchmarks: a settling running-bond wall.
 
-use crate::constitutive::MaterialId;
 use crate::error::{positive, Result};
+use crate::law::MaterialId;
 use crate::math::Real;
 
 /// Sub-contact spacing of [`benchmark_wall`] (m): 9 × 5 nodes on a 0.2 × 0.1 m bed face.
@@ -48,7 +48,7 @@ pub fn benchmark_wall_with_spacing(blocks: usize, spacing: Real) -> Result<crate
     model.set_joint_law(
         MaterialId(0),
         MaterialId(0),
-        crate::constitutive::CoulombSlip::dry(1e9, 4e8, 30.0)?,
+        crate::law::CoulombSlip::dry(1e9, 4e8, 30.0)?,
     )?;
     for b in running_bond_wall(&WallSpec::with_blocks(blocks))? {
         model.add_block(b)?;

@@ -10,14 +10,14 @@ use serde::{Deserialize, Serialize};
 
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
-use crate::constitutive::{ConstitutiveLaw, JointTable};
-use crate::constitutive::{JointForce, JointStatus};
 use crate::contact::{
     AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
 };
 use crate::error::{io_error, Error, Result};
 use crate::geometry::{ContactKind, SubKey};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
+use crate::law::{ConstitutiveLaw, JointTable};
+use crate::law::{JointForce, JointStatus};
 use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
 use crate::model::Energies;
 

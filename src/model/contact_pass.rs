@@ -9,11 +9,11 @@
 //! afterwards, so that they do not depend on the number of threads.
 
 use crate::block::RigidBlock;
-use crate::constitutive::ConstitutiveLaw;
 use crate::contact::{
     update_contact, ContactPair, ContactReference, ContactWrench, KernelContext, SubContact, SubContactRecord,
 };
 use crate::integrate::StiffnessBound;
+use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real};
 
 /// Contacts per chunk of the contact pass: sums are taken per chunk, then over the chunks in

@@ -5,13 +5,13 @@ use rayon::prelude::*;
 use super::changes::Changes;
 use super::{Model, BLOCK_CHUNK};
 use crate::block::{Block, BlockId};
-use crate::constitutive::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::contact::{
     AnchorPlane, ContactPair, ContactReference, ContactWrench, DisplacementMode, ForceMoments, SubContact,
     SubContactRecord,
 };
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, BroadPhase, NarrowPhaseScratch, SubcontactSeed};
+use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Real, Vector};
 
 /// Buffers reused from one detection to the next.

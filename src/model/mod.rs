@@ -20,7 +20,6 @@ pub use energy::Energies;
 pub use observe::Observer;
 
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
-use crate::constitutive::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
 use crate::contact::{
     ContactPair, ContactReference, ContactView, ContactWrench, DisplacementMode, KernelContext, SubContact,
     SubContactRecord,
@@ -28,6 +27,7 @@ use crate::contact::{
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
+use crate::law::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
 use crate::math::{is_finite_vector, Matrix, Pose, Real, Vector};
 
 use changes::Changes;
@@ -842,8 +842,8 @@ impl<L: ConstitutiveLaw> Model<L> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constitutive::JointStatus;
     use crate::contact::update_contact;
+    use crate::law::JointStatus;
 
     /// The AVX2 builds of the contact pass and the integrator and the portable ones give
     /// bit-identical results (no
@@ -908,10 +908,7 @@ mod tests {
     /// checks that each sub-contact gets bit for bit the same forces, gap, status, law state and
     /// slip, and each contact the same sums to round-off. Returns the numbers of sub-contacts
     /// compared, sliding, open, and in point contacts.
-    fn compare_loops<L: ConstitutiveLaw<State = crate::constitutive::CoulombState>>(
-        model: &Model,
-        law: &L,
-    ) -> [usize; 4] {
+    fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &Model, law: &L) -> [usize; 4] {
         let ctx = KernelContext {
             dt: model.dt,
             impact_speed: Real::INFINITY,
@@ -991,14 +988,14 @@ mod tests {
     struct WithoutRegime(CoulombSlip);
 
     impl ConstitutiveLaw for WithoutRegime {
-        type State = crate::constitutive::CoulombState;
-        fn stiffness(&self) -> crate::constitutive::JointStiffness {
+        type State = crate::law::CoulombState;
+        fn stiffness(&self) -> crate::law::JointStiffness {
             self.0.stiffness()
         }
         fn update(
             &self,
-            step: &crate::constitutive::JointStep,
-            force: &mut crate::constitutive::JointForce,
+            step: &crate::law::JointStep,
+            force: &mut crate::law::JointForce,
             state: &mut Self::State,
         ) -> JointStatus {
             self.0.update(step, force, state)
@@ -1009,7 +1006,7 @@ mod tests {
     }
 
     /// Both loops for contacts without dashpot forces — sub-contacts in their elastic regime
-    /// first (a law with an [`crate::constitutive::ElasticRegime`]), four at a time (a law
+    /// first (a law with an [`crate::law::ElasticRegime`]), four at a time (a law
     /// without) — give each sub-contact bit for bit the forces, gap, status, law state and slip
     /// of the one-at-a-time loop (which runs when the contact has dashpot forces); only the
     /// contact sums of the four-at-a-time loop, taken in another order, differ by round-off.
@@ -1064,8 +1061,8 @@ mod tests {
     /// fresh one; reading the components in fresh axes would turn every shear force by 40°.
     #[test]
     fn redetection_carries_shear_forces_in_turned_axes() {
-        use crate::constitutive::JointAxes;
         use crate::geometry::SubKey;
+        use crate::law::JointAxes;
         use crate::math::Pose;
         let mut model: Model = Model::new(ModelParameters::default()).expect("model");
         model

@@ -13,9 +13,9 @@ use rayon::prelude::*;
 use super::detection::prepare_chunk;
 use super::{diverged, BlockSums, Model, BLOCK_CHUNK};
 use crate::block::{Block, RigidBlock, Wrench};
-use crate::constitutive::ConstitutiveLaw;
 use crate::contact::{ContactWrench, DisplacementMode};
 use crate::integrate::{Integrator, StepDurations, StepRecord};
+use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real, Vector};
 
 /// What the per-block stages read besides the block itself.

@@ -4,8 +4,8 @@
 use std::ops::ControlFlow;
 
 use super::Model;
-use crate::constitutive::ConstitutiveLaw;
 use crate::error::Result;
+use crate::law::ConstitutiveLaw;
 use crate::math::Real;
 
 /// What a run calls after each step: a recorder, a progress bar, a stopping condition. Return

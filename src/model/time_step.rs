@@ -2,9 +2,9 @@
 //! ([`crate::integrate::Integrator::critical_step`]), then the step the parameters ask for.
 
 use super::Model;
-use crate::constitutive::ConstitutiveLaw;
 use crate::error::{Error, Result};
 use crate::integrate::{AreaMoments, ContactStiffness, TimeStep};
+use crate::law::ConstitutiveLaw;
 use crate::math::{Real, Vector};
 
 impl<L: ConstitutiveLaw> Model<L> {

@@ -33,9 +33,9 @@ use serde::{Deserialize, Serialize};
 use super::{in_range, non_negative, positive};
 use voussoir::block::{Block, BlockId, Dof, Fixity, RigidBlock};
 use voussoir::build::arch::Arch;
-use voussoir::constitutive::CoulombSlip;
 use voussoir::error::{Error, Result};
 use voussoir::integrate::Damping;
+use voussoir::law::CoulombSlip;
 use voussoir::math::{Real, Vector};
 use voussoir::model::Model;
 

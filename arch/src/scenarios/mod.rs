@@ -6,10 +6,10 @@ pub mod arch_impact;
 pub mod arch_static;
 
 use voussoir::build::arch::{Arch, ArchSpec};
-use voussoir::constitutive::{CoulombSlip, MaterialId};
 use voussoir::contact::DisplacementMode;
 use voussoir::error::{Error, Result};
 use voussoir::geometry::{ContactParameters, SubcontactDensity};
+use voussoir::law::{CoulombSlip, MaterialId};
 use voussoir::math::{Real, Vector};
 use voussoir::model::{Model, ModelParameters};
 

@@ -40,7 +40,7 @@ pub struct JointStiffness {
 /// turns (see `docs/theory.md`, "Sub-contact kinematics").
 ///
 /// ```
-/// use voussoir::constitutive::JointAxes;
+/// use voussoir::law::JointAxes;
 /// use voussoir::math::{Vector, Vector2};
 /// let axes = JointAxes::from_normal(Vector::Z);
 /// let s = Vector::new(3.0, -4.0, 0.0);
@@ -124,7 +124,7 @@ pub struct JointForce {
 /// `L = c·A + F_n·tan φ ≥ 0`, computed in exactly this order ([`ElasticRegime::trial`]).
 ///
 /// ```
-/// use voussoir::constitutive::{ConstitutiveLaw, CoulombSlip, ElasticRegime};
+/// use voussoir::law::{ConstitutiveLaw, CoulombSlip, ElasticRegime};
 /// use voussoir::math::Vector2;
 /// let law = CoulombSlip::dry(1e9, 4e8, 30.0)?;
 /// let regime = law.elastic_regime().expect("Coulomb slip has one");
@@ -198,8 +198,8 @@ pub enum JointStatus {
 /// See `docs/custom-law.md` for a walk-through. A minimal law, frictionless and no-tension:
 ///
 /// ```
-/// use voussoir::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
-/// use voussoir::constitutive::JointAxes;
+/// use voussoir::law::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
+/// use voussoir::law::JointAxes;
 /// use voussoir::math::{Vector, Vector2};
 ///
 /// #[derive(Debug, Clone)]
@@ -293,7 +293,7 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
 /// The joint law of each pair of block materials (the pair is unordered).
 ///
 /// ```
-/// use voussoir::constitutive::{CoulombSlip, JointTable, MaterialId};
+/// use voussoir::law::{CoulombSlip, JointTable, MaterialId};
 /// let stone = MaterialId(0);
 /// let steel = MaterialId(1);
 /// let mut joints = JointTable::new();

@@ -28,7 +28,7 @@ use crate::math::Real;
 /// [`CoulombSlip`] is validated as it is read.
 ///
 /// ```
-/// use voussoir::constitutive::{conformance, AnyLaw};
+/// use voussoir::law::{conformance, AnyLaw};
 /// use voussoir::prelude::*;
 ///
 /// const STONE: MaterialId = MaterialId(0);
@@ -80,7 +80,7 @@ pub enum AnyLaw {
 /// it would its own. The struct is `Copy` and as small as the states it holds (one byte today).
 ///
 /// ```
-/// use voussoir::constitutive::{AnyLaw, AnyState, ConstitutiveLaw, CoulombSlip};
+/// use voussoir::law::{AnyLaw, AnyState, ConstitutiveLaw, CoulombSlip};
 /// let law = AnyLaw::from(CoulombSlip::new(1e9, 4e8, 30.0, 25.0, 1e5, 5e4)?);
 /// let mut state = AnyState::default();
 /// assert!(!law.is_failed(&state));
@@ -169,7 +169,7 @@ impl ConstitutiveLaw for AnyLaw {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constitutive::JointAxes;
+    use crate::law::JointAxes;
     use crate::math::{Vector, Vector2};
 
     fn coulomb_laws() -> [CoulombSlip; 3] {

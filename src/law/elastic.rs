@@ -57,7 +57,7 @@ mod tests {
     use super::*;
     use crate::math::Vector2;
 
-    /// The law keeps the contract ([`crate::constitutive::conformance`]): in compression the
+    /// The law keeps the contract ([`crate::law::conformance`]): in compression the
     /// trial of its elastic regime is `update`, bit for bit, whatever the shear.
     #[test]
     fn conforms_to_the_law_contract() {
@@ -65,7 +65,7 @@ mod tests {
             normal_stiffness: 3e9,
             shear_stiffness: 1.2e9,
         };
-        let report = crate::constitutive::conformance::check(&law).expect("conforms");
+        let report = crate::law::conformance::check(&law).expect("conforms");
         assert!(report.regime_stood > 1000 && report.open_promised == 0, "{report:?}");
     }
 

@@ -46,8 +46,8 @@
 //! inner law's shows whether it forwards the shortcuts.
 //!
 //! ```
-//! use voussoir::constitutive::conformance::{self, Clause};
-//! use voussoir::constitutive::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
+//! use voussoir::law::conformance::{self, Clause};
+//! use voussoir::law::{ConstitutiveLaw, JointForce, JointStatus, JointStep, JointStiffness};
 //! use voussoir::math::Vector2;
 //!
 //! /// Frictionless, no tension; open when not compressed.
@@ -602,7 +602,7 @@ fn booked_dissipation<L: ConstitutiveLaw>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::constitutive::{AnyLaw, CoulombSlip, CoulombState, ElasticRegime, JointStiffness, LinearElastic};
+    use crate::law::{AnyLaw, CoulombSlip, CoulombState, ElasticRegime, JointStiffness, LinearElastic};
 
     fn coulomb_laws() -> [CoulombSlip; 4] {
         [

@@ -325,11 +325,11 @@ mod tests {
     }
 
     /// Dry, cohesive and bonded joints keep the law contract (`elastic_regime` and `stays_open`
-    /// agree with `update`, see [`crate::constitutive::conformance`]), and offer both shortcuts.
+    /// agree with `update`, see [`crate::law::conformance`]), and offer both shortcuts.
     #[test]
     fn conforms_to_the_law_contract() {
         for law in laws() {
-            let report = crate::constitutive::conformance::check(&law).unwrap_or_else(|e| panic!("{law:?}: {e}"));
+            let report = crate::law::conformance::check(&law).unwrap_or_else(|e| panic!("{law:?}: {e}"));
             assert!(report.regime_stood > 1000 && report.open_promised > 100, "{report:?}");
         }
     }
