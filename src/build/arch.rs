@@ -22,7 +22,7 @@ pub struct AbutmentShape {
 }
 
 impl Default for AbutmentShape {
-    /// 0.20 m beyond the extrados springing, 0.30 m deep: the outline of `BENCHMARKS.md` §1.
+    /// 0.20 m beyond the extrados springing, 0.30 m deep: the outline of the reference arch (`docs/benchmarks/arch-static.md`, Model).
     fn default() -> Self {
         Self {
             outer_width: 0.20,
@@ -281,7 +281,7 @@ mod tests {
     use super::*;
     use crate::block::Block;
 
-    /// `BENCHMARKS.md` §1: joint coordinates, section area, load point, extrados slope.
+    /// The reference arch (`docs/benchmarks/arch-static.md`): joint coordinates, section area, load point, extrados slope.
     #[test]
     fn reference_arch_matches_the_benchmark_table() {
         let spec = ArchSpec::reference(0.15);

@@ -1,5 +1,5 @@
 //! The six drop-weight impact tests of the reference arch (Pulatsu, Gonen & Lourenço 2021;
-//! `BENCHMARKS.md` §4).
+//! `docs/benchmarks/arch-impact.md`).
 //!
 //! ```text
 //! cargo run --release --example arch_impact                       # six setups × five drop heights
@@ -552,7 +552,7 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
         cases.len()
     );
     println!(
-        "Adopted (BENCHMARKS.md): width {} m; impactor {} m along the span × {} m × width, {};",
+        "Adopted (docs/benchmarks/arch-impact.md): width {} m; impactor {} m along the span × {} m × width, {};",
         base.width,
         base.impactor_length,
         base.impactor_height,

@@ -1,4 +1,4 @@
-//! The quasi-static test of the reference arch (Pulatsu, Gonen & Lourenço 2021; `BENCHMARKS.md` §3).
+//! The quasi-static test of the reference arch (Pulatsu, Gonen & Lourenço 2021; `docs/benchmarks/arch-static.md`).
 //!
 //! ```text
 //! cargo run --release --example arch_static                 # baseline + every study, in parallel
@@ -192,7 +192,7 @@ fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
         cases.len()
     );
     println!(
-        "Adopted values (BENCHMARKS.md): width {} m; plate {:.2} m × {} m steel, vertical velocity only",
+        "Adopted values (docs/benchmarks/arch-static.md): width {} m; plate {:.2} m × {} m steel, vertical velocity only",
         base.width, base.plate_length, base.plate_thickness
     );
     println!(

@@ -1,4 +1,4 @@
-//! The drop-weight impact tests of the reference arch (`BENCHMARKS.md` §4).
+//! The drop-weight impact tests of the reference arch (Pulatsu, Gonen & Lourenço 2021; `docs/benchmarks/arch-impact.md`).
 //!
 //! Default model ([`ImpactorGuide::Frame`], as the paper's §4.2: "new rigid blocks are added to
 //! simulate the frame and the free-falling object … noncohesive bonds between the falling object
@@ -61,7 +61,7 @@ pub struct ImpactSetup {
     pub max_accel: Real,
 }
 
-/// The six tests of the paper (Table 3 and §4 of `BENCHMARKS.md`).
+/// The six tests of the paper (the paper's Table 3; `docs/benchmarks/arch-impact.md`).
 pub fn setups() -> Vec<ImpactSetup> {
     let s = |name: &str, mass, height, collapsed, max_disp, max_velocity, max_accel| ImpactSetup {
         name: name.into(),

@@ -1,4 +1,4 @@
-//! The quasi-static test of the reference arch (`BENCHMARKS.md` §3): a displacement-controlled
+//! The quasi-static test of the reference arch (Pulatsu, Gonen & Lourenço 2021; `docs/benchmarks/arch-static.md`): a displacement-controlled
 //! vertical load on voussoir 5 through a plate that does not restrain it horizontally.
 //!
 //! Model: the arch of [`voussoir::build::arch::ArchSpec::reference`]; a steel plate seated on the extrados of voussoir 5
