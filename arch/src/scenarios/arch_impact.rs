@@ -26,6 +26,7 @@
 //! the ring thickness below its settled position. First-impact peak: the largest downward
 //! quarter-span displacement until the impactor first moves up (its first rebound).
 
+use std::ops::ControlFlow;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -575,6 +576,161 @@ fn impact_force(model: &Model, targets: &[BlockId], impactor: BlockId) -> Real {
         .sum()
 }
 
+/// The impact run's observer: after every step, the contact check until the impactor first
+/// touches the arch, and every `sample_interval` of simulated time the histories, maxima and the
+/// collapse check; it stops the run at the case's duration, or 0.1 s after a collapse.
+struct ImpactRun<'a, F> {
+    case: &'a ImpactCase,
+    targets: &'a [BlockId],
+    /// Ring blocks whose potential energy is tracked: id, mass, settled height.
+    ring: &'a [(BlockId, Real, Real)],
+    arch: &'a Arch,
+    settled: &'a [Vector],
+    impactor: BlockId,
+    quarter: Vector,
+    q_block: BlockId,
+    q_settled: Vector,
+    /// Energies just before release.
+    e0: voussoir::model::Energies,
+    impactor_start: voussoir::math::Pose,
+    t0: Real,
+    frame_every: Option<Real>,
+    on_frame: &'a mut F,
+    /// The impactor's downward speed before the step just taken.
+    before: Real,
+    samples: Vec<ImpactSample>,
+    last_v: Real,
+    next_sample: Real,
+    next_frame: Real,
+    first_peak: Real,
+    first_done: bool,
+    impact_started: bool,
+    contact_speed: Real,
+    contact_time: Real,
+    contact_dt: Real,
+    max_disp: Real,
+    max_v: Real,
+    max_a: Real,
+    max_f: Real,
+    max_excess: Real,
+    max_rise: Real,
+    max_rise_time: Real,
+    max_drift: [Real; 2],
+    max_rot: Real,
+    max_error: Real,
+    collapse_time: Option<Real>,
+    last_sample_t: Real,
+}
+
+impl<F: FnMut(&Model) -> Result<()>> voussoir::model::Observer<CoulombSlip> for ImpactRun<'_, F> {
+    fn after_step(&mut self, model: &Model) -> Result<ControlFlow<()>> {
+        let before = self.before;
+        self.before = -model.blocks()[self.impactor.index()].state().velocity.y;
+        let case = self.case;
+        let t = model.time() - self.t0;
+        if !self.impact_started {
+            // Checked every step until the first contact, so the speed at contact is exact.
+            let force = impact_force(model, self.targets, self.impactor);
+            if force > 0.0 {
+                self.impact_started = true;
+                self.contact_speed = before;
+                self.contact_time = t;
+                self.contact_dt = model.dt();
+            }
+        }
+        if t + 1e-12 < self.next_sample && t < case.duration {
+            return Ok(ControlFlow::Continue(()));
+        }
+        self.next_sample += case.sample_interval;
+        let qb = &model.blocks()[self.q_block.index()];
+        let p = moved(model, self.q_block, self.quarter);
+        let disp = p.y - self.q_settled.y;
+        let velocity = qb.point_velocity(p).y;
+        let accel = if t > self.last_sample_t {
+            (velocity - self.last_v) / (t - self.last_sample_t)
+        } else {
+            0.0
+        };
+        self.last_v = velocity;
+        self.last_sample_t = t;
+        let force = impact_force(model, self.targets, self.impactor);
+        let e = model.energies();
+        let e0 = &self.e0;
+        let ib = &model.blocks()[self.impactor.index()];
+        let pose = ib.state().pose;
+        let drift = pose.translation - self.impactor_start.translation;
+        let rotation = (pose.rotation * self.impactor_start.rotation.inverse())
+            .to_axis_angle()
+            .1;
+        let arch_potential: Real = self
+            .ring
+            .iter()
+            .map(|&(id, m, y0)| m * GRAVITY * (model.blocks()[id.index()].state().pose.translation.y - y0))
+            .sum();
+        let sample = ImpactSample {
+            time: t,
+            disp,
+            velocity,
+            accel,
+            impact_force: force,
+            impactor_velocity: ib.state().velocity.y,
+            impactor_drift_x: drift.x,
+            impactor_drift_z: drift.z,
+            kinetic: e.kinetic,
+            impactor_kinetic: ib.kinetic_energy(),
+            arch_potential,
+            elastic: e.elastic - e0.elastic,
+            friction: e.friction - e0.friction,
+            damping: e.damping - e0.damping,
+            gravity_work: e.gravity_work - e0.gravity_work,
+            input: e.input() - e0.input(),
+            accounted: e.accounted() - e0.accounted(),
+        };
+        if self.impact_started && !self.first_done {
+            self.first_peak = self.first_peak.max(-disp);
+            // The first impact ends when the impactor first moves up (its rebound); if it rides
+            // the arch down, the first peak is the overall maximum. (The contact force is no
+            // measure of it: the impactor chatters on the arch within the first milliseconds.)
+            if sample.impactor_velocity > 0.0 {
+                self.first_done = true;
+            }
+        }
+        if self.impact_started && disp > self.max_rise {
+            self.max_rise = disp;
+            self.max_rise_time = t;
+        }
+        self.max_disp = self.max_disp.max(-disp);
+        self.max_v = self.max_v.max(velocity.abs());
+        self.max_a = self.max_a.max(accel.abs());
+        self.max_f = self.max_f.max(force);
+        self.max_drift = [
+            self.max_drift[0].max(drift.x.abs()),
+            self.max_drift[1].max(drift.z.abs()),
+        ];
+        self.max_rot = self.max_rot.max(rotation.abs());
+        self.max_excess = self.max_excess.max(sample.accounted - sample.input);
+        self.max_error = self.max_error.max((sample.accounted - sample.input).abs());
+        self.samples.push(sample);
+        if let Some(every) = self.frame_every {
+            if t >= self.next_frame {
+                (self.on_frame)(model)?;
+                self.next_frame += every;
+            }
+        }
+        if self.collapse_time.is_none() && collapsed_voussoir(model, self.arch, self.settled).is_some() {
+            self.collapse_time = Some(t);
+        }
+        // After a collapse, keep 0.1 s for the record, then stop.
+        Ok(
+            if t >= case.duration || self.collapse_time.is_some_and(|tc| t > tc + 0.1) {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            },
+        )
+    }
+}
+
 /// Runs a case.
 ///
 /// # Errors
@@ -620,116 +776,67 @@ pub fn run(
     model.set_fixity(impactor, fixity)?;
     model.set_velocity(impactor, Vector::new(0.0, -v_release, 0.0), Vector::ZERO)?;
     model.set_damping(Damping::rayleigh_stiffness(case.damping_ratio, case.damping_frequency)?)?;
-    let impactor_start = model.blocks()[impactor.index()].state().pose;
-    let t0 = model.time();
     let step0 = model.step_count();
-    let mut samples = Vec::new();
-    let mut last_v = 0.0;
-    let mut next_sample = 0.0;
-    let mut next_frame = 0.0;
-    let (mut first_peak, mut first_done, mut impact_started): (Real, bool, bool) = (0.0, false, false);
-    let (mut contact_speed, mut contact_time, mut contact_dt) = (v_release, Real::NAN, Real::NAN);
-    let (mut max_disp, mut max_v, mut max_a, mut max_f, mut max_excess): (Real, Real, Real, Real, Real) =
-        (0.0, 0.0, 0.0, 0.0, 0.0);
-    let (mut max_rise, mut max_rise_time): (Real, Real) = (0.0, 0.0);
-    let (mut max_drift, mut max_rot): ([Real; 2], Real) = ([0.0; 2], 0.0);
-    let mut max_error: Real = 0.0;
-    let mut collapse_time = None;
-    let mut last_sample_t = 0.0;
-    loop {
-        let before = -model.blocks()[impactor.index()].state().velocity.y;
-        model.step()?;
-        let t = model.time() - t0;
-        if !impact_started {
-            // Checked every step until the first contact, so the speed at contact is exact.
-            let force = impact_force(model, &targets, impactor);
-            if force > 0.0 {
-                impact_started = true;
-                contact_speed = before;
-                contact_time = t;
-                contact_dt = model.dt();
-            }
-        }
-        if t + 1e-12 < next_sample && t < case.duration {
-            continue;
-        }
-        next_sample += case.sample_interval;
-        let qb = &model.blocks()[q_block.index()];
-        let p = moved(model, q_block, quarter);
-        let disp = p.y - q_settled.y;
-        let velocity = qb.point_velocity(p).y;
-        let accel = if t > last_sample_t {
-            (velocity - last_v) / (t - last_sample_t)
-        } else {
-            0.0
-        };
-        last_v = velocity;
-        last_sample_t = t;
-        let force = impact_force(model, &targets, impactor);
-        let e = model.energies();
-        let ib = &model.blocks()[impactor.index()];
-        let pose = ib.state().pose;
-        let drift = pose.translation - impactor_start.translation;
-        let rotation = (pose.rotation * impactor_start.rotation.inverse()).to_axis_angle().1;
-        let arch_potential: Real = ring
-            .iter()
-            .map(|&(id, m, y0)| m * GRAVITY * (model.blocks()[id.index()].state().pose.translation.y - y0))
-            .sum();
-        let sample = ImpactSample {
-            time: t,
-            disp,
-            velocity,
-            accel,
-            impact_force: force,
-            impactor_velocity: ib.state().velocity.y,
-            impactor_drift_x: drift.x,
-            impactor_drift_z: drift.z,
-            kinetic: e.kinetic,
-            impactor_kinetic: ib.kinetic_energy(),
-            arch_potential,
-            elastic: e.elastic - e0.elastic,
-            friction: e.friction - e0.friction,
-            damping: e.damping - e0.damping,
-            gravity_work: e.gravity_work - e0.gravity_work,
-            input: e.input() - e0.input(),
-            accounted: e.accounted() - e0.accounted(),
-        };
-        if impact_started && !first_done {
-            first_peak = first_peak.max(-disp);
-            // The first impact ends when the impactor first moves up (its rebound); if it rides
-            // the arch down, the first peak is the overall maximum. (The contact force is no
-            // measure of it: the impactor chatters on the arch within the first milliseconds.)
-            if sample.impactor_velocity > 0.0 {
-                first_done = true;
-            }
-        }
-        if impact_started && disp > max_rise {
-            max_rise = disp;
-            max_rise_time = t;
-        }
-        max_disp = max_disp.max(-disp);
-        max_v = max_v.max(velocity.abs());
-        max_a = max_a.max(accel.abs());
-        max_f = max_f.max(force);
-        max_drift = [max_drift[0].max(drift.x.abs()), max_drift[1].max(drift.z.abs())];
-        max_rot = max_rot.max(rotation.abs());
-        max_excess = max_excess.max(sample.accounted - sample.input);
-        max_error = max_error.max((sample.accounted - sample.input).abs());
-        samples.push(sample);
-        if let Some(every) = frame_every {
-            if t >= next_frame {
-                on_frame(model)?;
-                next_frame += every;
-            }
-        }
-        if collapse_time.is_none() && collapsed_voussoir(model, &arch, &settled).is_some() {
-            collapse_time = Some(t);
-        }
-        // After a collapse, keep 0.1 s for the record, then stop.
-        if t >= case.duration || collapse_time.is_some_and(|tc| t > tc + 0.1) {
-            break;
-        }
-    }
+    let mut run = ImpactRun {
+        case,
+        targets: &targets,
+        ring: &ring,
+        arch: &arch,
+        settled: &settled,
+        impactor,
+        quarter,
+        q_block,
+        q_settled,
+        e0,
+        impactor_start: model.blocks()[impactor.index()].state().pose,
+        t0: model.time(),
+        frame_every,
+        on_frame: &mut on_frame,
+        before: -model.blocks()[impactor.index()].state().velocity.y,
+        samples: Vec::new(),
+        last_v: 0.0,
+        next_sample: 0.0,
+        next_frame: 0.0,
+        first_peak: 0.0,
+        first_done: false,
+        impact_started: false,
+        contact_speed: v_release,
+        contact_time: Real::NAN,
+        contact_dt: Real::NAN,
+        max_disp: 0.0,
+        max_v: 0.0,
+        max_a: 0.0,
+        max_f: 0.0,
+        max_excess: 0.0,
+        max_rise: 0.0,
+        max_rise_time: 0.0,
+        max_drift: [0.0; 2],
+        max_rot: 0.0,
+        max_error: 0.0,
+        collapse_time: None,
+        last_sample_t: 0.0,
+    };
+    // Until the observer stops the run: the duration, or 0.1 s after a collapse.
+    model.run_observed(u64::MAX, &mut run)?;
+    let ImpactRun {
+        samples,
+        first_peak,
+        contact_speed,
+        contact_time,
+        contact_dt,
+        max_disp,
+        max_v,
+        max_a,
+        max_f,
+        max_excess,
+        max_rise,
+        max_rise_time,
+        max_drift,
+        max_rot,
+        max_error,
+        collapse_time,
+        ..
+    } = run;
     let mass = case.setup.mass;
     Ok(ImpactResult {
         case: case.clone(),

@@ -9,6 +9,7 @@
 //! is driven down at the loading rate with local damping on, until the plate has travelled
 //! `max_displacement` or the load has fallen below `stop_fraction` of its peak.
 
+use std::ops::ControlFlow;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -209,6 +210,88 @@ fn plate_fixity(vy: Real) -> Fixity {
     }
 }
 
+/// The static run's observer: every `sample_every` steps, the load–displacement sample (with
+/// its moving average over the smoothing window), the peak and the joints' states at it, the
+/// frames; it stops the run at the maximum displacement or once the load has fallen after the
+/// peak.
+struct StaticRun<'a, F> {
+    case: &'a StaticCase,
+    plate: BlockId,
+    loaded: BlockId,
+    joints: &'a [JointRef],
+    criteria: &'a MechanismCriteria,
+    left: (BlockId, Vector),
+    right: (BlockId, Vector),
+    sample_every: u64,
+    step0: u64,
+    t0: Real,
+    frame_every: Option<Real>,
+    on_frame: &'a mut F,
+    curve: Vec<Sample>,
+    peak: (Real, Real),
+    raw_peak: Real,
+    window: std::collections::VecDeque<(Real, Real)>,
+    window_sum: Real,
+    at_peak: (Vec<JointState>, Mechanism),
+    next_frame: Real,
+}
+
+impl<F: FnMut(&Model) -> Result<()>> voussoir::model::Observer<voussoir::law::CoulombSlip> for StaticRun<'_, F> {
+    fn after_step(&mut self, model: &Model) -> Result<ControlFlow<()>> {
+        if !(model.step_count() - self.step0).is_multiple_of(self.sample_every) {
+            return Ok(ControlFlow::Continue(()));
+        }
+        let case = self.case;
+        let t = model.time() - self.t0;
+        let displacement = case.rate * t;
+        // The resultant acts on the plate (the higher id); the load on the arch is its opposite
+        // reaction, i.e. the upward force on the plate.
+        let load = model
+            .contact_between(self.plate, self.loaded)
+            .map(|c| c.resultant().y)
+            .unwrap_or(0.0);
+        let window = &mut self.window;
+        window.push_back((displacement, load));
+        self.window_sum += load;
+        while window
+            .front()
+            .is_some_and(|&(d, _)| d < displacement - case.smoothing_window)
+        {
+            self.window_sum -= window.pop_front().map_or(0.0, |w| w.1);
+        }
+        let smoothed_load = self.window_sum / window.len() as Real;
+        // The smoothed value describes the middle of the window.
+        let smoothed_at = displacement - 0.5 * (displacement - window.front().map_or(displacement, |w| w.0));
+        self.raw_peak = self.raw_peak.max(load);
+        let sample = Sample {
+            time: t,
+            displacement,
+            load,
+            smoothed_load,
+            left_support_dx: model.blocks()[self.left.0.index()].displacement_of(self.left.1).x,
+            right_support_dx: model.blocks()[self.right.0.index()].displacement_of(self.right.1).x,
+        };
+        self.curve.push(sample);
+        if smoothed_load > self.peak.0 {
+            self.peak = (smoothed_load, smoothed_at);
+            self.at_peak = classify_joints(model, self.joints, self.criteria);
+        }
+        if let Some(every) = self.frame_every {
+            if displacement >= self.next_frame {
+                (self.on_frame)(model)?;
+                self.next_frame += every;
+            }
+        }
+        let fallen =
+            self.peak.0 > 0.0 && smoothed_load < case.stop_fraction * self.peak.0 && displacement > self.peak.1;
+        Ok(if displacement >= case.max_displacement || fallen {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        })
+    }
+}
+
 /// Runs a case; `on_frame` is called with the model every `frame_every` metres of plate travel
 /// (and at the start and end of loading), for ParaView frames.
 ///
@@ -235,61 +318,38 @@ pub fn run(
     let right = arch.extrados_midpoint(arch.spec.voussoirs);
     let (left_id, right_id) = (BlockId(1), BlockId(arch.spec.voussoirs as u32));
     let sample_every = ((2e-5 / case.rate) / model.dt()).ceil().max(1.0) as u64;
-    let t0 = model.time();
     let step0 = model.step_count();
-    let mut curve: Vec<Sample> = Vec::new();
-    let mut peak = (0.0, 0.0);
-    let mut raw_peak: Real = 0.0;
-    let mut window = std::collections::VecDeque::new();
-    let mut window_sum = 0.0;
-    let mut at_peak = classify_joints(&model, &joints, &criteria);
-    let mut next_frame = 0.0;
-    loop {
-        model.run_steps(sample_every)?;
-        let t = model.time() - t0;
-        let displacement = case.rate * t;
-        // The resultant acts on the plate (the higher id); the load on the arch is its opposite
-        // reaction, i.e. the upward force on the plate.
-        let load = model
-            .contact_between(plate, loaded)
-            .map(|c| c.resultant().y)
-            .unwrap_or(0.0);
-        window.push_back((displacement, load));
-        window_sum += load;
-        while window
-            .front()
-            .is_some_and(|&(d, _)| d < displacement - case.smoothing_window)
-        {
-            window_sum -= window.pop_front().map_or(0.0, |w| w.1);
-        }
-        let smoothed_load = window_sum / window.len() as Real;
-        // The smoothed value describes the middle of the window.
-        let smoothed_at = displacement - 0.5 * (displacement - window.front().map_or(displacement, |w| w.0));
-        raw_peak = raw_peak.max(load);
-        let sample = Sample {
-            time: t,
-            displacement,
-            load,
-            smoothed_load,
-            left_support_dx: model.blocks()[left_id.index()].displacement_of(left).x,
-            right_support_dx: model.blocks()[right_id.index()].displacement_of(right).x,
-        };
-        curve.push(sample);
-        if smoothed_load > peak.0 {
-            peak = (smoothed_load, smoothed_at);
-            at_peak = classify_joints(&model, &joints, &criteria);
-        }
-        if let Some(every) = frame_every {
-            if displacement >= next_frame {
-                on_frame(&model)?;
-                next_frame += every;
-            }
-        }
-        let fallen = peak.0 > 0.0 && smoothed_load < case.stop_fraction * peak.0 && displacement > peak.1;
-        if displacement >= case.max_displacement || fallen {
-            break;
-        }
-    }
+    let mut run = StaticRun {
+        case,
+        plate,
+        loaded,
+        joints: &joints,
+        criteria: &criteria,
+        left: (left_id, left),
+        right: (right_id, right),
+        sample_every,
+        step0,
+        t0: model.time(),
+        frame_every,
+        on_frame: &mut on_frame,
+        curve: Vec::new(),
+        peak: (0.0, 0.0),
+        raw_peak: 0.0,
+        window: std::collections::VecDeque::new(),
+        window_sum: 0.0,
+        at_peak: classify_joints(&model, &joints, &criteria),
+        next_frame: 0.0,
+    };
+    // Until the observer stops the run: the maximum displacement, or the load fallen after the
+    // peak.
+    model.run_observed(u64::MAX, &mut run)?;
+    let StaticRun {
+        curve,
+        peak,
+        raw_peak,
+        at_peak,
+        ..
+    } = run;
     if frame_every.is_some() {
         on_frame(&model)?;
     }
