@@ -59,8 +59,9 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// already, see [`DetectionScratch::prepared`].)
     pub(super) fn prepare_blocks(&mut self, check: bool) -> bool {
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
-        self.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
-        self.rotations
+        self.pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        self.pipeline
+            .rotations
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(self.blocks.par_chunks(BLOCK_CHUNK))
             .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
@@ -74,7 +75,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let params = self.params.contact;
         let full = self.changes.need_full_detection() || self.params.mode == DisplacementMode::Small;
         let trigger = params.redetect_fraction * params.tolerance;
-        let sc = &mut self.scratch;
+        let sc = &mut self.pipeline.detection;
         sc.moved.clear();
         sc.moved.extend(
             self.blocks
@@ -252,22 +253,24 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     pub(super) fn rebuild_block_index(&mut self) {
         let n = self.blocks.len();
-        self.block_offsets.clear();
-        self.block_offsets.resize(n + 1, 0);
+        self.pipeline.block_offsets.clear();
+        self.pipeline.block_offsets.resize(n + 1, 0);
         for p in &self.pairs {
-            self.block_offsets[p.a as usize + 1] += 1;
-            self.block_offsets[p.b as usize + 1] += 1;
+            self.pipeline.block_offsets[p.a as usize + 1] += 1;
+            self.pipeline.block_offsets[p.b as usize + 1] += 1;
         }
         for i in 0..n {
-            self.block_offsets[i + 1] += self.block_offsets[i];
+            self.pipeline.block_offsets[i + 1] += self.pipeline.block_offsets[i];
         }
-        self.block_contacts.clear();
-        self.block_contacts.resize(self.block_offsets[n] as usize, 0);
-        let mut fill: Vec<u32> = self.block_offsets[..n].to_vec();
+        self.pipeline.block_contacts.clear();
+        self.pipeline
+            .block_contacts
+            .resize(self.pipeline.block_offsets[n] as usize, 0);
+        let mut fill: Vec<u32> = self.pipeline.block_offsets[..n].to_vec();
         // Each entry is `2 × contact + side`, side 1 when the block is the contact's `b`.
         for (c, p) in self.pairs.iter().enumerate() {
             for (k, side) in [(p.a as usize, 0), (p.b as usize, 1)] {
-                self.block_contacts[fill[k] as usize] = 2 * c as u32 + side;
+                self.pipeline.block_contacts[fill[k] as usize] = 2 * c as u32 + side;
                 fill[k] += 1;
             }
         }

@@ -9,6 +9,7 @@ mod detection;
 mod energy;
 mod motion;
 mod observe;
+mod pipeline;
 mod time_step;
 
 use rayon::prelude::*;
@@ -28,11 +29,11 @@ use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
 use crate::law::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
-use crate::math::{is_finite_vector, Matrix, Pose, Real, Vector};
+use crate::math::{is_finite_vector, Pose, Real, Vector};
 
 use changes::Changes;
 use contact_pass::{ContactPass, ContactSlices, PairSums, CONTACT_CHUNK};
-use detection::DetectionScratch;
+use pipeline::Pipeline;
 
 /// Global parameters of a model, with documented defaults.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -125,23 +126,13 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     subs: Vec<SubContact<L::State>>,
     /// The sub-contacts' records (key, slip, dashpot force), index for index with `subs`.
     sub_records: Vec<SubContactRecord>,
-    /// Block → contact index (CSR with `block_offsets`): `2 × contact + side`, side 1 when the
-    /// block is the contact's `b`.
-    block_contacts: Vec<u32>,
-    block_offsets: Vec<u32>,
-    forces: Vec<Wrench>,
     records: Vec<StepRecord>,
     /// The contacts' resultants and moments, index for index with `pairs`: written by the
     /// contact pass, read by the per-block gather and the accessors (kept out of `ContactPair`,
     /// whose stream they would lengthen by 72 bytes per contact). Detection carries a kept
     /// contact's wrench and starts a new one at zero; checkpointed.
     wrenches: Vec<ContactWrench>,
-    pair_sums: Vec<PairSums>,
-    block_sums: Vec<BlockSums>,
     ref_poses: Vec<Pose>,
-    /// Rotation matrices of the blocks at the start of the step (see `prepare_blocks`).
-    rotations: Vec<Matrix>,
-    bounds: Vec<StiffnessBound>,
     /// The step: `safety × critical` (or the fixed one), as set at the last evaluation.
     dt: Real,
     /// The step that brought the blocks to their poses (`Δt_{n−½}`): `dt`, or shorter around
@@ -163,8 +154,8 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
     changes: Changes,
     unbalanced_ratio: Real,
     detections: u64,
-    scratch: DetectionScratch<L::State>,
-    timings: Timings,
+    /// What the step computes afresh, and buffers it reuses: no state of the model.
+    pipeline: Pipeline<L::State>,
 }
 
 /// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).
@@ -262,16 +253,9 @@ impl<L: ConstitutiveLaw> Model<L> {
             references: Vec::new(),
             subs: Vec::new(),
             sub_records: Vec::new(),
-            block_contacts: Vec::new(),
-            block_offsets: vec![0],
-            forces: Vec::new(),
             records: Vec::new(),
             wrenches: Vec::new(),
-            pair_sums: Vec::new(),
-            block_sums: Vec::new(),
             ref_poses: Vec::new(),
-            rotations: Vec::new(),
-            bounds: Vec::new(),
             dt: 0.0,
             drift: 0.0,
             refine_until: 0.0,
@@ -285,8 +269,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             changes: Changes::DETECTION,
             unbalanced_ratio: Real::INFINITY,
             detections: 0,
-            scratch: DetectionScratch::default(),
-            timings: Timings::default(),
+            pipeline: Pipeline::default(),
         })
     }
 
@@ -302,9 +285,9 @@ impl<L: ConstitutiveLaw> Model<L> {
         let id = BlockId(self.blocks.len() as u32);
         self.ref_poses.push(block.state.pose);
         self.blocks.push(block);
-        self.forces.push(Wrench::default());
+        self.pipeline.forces.push(Wrench::default());
         self.records.push(StepRecord::default());
-        self.bounds.push(StiffnessBound::default());
+        self.pipeline.bounds.push(StiffnessBound::default());
         self.changes.insert(Changes::BLOCKS);
         Ok(id)
     }
@@ -581,18 +564,19 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     fn contact_wrench_of(&self, i: usize) -> Wrench {
-        let entries = &self.block_contacts[self.block_offsets[i] as usize..self.block_offsets[i + 1] as usize];
+        let entries = &self.pipeline.block_contacts
+            [self.pipeline.block_offsets[i] as usize..self.pipeline.block_offsets[i + 1] as usize];
         motion::add_contact_wrenches(Wrench::default(), entries, &self.wrenches)
     }
 
     /// Time spent per stage (wall clock).
     pub fn timings(&self) -> &Timings {
-        &self.timings
+        &self.pipeline.timings
     }
 
     /// Restarts the stage timers.
     pub fn reset_timings(&mut self) {
-        self.timings = Timings::default();
+        self.pipeline.timings = Timings::default();
     }
 
     /// The integrator's damping model.
@@ -612,7 +596,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         // The changes since the last step come first: any of them asks for a full detection,
         // and makes what the last block pass prepared possibly stale.
         let changed = self.changes.need_full_detection();
-        let moved = match self.scratch.prepared.take() {
+        let moved = match self.pipeline.detection.prepared.take() {
             Some(moved) if self.started && !changed => moved,
             _ => self.prepare_blocks(large && self.started && !changed),
         };
@@ -638,7 +622,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let forces = std::time::Instant::now();
         let diverged = self.advance_blocks(0.5 * (previous + drift), drift);
         self.drift = drift;
-        let t = &mut self.timings;
+        let t = &mut self.pipeline.timings;
         t.detection += (detected - started).as_secs_f64();
         t.contacts += (forces - detected).as_secs_f64();
         t.integration += forces.elapsed().as_secs_f64();
@@ -678,7 +662,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             let hold = 3.0 * 2.0 / impact.sqrt();
             self.refine_until = self.refine_until.max(self.time + hold);
             self.refine_omega2 = self.refine_omega2.max(impact);
-            for (k, s) in self.pair_sums.iter().enumerate() {
+            for (k, s) in self.pipeline.pair_sums.iter().enumerate() {
                 if s.fired_count as usize <= s.fired.len() {
                     self.refining.extend_from_slice(&s.fired[..s.fired_count as usize]);
                 } else {
@@ -726,21 +710,26 @@ impl<L: ConstitutiveLaw> Model<L> {
             self.subs.len(),
             "sub-contact records out of step"
         );
-        assert_eq!(self.rotations.len(), self.blocks.len(), "rotation matrices out of step");
+        assert_eq!(
+            self.pipeline.rotations.len(),
+            self.blocks.len(),
+            "rotation matrices out of step"
+        );
         assert_eq!(self.wrenches.len(), self.pairs.len(), "contact wrenches out of step");
         let pass = ContactPass {
             blocks: &self.blocks,
-            rotations: &self.rotations,
+            rotations: &self.pipeline.rotations,
             references: &self.references,
             laws: self.joints.laws(),
-            bounds: &self.bounds,
+            bounds: &self.pipeline.bounds,
             refining: &self.refining,
             ctx,
         };
         // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed
         // per fixed chunk of contacts, so that the totals do not depend on the thread count.
-        self.pair_sums.clear();
-        self.pair_sums
+        self.pipeline.pair_sums.clear();
+        self.pipeline
+            .pair_sums
             .resize(self.pairs.len().div_ceil(CONTACT_CHUNK), PairSums::default());
         if !self.pairs.is_empty() {
             let first_sub = self.pairs[0].first as usize;
@@ -749,7 +738,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     first: 0,
                     pairs: &mut self.pairs,
                     wrenches: &mut self.wrenches,
-                    sums: &mut self.pair_sums,
+                    sums: &mut self.pipeline.pair_sums,
                     subs: &mut self.subs[first_sub..],
                     records: &mut self.sub_records[first_sub..],
                 },
@@ -757,8 +746,8 @@ impl<L: ConstitutiveLaw> Model<L> {
             );
         }
         (
-            self.pair_sums.iter().map(|s| s.impact).fold(0.0, Real::max),
-            self.pair_sums.iter().any(|s| s.busy),
+            self.pipeline.pair_sums.iter().map(|s| s.impact).fold(0.0, Real::max),
+            self.pipeline.pair_sums.iter().any(|s| s.busy),
         )
     }
 
@@ -924,8 +913,8 @@ mod tests {
             let r = model.pairs[k].range();
             let (a, b) = (model.pairs[k].a as usize, model.pairs[k].b as usize);
             let (ra, rb) = (
-                Matrix::from_quat(model.blocks[a].state.pose.rotation),
-                Matrix::from_quat(model.blocks[b].state.pose.rotation),
+                crate::math::Matrix::from_quat(model.blocks[a].state.pose.rotation),
+                crate::math::Matrix::from_quat(model.blocks[b].state.pose.rotation),
             );
             let (sa, sb) = ((&model.blocks[a].state, &ra), (&model.blocks[b].state, &rb));
             let point = matches!(model.pairs[k].kind, crate::geometry::ContactKind::Point { .. });

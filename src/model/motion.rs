@@ -135,8 +135,8 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub(super) fn advance_blocks(&mut self, kick: Real, drift: Real) -> Option<usize> {
         let pass = BlockPass {
             wrenches: &self.wrenches,
-            contacts: &self.block_contacts,
-            offsets: &self.block_offsets,
+            contacts: &self.pipeline.block_contacts,
+            offsets: &self.pipeline.block_offsets,
             gravity: self.params.gravity,
             dt: self.drift,
             drift_over_kick: if kick == drift { 1.0 } else { drift / kick },
@@ -145,21 +145,22 @@ impl<L: ConstitutiveLaw> Model<L> {
             trigger: (self.params.mode == DisplacementMode::Large)
                 .then_some(self.params.contact.redetect_fraction * self.params.contact.tolerance),
         };
-        self.block_sums.clear();
-        self.block_sums
+        self.pipeline.block_sums.clear();
+        self.pipeline
+            .block_sums
             .resize(self.blocks.len().div_ceil(BLOCK_CHUNK), BlockSums::default());
         let integrator: &dyn Integrator = &*self.integrator;
         let step = StepDurations { kick, drift };
         // Also the next step's first stage, while the blocks are in cache: their rotation
         // matrices and movement check (`prepare_blocks`).
-        self.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        self.pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
         self.blocks
             .par_chunks_mut(BLOCK_CHUNK)
-            .zip(self.forces.par_chunks_mut(BLOCK_CHUNK))
+            .zip(self.pipeline.forces.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.records.par_chunks_mut(BLOCK_CHUNK))
-            .zip(self.rotations.par_chunks_mut(BLOCK_CHUNK))
+            .zip(self.pipeline.rotations.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
-            .zip(self.block_sums.par_iter_mut())
+            .zip(self.pipeline.block_sums.par_iter_mut())
             .enumerate()
             .for_each(|(k, (((((blocks, forces), records), rotations), refs), sums))| {
                 let first_block = k * BLOCK_CHUNK;
@@ -168,7 +169,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 pass.settle(first_block, blocks, records, sums);
                 sums.moved = prepare_chunk(rotations, blocks, refs, pass.trigger);
             });
-        self.scratch.prepared = Some(self.block_sums.iter().any(|s| s.moved));
+        self.pipeline.detection.prepared = Some(self.pipeline.block_sums.iter().any(|s| s.moved));
         self.gather_block_sums()
     }
 
@@ -179,7 +180,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let mut kinetic = 0.0;
         let mut first_diverged = None;
         let e = &mut self.energy;
-        for s in &self.block_sums {
+        for s in &self.pipeline.block_sums {
             max_unbalanced = max_unbalanced.max(s.max_unbalanced);
             e.gravity_work += s.gravity_work;
             e.load_work += s.load_work;
@@ -189,12 +190,12 @@ impl<L: ConstitutiveLaw> Model<L> {
             first_diverged = first_diverged.or(s.diverged);
         }
         e.kinetic = kinetic;
-        for s in &self.pair_sums {
+        for s in &self.pipeline.pair_sums {
             e.joint_work += s.work;
             e.friction += s.dissipated;
             e.damping += s.dashpot_work;
         }
-        let force_magnitudes: Real = self.pair_sums.iter().map(|s| s.force_magnitude).sum();
+        let force_magnitudes: Real = self.pipeline.pair_sums.iter().map(|s| s.force_magnitude).sum();
         let mean_contact = if self.pairs.is_empty() {
             0.0
         } else {

@@ -45,8 +45,8 @@ impl<L: ConstitutiveLaw> Model<L> {
                 k.normal + 2.0 * k.shear
             })
             .fold(0.0, Real::max);
-        crate::integrate::block_bounds(&self.blocks, &contacts, k_max, &mut self.bounds);
-        self.critical = self.integrator.critical_step(&self.bounds);
+        crate::integrate::block_bounds(&self.blocks, &contacts, k_max, &mut self.pipeline.bounds);
+        self.critical = self.integrator.critical_step(&self.pipeline.bounds);
         let Some(crit) = self.critical else {
             // No stiffness anywhere: free flight; keep a previous step or a small default.
             if self.dt == 0.0 {

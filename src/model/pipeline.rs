@@ -1,0 +1,49 @@
+//! The step's pipeline: what each step computes afresh from the model's state, and the buffers
+//! it reuses so that a step does not allocate. Nothing here is state: a checkpoint does not
+//! store it, and a restored model rebuilds it.
+
+use super::contact_pass::PairSums;
+use super::detection::DetectionScratch;
+use super::{BlockSums, Timings};
+use crate::block::Wrench;
+use crate::integrate::StiffnessBound;
+use crate::math::Matrix;
+
+/// Scratch of the step's stages.
+#[derive(Debug, Clone)]
+pub(super) struct Pipeline<S> {
+    /// Block → contact index (CSR with `block_offsets`): `2 × contact + side`, side 1 when the
+    /// block is the contact's `b`. Rebuilt at detection and on checkpoint load.
+    pub block_contacts: Vec<u32>,
+    pub block_offsets: Vec<u32>,
+    /// Each block's total force and moment in the step (gathered by the block pass).
+    pub forces: Vec<Wrench>,
+    /// Per-chunk sums of the contact pass and of the block pass.
+    pub pair_sums: Vec<PairSums>,
+    pub block_sums: Vec<BlockSums>,
+    /// Rotation matrices of the blocks at the start of the step (see `prepare_blocks`).
+    pub rotations: Vec<Matrix>,
+    /// The blocks' squared frequency bounds of the last step evaluation (critical step and
+    /// impact probe).
+    pub bounds: Vec<StiffnessBound>,
+    /// Detection's buffers, and what the block pass prepared for the next step.
+    pub detection: DetectionScratch<S>,
+    /// Wall-clock time per stage.
+    pub timings: Timings,
+}
+
+impl<S> Default for Pipeline<S> {
+    fn default() -> Self {
+        Self {
+            block_contacts: Vec::new(),
+            block_offsets: vec![0],
+            forces: Vec::new(),
+            pair_sums: Vec::new(),
+            block_sums: Vec::new(),
+            rotations: Vec::new(),
+            bounds: Vec::new(),
+            detection: DetectionScratch::default(),
+            timings: Timings::default(),
+        }
+    }
+}
