@@ -129,7 +129,7 @@ pub enum Monitor {
     /// Resultant force (N) of the joint between two blocks, on the second one (zero when they
     /// are not in contact). Scene files written before the rename say `JointForce`.
     #[cfg_attr(feature = "serde", serde(alias = "JointForce"))]
-    JointResultant {
+    ContactResultant {
         /// First block.
         a: BlockId,
         /// Second block: the force is the one acting on it.
@@ -150,7 +150,7 @@ impl Monitor {
             | Monitor::Velocity { block, .. }
             | Monitor::Reaction { block, .. }
             | Monitor::ContactForce { block, .. } => vec![block],
-            Monitor::JointResultant { a, b, .. } => vec![a, b],
+            Monitor::ContactResultant { a, b, .. } => vec![a, b],
             _ => Vec::new(),
         }
     }
@@ -160,7 +160,7 @@ impl Monitor {
         match self {
             Monitor::Displacement { .. } => "m",
             Monitor::Velocity { .. } => "m/s",
-            Monitor::Reaction { .. } | Monitor::ContactForce { .. } | Monitor::JointResultant { .. } => "N",
+            Monitor::Reaction { .. } | Monitor::ContactForce { .. } | Monitor::ContactResultant { .. } => "N",
             Monitor::Energy(_) => "J",
             Monitor::UnbalancedRatio => "-",
         }
@@ -190,7 +190,7 @@ impl Monitor {
             Monitor::ContactForce { block: id, component } => {
                 component.of(model.contact_wrench(id).map(|w| w.force).unwrap_or_default())
             }
-            Monitor::JointResultant { a, b, component } => {
+            Monitor::ContactResultant { a, b, component } => {
                 let f = model.contact_between(a, b).map(|c| c.resultant()).unwrap_or_default();
                 // The stored resultant acts on the higher-numbered block.
                 component.of(if b.0 > a.0 { f } else { -f })
