@@ -4,8 +4,8 @@
 //! updates per second.
 
 use divan::counter::ItemsCount;
-use voussoir::model::benchmark_wall;
 use voussoir::prelude::*;
+use voussoir::scenes::benchmark_wall;
 
 fn main() {
     divan::main();

@@ -14,8 +14,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use serde::Serialize;
-use voussoir::model::{benchmark_wall_with_spacing, BENCHMARK_SPACING};
 use voussoir::prelude::*;
+use voussoir::scenes::{benchmark_wall_with_spacing, BENCHMARK_SPACING};
 
 #[derive(Serialize)]
 struct Run {

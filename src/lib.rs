@@ -38,16 +38,20 @@
 //!
 //! ## Map of the crate
 //!
+//! `docs/architecture.md` draws the house: the step as a list of stages, who owns which data.
+//!
 //! | module | stage |
 //! |---|---|
 //! | [`geometry`] | polyhedra, mass properties, broad phase, contact polygon and sub-contacts |
-//! | [`block`] | the [`Block`] trait, ids, fixity, rigid blocks |
-//! | [`contact`] | the [`Contact`] trait, sub-contact state and kinematics |
+//! | [`block`] | the [`Block`] trait, fixity, rigid blocks |
+//! | [`ids`] | typed ids |
+//! | [`contact`] | the read API of contacts (views, the [`Contact`] trait) and the contact kernel |
 //! | [`law`] | the [`ConstitutiveLaw`] trait and the shipped laws |
 //! | [`integrate`] | the [`Integrator`] trait, central difference, damping, critical step |
-//! | [`model`] | the [`Model`]: stepping, runs, energies |
+//! | [`model`] | the [`Model`]: state, the step's stages, runs and observers, energies, checkpoints |
 //! | [`monitor`] | observation: the [`monitor::Probe`] trait, built-in monitors, the recorder and histories |
-//! | [`build`] | generators (walls, stacks) |
+//! | [`build`] | generators (walls, arches, vaults): they return blocks |
+//! | [`scenes`] | ready-made models (the benchmarks' wall) |
 //! | [`io`] | ParaView series, CSV histories, scenes (feature `io`) |
 //! | [`analysis`] | joint states and collapse mechanisms |
 //!
@@ -83,6 +87,7 @@ pub mod law;
 pub mod math;
 pub mod model;
 pub mod monitor;
+pub mod scenes;
 
 pub use block::{Block, BlockId, RigidBlock};
 pub use contact::Contact;

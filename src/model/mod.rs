@@ -1,6 +1,5 @@
 //! The model: blocks, joint laws, gravity and loads; stepping and runs.
 
-mod benchmark;
 mod changes;
 #[cfg(feature = "serde")]
 mod checkpoint;
@@ -16,7 +15,6 @@ use rayon::prelude::*;
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
-pub use benchmark::{benchmark_wall, benchmark_wall_with_spacing, BENCHMARK_SPACING};
 pub use energy::Energies;
 pub use observe::Observer;
 
@@ -842,7 +840,7 @@ mod tests {
     fn avx2_and_portable_builds_are_bit_identical() {
         let run = |portable: bool| {
             crate::dispatch::set_portable_only(portable);
-            let mut model = benchmark_wall(300).expect("wall");
+            let mut model = crate::scenes::benchmark_wall(300).expect("wall");
             model.run_steps(300).expect("run");
             crate::dispatch::set_portable_only(false);
             let states: Vec<_> = model.blocks().iter().map(|b| *b.state()).collect();
@@ -1003,7 +1001,7 @@ mod tests {
     /// and small-displacement mode.
     #[test]
     fn grouped_and_single_sub_contact_loops_agree() {
-        let mut wall = benchmark_wall(300).expect("wall");
+        let mut wall = crate::scenes::benchmark_wall(300).expect("wall");
         wall.run_steps(40).expect("run");
         let coulomb = wall.joints.laws()[0];
         for counts in [

@@ -1,4 +1,6 @@
-//! The ready-made model of the benchmarks: a settling running-bond wall.
+//! Ready-made models: the settling running-bond wall of the benchmarks and the `scaling`
+//! example. (Above `model` and `build` in the house: generators return blocks, and this
+//! assembles them into a model.)
 
 use crate::error::{positive, Result};
 use crate::law::MaterialId;
@@ -21,7 +23,7 @@ pub fn benchmark_wall(blocks: usize) -> Result<crate::Model> {
 /// sub-contact density.
 ///
 /// ```
-/// use voussoir::model::{benchmark_wall, benchmark_wall_with_spacing};
+/// use voussoir::scenes::{benchmark_wall, benchmark_wall_with_spacing};
 /// let (mut coarse, mut fine) = (benchmark_wall_with_spacing(100, 0.1)?, benchmark_wall(100)?);
 /// coarse.step()?; // the first step detects the contacts
 /// fine.step()?;
