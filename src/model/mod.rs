@@ -1109,4 +1109,52 @@ mod tests {
         let first = model.subs[model.pairs[0].range()][0].force.shear;
         assert!((fresh.shear(first) - before[0].1).length() > 0.5 * misread);
     }
+
+    /// A custom integrator is neither saved as another nor silently replaced by `set_damping`.
+    #[test]
+    fn custom_integrators_are_not_swapped_behind_the_users_back() {
+        use crate::block::{BlockState, Fixity};
+        use crate::geometry::MassProperties;
+        use crate::integrate::{StepDurations, StepRecord};
+
+        #[derive(Debug, Clone, Copy)]
+        struct Mine(CentralDifference);
+        impl Integrator for Mine {
+            fn advance_block(
+                &self,
+                state: &mut BlockState,
+                mass: &MassProperties,
+                fixity: &Fixity,
+                wrench: &Wrench,
+                step: StepDurations,
+            ) -> StepRecord {
+                self.0.advance_block(state, mass, fixity, wrench, step)
+            }
+            fn damping(&self) -> Damping {
+                self.0.damping()
+            }
+            fn boxed_clone(&self) -> Box<dyn Integrator> {
+                Box::new(*self)
+            }
+        }
+        let mut model: Model = Model::new(ModelParameters::default()).unwrap();
+        model
+            .add_block(RigidBlock::cuboid("b", Vector::ZERO, Vector::splat(0.1), 2000.0).unwrap())
+            .unwrap();
+        model
+            .set_integrator(Mine(CentralDifference::new(Damping::None)))
+            .unwrap();
+        model.run_steps(3).unwrap();
+        assert!(matches!(
+            model.set_damping(Damping::None),
+            Err(Error::Unsupported { .. })
+        ));
+        #[cfg(feature = "serde")]
+        assert!(matches!(model.to_checkpoint_string(), Err(Error::Unsupported { .. })));
+        // Central difference is restored by a checkpoint, and set_damping replaces it.
+        model.set_integrator(CentralDifference::new(Damping::None)).unwrap();
+        model.set_damping(Damping::Local { alpha: 0.8 }).unwrap();
+        #[cfg(feature = "serde")]
+        assert!(model.to_checkpoint_string().is_ok());
+    }
 }
