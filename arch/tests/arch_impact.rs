@@ -72,7 +72,7 @@ fn impact_energy_momentum_and_outcomes() {
     // the arch standing. Whether the heavy tests collapse is the benchmark's comparison with the
     // experiment (`docs/benchmarks/arch-impact.md`), not a property to assert here. The
     // first-impact peak of a linear system struck by a mass grows as √E (`δ = v √(m/k)` =
-    // `√(2E/k)`): the ring's, which hinges, within a factor 2 of that (measured 3.76 against
+    // `√(2E/k)`): the ring's, which hinges, within a factor 2 of that (measured 3.69 against
     // √(357.6/29.9) = 3.46). The later maxima come from the ring falling back after its rebound
     // and are not ordered so simply (`docs/benchmarks/arch-impact.md`).
     let expected = (r[0].kinetic_energy / r[1].kinetic_energy).sqrt();
