@@ -4,13 +4,13 @@ use rayon::prelude::*;
 
 use super::changes::Changes;
 use super::{Model, BLOCK_CHUNK};
-use crate::block::{Block, BlockId};
+use crate::block::{Block, BlockId, RigidBlock};
 use crate::contact::{
     AnchorPlane, ContactPair, ContactReference, ContactWrench, DisplacementMode, ForceMoments, SubContact,
     SubContactRecord,
 };
 use crate::error::{Error, Result};
-use crate::geometry::{detect, BlockGeometry, BroadPhase, NarrowPhaseScratch, SubcontactSeed};
+use crate::geometry::{detect, BlockGeometry, BroadPhase, DetectedContact, NarrowPhaseScratch, SubcontactSeed};
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Real, Vector};
 
@@ -88,27 +88,29 @@ impl<L: ConstitutiveLaw> Model<L> {
             params.tolerance,
             &mut sc.candidates,
         );
-        sc.pairs.clear();
-        sc.references.clear();
-        sc.wrenches.clear();
-        sc.subs.clear();
-        sc.records.clear();
+        let mut new = NewContacts {
+            pairs: &mut sc.pairs,
+            references: &mut sc.references,
+            wrenches: &mut sc.wrenches,
+            subs: &mut sc.subs,
+            records: &mut sc.records,
+        };
+        new.clear();
+        let old = OldContacts {
+            pairs: &self.pairs,
+            references: &self.references,
+            subs: &self.subs,
+            records: &self.sub_records,
+        };
         for &(i, j) in &sc.candidates {
-            let old = self.pairs.binary_search_by_key(&(i, j), |p| (p.a, p.b)).ok();
+            let k_old = old.pairs.binary_search_by_key(&(i, j), |p| (p.a, p.b)).ok();
             let (bi, bj) = (&self.blocks[i as usize], &self.blocks[j as usize]);
             if bi.fixity().is_fixed() && bj.fixity().is_fixed() {
                 continue;
             }
             if !sc.moved[i as usize] && !sc.moved[j as usize] {
-                if let Some(k) = old {
-                    let p = &self.pairs[k];
-                    let mut kept = p.clone();
-                    kept.first = sc.subs.len() as u32;
-                    sc.subs.extend_from_slice(&self.subs[p.range()]);
-                    sc.records.extend_from_slice(&self.sub_records[p.range()]);
-                    sc.pairs.push(kept);
-                    sc.references.push(self.references[k].clone());
-                    sc.wrenches.push(self.wrenches.get(k).copied().unwrap_or_default());
+                if let Some(k) = k_old {
+                    new.keep(&old, k, self.wrenches.get(k).copied().unwrap_or_default());
                 }
                 continue;
             }
@@ -122,7 +124,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     shape: bj.shape(),
                     pose: &bj.state.pose,
                 },
-                old.map(|k| (self.pairs[k].kind, self.pairs[k].host_is_a)),
+                k_old.map(|k| (old.pairs[k].kind, old.pairs[k].host_is_a)),
                 &params,
                 &mut sc.narrow,
                 &mut sc.seeds,
@@ -140,85 +142,13 @@ impl<L: ConstitutiveLaw> Model<L> {
                     block_a: BlockId(i),
                     block_b: BlockId(j),
                 })?;
-            let host = if dc.host_is_a { bi } else { bj };
-            let bound_area = old.map_or(0.0, |k| self.references[k].bound_area);
-            let old_subs = old.map(|k| {
-                let p = &self.pairs[k];
-                (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
-                    .then(|| (&self.subs[p.range()], &self.sub_records[p.range()]))
-            });
-            let old_subs = old_subs.flatten();
-            // Carried spring forces were composed in the old contact's axes: their shear forces
-            // are components along its tangents, and the next step's energy increment needs its
-            // normal as the previous one. A new contact starts with any tangents.
-            let axes = match (old, old_subs) {
-                (Some(k), Some(_)) => self.pairs[k].axes(),
-                _ => JointAxes::from_normal(dc.normal),
-            };
-            let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
-            let anchors = AnchorPlane::through(sc.seeds.iter().map(|s| s.anchor));
-            let first = sc.subs.len() as u32;
-            for seed in &sc.seeds {
-                let mut sub = SubContact {
-                    plane: anchors.coordinates(seed.anchor),
-                    area: seed.area,
-                    gap: seed.gap,
-                    force: JointForce::default(),
-                    slip: 0.0,
-                    status: JointStatus::Open,
-                    state: L::State::default(),
-                };
-                let mut record = SubContactRecord::new(seed.key);
-                if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
-                    let o = &old_subs[k];
-                    sub.force = o.force;
-                    sub.slip = o.slip;
-                    sub.status = o.status;
-                    sub.state = o.state.clone();
-                    record = old_records[k].clone();
-                }
-                sc.subs.push(sub);
-                sc.records.push(record);
-            }
-            let mut pair = ContactPair {
-                a: i,
-                b: j,
-                kind: dc.kind,
-                host_is_a: dc.host_is_a,
-                law,
-                first,
-                count: sc.seeds.len() as u32,
-                normal: axes.normal,
-                tangent: axes.tangent,
-                anchors,
-                plane_normal: Vector::ZERO,
-                plane_offset: 0.0,
-                dashpots: true,
-                normal_force: 0.0,
-                springs: ForceMoments::default(),
-            };
-            pair.cache_local_faces(bi.shape(), bj.shape());
-            pair.refresh_springs(&sc.subs);
-            sc.pairs.push(pair);
-            sc.wrenches.push(ContactWrench::default());
-            sc.references.push(ContactReference {
-                ref_a: bi.state.pose.translation,
-                ref_b: bj.state.pose.translation,
-                ref_host_rotation: host.state.pose.rotation,
-                area: sc.seeds.iter().map(|s| s.area).sum(),
-                bound_area,
-            });
+            new.add_detected(&old, k_old, (i, bi), (j, bj), &dc, law, &sc.seeds);
         }
         // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
         // since the last evaluation (lost contacts only make the step safer).
         let stiffer = sc.references.iter().any(|r| r.area > 1.05 * r.bound_area);
         let (work, dashpot) = dropped_work(
-            OldContacts {
-                pairs: &self.pairs,
-                references: &self.references,
-                subs: &self.subs,
-                records: &self.sub_records,
-            },
+            old,
             (&sc.pairs, &sc.records),
             &sc.moved,
             &self.blocks,
@@ -322,6 +252,121 @@ struct OldContacts<'a, S> {
     references: &'a [ContactReference],
     subs: &'a [SubContact<S>],
     records: &'a [SubContactRecord],
+}
+
+/// The contact lists detection builds, swapped in for the model's at its end.
+struct NewContacts<'a, S> {
+    pairs: &'a mut Vec<ContactPair>,
+    references: &'a mut Vec<ContactReference>,
+    wrenches: &'a mut Vec<ContactWrench>,
+    subs: &'a mut Vec<SubContact<S>>,
+    records: &'a mut Vec<SubContactRecord>,
+}
+
+impl<S: Clone + Default> NewContacts<'_, S> {
+    fn clear(&mut self) {
+        self.pairs.clear();
+        self.references.clear();
+        self.wrenches.clear();
+        self.subs.clear();
+        self.records.clear();
+    }
+
+    /// Keeps old contact `k` as it is (neither block moved beyond the trigger), with its wrench.
+    fn keep(&mut self, old: &OldContacts<'_, S>, k: usize, wrench: ContactWrench) {
+        let p = &old.pairs[k];
+        let mut kept = p.clone();
+        kept.first = self.subs.len() as u32;
+        self.subs.extend_from_slice(&old.subs[p.range()]);
+        self.records.extend_from_slice(&old.records[p.range()]);
+        self.pairs.push(kept);
+        self.references.push(old.references[k].clone());
+        self.wrenches.push(wrench);
+    }
+
+    /// Adds the contact the narrow phase found between blocks `i < j` (`seeds` its sub-contacts,
+    /// `law` the index of its joint law), carrying the history of old contact `k_old` by
+    /// sub-contact key when it joins the same features with the same host.
+    #[allow(clippy::too_many_arguments)]
+    fn add_detected(
+        &mut self,
+        old: &OldContacts<'_, S>,
+        k_old: Option<usize>,
+        (i, bi): (u32, &RigidBlock),
+        (j, bj): (u32, &RigidBlock),
+        dc: &DetectedContact,
+        law: u32,
+        seeds: &[SubcontactSeed],
+    ) {
+        let host = if dc.host_is_a { bi } else { bj };
+        let bound_area = k_old.map_or(0.0, |k| old.references[k].bound_area);
+        let old_subs = k_old.map(|k| {
+            let p = &old.pairs[k];
+            (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
+                .then(|| (&old.subs[p.range()], &old.records[p.range()]))
+        });
+        let old_subs = old_subs.flatten();
+        // Carried spring forces were composed in the old contact's axes: their shear forces
+        // are components along its tangents, and the next step's energy increment needs its
+        // normal as the previous one. A new contact starts with any tangents.
+        let axes = match (k_old, old_subs) {
+            (Some(k), Some(_)) => old.pairs[k].axes(),
+            _ => JointAxes::from_normal(dc.normal),
+        };
+        let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
+        let anchors = AnchorPlane::through(seeds.iter().map(|s| s.anchor));
+        let first = self.subs.len() as u32;
+        for seed in seeds {
+            let mut sub = SubContact {
+                plane: anchors.coordinates(seed.anchor),
+                area: seed.area,
+                gap: seed.gap,
+                force: JointForce::default(),
+                slip: 0.0,
+                status: JointStatus::Open,
+                state: S::default(),
+            };
+            let mut record = SubContactRecord::new(seed.key);
+            if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
+                let o = &old_subs[k];
+                sub.force = o.force;
+                sub.slip = o.slip;
+                sub.status = o.status;
+                sub.state = o.state.clone();
+                record = old_records[k].clone();
+            }
+            self.subs.push(sub);
+            self.records.push(record);
+        }
+        let mut pair = ContactPair {
+            a: i,
+            b: j,
+            kind: dc.kind,
+            host_is_a: dc.host_is_a,
+            law,
+            first,
+            count: seeds.len() as u32,
+            normal: axes.normal,
+            tangent: axes.tangent,
+            anchors,
+            plane_normal: Vector::ZERO,
+            plane_offset: 0.0,
+            dashpots: true,
+            normal_force: 0.0,
+            springs: ForceMoments::default(),
+        };
+        pair.cache_local_faces(bi.shape(), bj.shape());
+        pair.refresh_springs(self.subs);
+        self.pairs.push(pair);
+        self.wrenches.push(ContactWrench::default());
+        self.references.push(ContactReference {
+            ref_a: bi.state.pose.translation,
+            ref_b: bj.state.pose.translation,
+            ref_host_rotation: host.state.pose.rotation,
+            area: seeds.iter().map(|s| s.area).sum(),
+            bound_area,
+        });
+    }
 }
 
 /// The work still owed by sub-contacts that re-detection drops while they carry a force:
