@@ -1,9 +1,13 @@
 //! Checkpoint and restart: a restarted run continues bit-identically; corrupt or truncated
 //! checkpoints give errors, never panics.
 
+mod common;
+
 use voussoir::build::{running_bond_wall, WallSpec};
 use voussoir::monitor::Recorder;
 use voussoir::prelude::*;
+
+use common::fingerprint;
 
 /// A small wall under a lateral load, so that blocks slide, rock and get re-detected.
 fn moving_wall() -> Result<Model> {
@@ -15,12 +19,7 @@ fn moving_wall() -> Result<Model> {
         },
         ..ModelParameters::default()
     };
-    let mut model: Model = Model::new(params)?;
-    model.set_joint_law(
-        MaterialId(0),
-        MaterialId(0),
-        CoulombSlip::new(1e9, 4e8, 25.0, 20.0, 2e3, 1e3)?,
-    )?;
+    let mut model = common::model_with(params, CoulombSlip::new(1e9, 4e8, 25.0, 20.0, 2e3, 1e3)?);
     model.set_damping(Damping::rayleigh_stiffness(0.02, 50.0)?)?;
     for b in running_bond_wall(&WallSpec {
         bricks_per_course: 4,
@@ -46,26 +45,6 @@ fn wall_recorder(model: &Model) -> Result<Recorder<CoulombSlip>> {
         },
     )?;
     Ok(recorder)
-}
-
-fn state_bits(model: &Model) -> Vec<u64> {
-    let mut bits = Vec::new();
-    for b in model.blocks() {
-        let s = b.state();
-        for v in [s.pose.translation, s.velocity, s.angular_velocity, s.angular_momentum] {
-            bits.extend(v.to_array().map(f64::to_bits));
-        }
-        bits.extend(s.pose.rotation.to_array().map(f64::to_bits));
-    }
-    for c in model.contacts() {
-        for s in c.subcontacts() {
-            bits.push(s.normal_force().to_bits());
-            bits.extend(s.shear_force().to_array().map(f64::to_bits));
-        }
-    }
-    let e = model.energies();
-    bits.extend([e.kinetic, e.elastic, e.friction, e.damping, e.gravity_work].map(f64::to_bits));
-    bits
 }
 
 #[test]
@@ -97,7 +76,7 @@ fn restarted_run_is_bit_identical() -> Result<()> {
         model.contacts().flat_map(|c| c.subcontacts()).any(|s| s.slip() > 0.0),
         "the test must include slip"
     );
-    assert_eq!(state_bits(&model), state_bits(&restarted));
+    assert_eq!(fingerprint(&model), fingerprint(&restarted));
     assert_eq!(recorded.history(), recorded_again.history());
     assert_eq!(recorded.history().len(), 300);
     std::fs::remove_dir_all(&dir).ok();
@@ -200,7 +179,7 @@ fn pending_redetection_survives_a_checkpoint() -> Result<()> {
     assert_eq!(restored.dt(), model.dt());
     model.run_steps(20)?;
     restored.run_steps(20)?;
-    assert_eq!(state_bits(&model), state_bits(&restored));
+    assert_eq!(fingerprint(&model), fingerprint(&restored));
     Ok(())
 }
 

@@ -9,20 +9,14 @@
 //!
 //! Every reference value is computed here from its formula; nothing is copied from a run.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use voussoir::prelude::*;
 
 /// Density of every block (kg/m³): stone.
 const RHO: Real = 2500.0;
-
-/// A fixed 2 m × 2 m × 0.2 m base whose top face is the plane z = 0.
-fn base() -> Result<RigidBlock> {
-    Ok(
-        RigidBlock::cuboid("base", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), RHO)?
-            .with_fixity(Fixity::FIXED),
-    )
-}
 
 /// World positions of a block's vertices.
 fn world_vertices(b: &RigidBlock) -> impl Iterator<Item = Vector> + '_ {
@@ -80,17 +74,15 @@ impl Oscillator {
             time_step,
             ..ModelParameters::default()
         };
-        let mut model: Model<LinearElastic> = Model::new(params)?;
-        model.set_joint_law(
-            MaterialId(0),
-            MaterialId(0),
+        let mut model = common::model_with(
+            params,
             LinearElastic {
                 normal_stiffness: Self::KN,
                 shear_stiffness: Self::KN,
             },
-        )?;
+        );
         model.set_damping(damping)?;
-        model.add_block(base()?)?;
+        model.add_block(common::fixed_slab("base"))?;
         let cube = model.add_block(
             RigidBlock::cuboid(
                 "cube",
@@ -471,10 +463,9 @@ fn rocking(label: &str, face_angle: Option<Real>) -> Result<()> {
         params.contact.face_angle_tolerance = angle;
     }
     let tolerance = params.contact.tolerance;
-    let mut model: Model = Model::new(params)?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e10, 1e10, 45.0)?)?;
+    let mut model = common::model_with(params, CoulombSlip::dry(1e10, 1e10, 45.0)?);
     model.set_damping(Damping::None)?;
-    model.add_block(base()?)?;
+    model.add_block(common::fixed_slab("base"))?;
     let upright = RigidBlock::cuboid(
         "column",
         Vector::new(-b / 2.0, -d / 2.0, 0.0),
@@ -585,13 +576,12 @@ fn drop_cube(label: &str, rotation: Rotation) -> Result<()> {
     let kn = 1e12;
     let g = 9.81;
     let mass = RHO * a * a * a;
-    let mut model: Model = Model::new(ModelParameters::default())?;
+    let mut model = common::model(CoulombSlip::dry(kn, 0.4 * kn, 35.0)?);
     let tolerance = model.parameters().contact.tolerance;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(kn, 0.4 * kn, 35.0)?)?;
     // Stiffness-proportional damping: 10 % at the frequency of the cube bouncing on a face.
     let f_contact = (kn * a * a / mass).sqrt() / (2.0 * PI);
     model.set_damping(Damping::rayleigh_stiffness(0.1, f_contact)?)?;
-    model.add_block(base()?)?;
+    model.add_block(common::fixed_slab("base"))?;
     let cube = RigidBlock::cuboid("cube", Vector::splat(-a / 2.0), Vector::splat(a / 2.0), RHO)?
         .transformed(Pose::from_rotation(rotation));
     let lowest = world_vertices(&cube).map(|v| v.z).fold(Real::INFINITY, Real::min);

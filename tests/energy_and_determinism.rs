@@ -1,8 +1,12 @@
 //! Whole-engine checks through the public API: the energy balance of damped collapses and of an
 //! undamped elastic system, and bit-identical determinism across runs and thread counts.
 
+mod common;
+
 use voussoir::build::{running_bond_wall, WallSpec};
 use voussoir::prelude::*;
+
+use common::fingerprint;
 
 /// Friction angle of the collapse joints (degrees).
 const PHI: f64 = 30.0;
@@ -17,10 +21,7 @@ fn column(damping: Damping, tilt_deg: f64, n: usize) -> Model {
         gravity: 9.81 * Vector::new(t.sin(), 0.0, -t.cos()),
         ..ModelParameters::default()
     };
-    let mut model: Model = Model::new(params).unwrap();
-    model
-        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e8, 4e7, PHI).unwrap())
-        .unwrap();
+    let mut model = common::model_with(params, CoulombSlip::dry(1e8, 4e7, PHI).unwrap());
     model.set_damping(damping).unwrap();
     model
         .add_block(
@@ -36,14 +37,9 @@ fn column(damping: Damping, tilt_deg: f64, n: usize) -> Model {
         .unwrap();
     for k in 0..n {
         let z = 0.2 * k as f64;
-        let cube = RigidBlock::cuboid(
-            &format!("cube {k}"),
-            Vector::new(-0.1, -0.1, z),
-            Vector::new(0.1, 0.1, z + 0.2),
-            2500.0,
-        )
-        .unwrap();
-        model.add_block(cube).unwrap();
+        model
+            .add_block(common::cube(&format!("cube {k}"), Vector::new(0.0, 0.0, z)))
+            .unwrap();
     }
     model
 }
@@ -198,35 +194,16 @@ fn collapse_with_rayleigh_damping_balances_energy() {
 /// the balance must hold within 1 % at every step over 0.2 s (tens of contact oscillations).
 #[test]
 fn undamped_elastic_stack_conserves_energy() {
-    let mut model: Model<LinearElastic> = Model::new(ModelParameters::default()).unwrap();
-    let law = LinearElastic {
+    let mut model = common::model(LinearElastic {
         normal_stiffness: 1e8,
         shear_stiffness: 4e7,
-    };
-    model.set_joint_law(MaterialId(0), MaterialId(0), law).unwrap();
+    });
     model.set_damping(Damping::None).unwrap();
-    model
-        .add_block(
-            RigidBlock::cuboid(
-                "slab",
-                Vector::new(-1.0, -1.0, -0.2),
-                Vector::new(1.0, 1.0, 0.0),
-                2500.0,
-            )
-            .unwrap()
-            .with_fixity(Fixity::FIXED),
-        )
-        .unwrap();
+    model.add_block(common::fixed_slab("slab")).unwrap();
     for k in 0..3 {
         let z = 0.2 * k as f64;
-        let cube = RigidBlock::cuboid(
-            &format!("cube {k}"),
-            Vector::new(-0.1, -0.1, z),
-            Vector::new(0.1, 0.1, z + 0.2),
-            2500.0,
-        )
-        .unwrap()
-        .with_velocity(Vector::new(0.002 * (k + 1) as f64, 0.0, 0.0), Vector::ZERO);
+        let cube = common::cube(&format!("cube {k}"), Vector::new(0.0, 0.0, z))
+            .with_velocity(Vector::new(0.002 * (k + 1) as f64, 0.0, 0.0), Vector::ZERO);
         model.add_block(cube).unwrap();
     }
     let mut max_friction: f64 = 0.0;
@@ -270,10 +247,7 @@ fn tilted_wall() -> Model {
         gravity: 9.81 * Vector::new(0.0, t.sin(), -t.cos()),
         ..ModelParameters::default()
     };
-    let mut model: Model = Model::new(params).unwrap();
-    model
-        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e8, 4e7, 25.0).unwrap())
-        .unwrap();
+    let mut model = common::model_with(params, CoulombSlip::dry(1e8, 4e7, 25.0).unwrap());
     let spec = WallSpec {
         bricks_per_course: 5,
         courses: 5,
@@ -288,43 +262,6 @@ fn tilted_wall() -> Model {
 /// Steps of the determinism runs: enough for the wall to move by millimetres and for several
 /// re-detections, within a second or two in release.
 const DETERMINISM_STEPS: u64 = 600;
-
-/// Every bit of the state that a run produces: block poses, velocities and angular momenta,
-/// energies, contact resultants and sub-contact forces.
-fn fingerprint(model: &Model) -> Vec<u64> {
-    let mut bits = Vec::new();
-    let mut push = |v: Vector| bits.extend([v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
-    for b in model.blocks() {
-        let s = b.state();
-        push(s.pose.translation);
-        push(Vector::new(s.pose.rotation.x, s.pose.rotation.y, s.pose.rotation.z));
-        push(Vector::new(s.pose.rotation.w, model.time(), model.dt()));
-        push(s.velocity);
-        push(s.angular_velocity);
-        push(s.angular_momentum);
-    }
-    for c in model.contacts() {
-        push(c.resultant());
-        for s in c.subcontacts() {
-            push(s.shear_force());
-            push(Vector::new(s.normal_force(), s.slip(), s.normal_displacement()));
-        }
-    }
-    let e = model.energies();
-    for x in [
-        e.kinetic,
-        e.elastic,
-        e.friction,
-        e.damping,
-        e.gravity_work,
-        e.joint_work,
-    ] {
-        bits.push(x.to_bits());
-    }
-    bits.push(model.detection_count());
-    bits.push(model.subcontact_count() as u64);
-    bits
-}
 
 fn run_wall() -> (Vec<u64>, Model) {
     let mut model = tilted_wall();

@@ -22,6 +22,8 @@
 //! `energy_balance_holds_at_every_step_with_a_resolving_step` checks separately with a
 //! smaller step.
 
+mod common;
+
 use voussoir::build::{running_bond_wall, WallSpec};
 use voussoir::prelude::*;
 
@@ -31,13 +33,6 @@ const EDGE: Real = 0.2;
 /// A frictionless, no-tension joint (kn = ks = 1 GPa/m, φ = 0).
 fn frictionless() -> CoulombSlip {
     CoulombSlip::dry(1e9, 1e9, 0.0).expect("valid law")
-}
-
-/// A fixed 2 m × 2 m × 0.2 m slab whose top face is the plane z = 0.
-fn slab() -> RigidBlock {
-    RigidBlock::cuboid("slab", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), RHO)
-        .expect("slab")
-        .with_fixity(Fixity::FIXED)
 }
 
 /// The lowest and highest world `z` of a block's vertices (m).
@@ -55,10 +50,9 @@ fn z_range(block: &RigidBlock) -> (Real, Real) {
 /// A model with the slab and a 0.2 m cube turned by `rotation` whose lowest point is `height`
 /// above the slab, undamped, with `law`.
 fn drop_model(rotation: Rotation, height: Real, law: CoulombSlip, params: ModelParameters) -> (Model, BlockId) {
-    let mut model: Model = Model::new(params).expect("model");
-    model.set_joint_law(MaterialId(0), MaterialId(0), law).expect("law");
+    let mut model = common::model_with(params, law);
     model.set_damping(Damping::None).expect("damping");
-    model.add_block(slab()).expect("slab");
+    model.add_block(common::fixed_slab("slab")).expect("slab");
     let cube = RigidBlock::cuboid("cube", Vector::splat(-EDGE / 2.0), Vector::splat(EDGE / 2.0), RHO)
         .expect("cube")
         .transformed(Pose::from_rotation(rotation));
@@ -228,22 +222,13 @@ fn energy_balance_holds_at_every_step_with_a_resolving_step() {
 #[test]
 fn undamped_block_at_rest_on_an_incline_stays_put() {
     let tilt = Pose::from_rotation(Rotation::from_rotation_y(-30f64.to_radians()));
-    let mut model: Model = Model::new(ModelParameters::default()).expect("model");
-    model
-        .set_joint_law(
-            MaterialId(0),
-            MaterialId(0),
-            CoulombSlip::dry(1e9, 1e9, 40.0).expect("law"),
-        )
-        .expect("law");
+    let mut model = common::model(CoulombSlip::dry(1e9, 1e9, 40.0).expect("law"));
     model.set_damping(Damping::local()).expect("damping");
-    model.add_block(slab().transformed(tilt)).expect("slab");
+    model
+        .add_block(common::fixed_slab("slab").transformed(tilt))
+        .expect("slab");
     let cube = model
-        .add_block(
-            RigidBlock::cuboid("cube", Vector::new(-0.1, -0.1, 0.0), Vector::new(0.1, 0.1, 0.2), RHO)
-                .expect("cube")
-                .transformed(tilt),
-        )
+        .add_block(common::cube("cube", Vector::ZERO).transformed(tilt))
         .expect("cube");
     model.run_to_equilibrium(1e-7, 400_000).expect("equilibrium");
     model.set_damping(Damping::None).expect("damping");
@@ -284,14 +269,7 @@ fn undamped_block_at_rest_on_an_incline_stays_put() {
 /// of gravity at every sampled step (measured 0.7 %).
 #[test]
 fn undamped_wall_settles_without_walking() {
-    let mut model: Model = Model::new(ModelParameters::default()).expect("model");
-    model
-        .set_joint_law(
-            MaterialId(0),
-            MaterialId(0),
-            CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"),
-        )
-        .expect("law");
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
     model.set_damping(Damping::None).expect("damping");
     let spec = WallSpec {
         bricks_per_course: 10,
@@ -405,10 +383,7 @@ fn frictionless_drops_of_sharp_blocks_keep_their_energy() {
     let mut rng = Lcg(12345);
     let mut failures = Vec::new();
     for case in 0..40 {
-        let mut model: Model = Model::new(ModelParameters::default()).expect("model");
-        model
-            .set_joint_law(MaterialId(0), MaterialId(0), frictionless())
-            .expect("law");
+        let mut model = common::model(frictionless());
         model.set_damping(Damping::None).expect("damping");
         let mut turn = |scale: Real| {
             Rotation::from_scaled_axis(Vector::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5) * scale)

@@ -2,6 +2,8 @@
 //! variant comes back (never a panic), its fields name what is wrong, where, and the bad value,
 //! and so does its message.
 
+mod common;
+
 use voussoir::block::Dof;
 use voussoir::geometry::{ContactParameters, SubcontactDensity};
 use voussoir::prelude::*;
@@ -35,24 +37,10 @@ fn assert_names(message: &str, parts: &[&str]) {
 
 /// A model with a fixed 2 m slab (block #0) and a 0.2 m cube resting on it (block #1).
 fn slab_and_cube(params: ModelParameters) -> Model {
-    let mut model: Model = Model::new(params).unwrap();
+    let mut model = common::model_with(params, CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
+    model.add_block(common::fixed_slab("slab")).unwrap();
     model
-        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).unwrap())
-        .unwrap();
-    model
-        .add_block(
-            RigidBlock::cuboid(
-                "slab",
-                Vector::new(-1.0, -1.0, -0.2),
-                Vector::new(1.0, 1.0, 0.0),
-                2500.0,
-            )
-            .unwrap()
-            .with_fixity(Fixity::FIXED),
-        )
-        .unwrap();
-    model
-        .add_block(RigidBlock::cuboid("cube", Vector::ZERO, Vector::splat(0.2), 2500.0).unwrap())
+        .add_block(common::cube("cube", Vector::new(0.1, 0.1, 0.0)))
         .unwrap();
     model
 }
@@ -535,22 +523,8 @@ fn non_finite_loads_and_velocities() {
 /// both materials and both blocks.
 #[test]
 fn missing_joint_law() {
-    let mut model: Model = Model::new(ModelParameters::default()).unwrap();
-    model
-        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).unwrap())
-        .unwrap();
-    model
-        .add_block(
-            RigidBlock::cuboid(
-                "slab",
-                Vector::new(-1.0, -1.0, -0.2),
-                Vector::new(1.0, 1.0, 0.0),
-                2500.0,
-            )
-            .unwrap()
-            .with_fixity(Fixity::FIXED),
-        )
-        .unwrap();
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
+    model.add_block(common::fixed_slab("slab")).unwrap();
     model
         .add_block(
             RigidBlock::cuboid("steel plate", Vector::ZERO, Vector::new(0.2, 0.2, 0.02), 7850.0)
@@ -653,22 +627,8 @@ fn diverging_runs() {
         max_speed: 1e-3,
         ..ModelParameters::default()
     };
-    let mut model: Model = Model::new(params).unwrap();
-    model
-        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).unwrap())
-        .unwrap();
-    model
-        .add_block(
-            RigidBlock::cuboid(
-                "slab",
-                Vector::new(-1.0, -1.0, -0.2),
-                Vector::new(1.0, 1.0, 0.0),
-                2500.0,
-            )
-            .unwrap()
-            .with_fixity(Fixity::FIXED),
-        )
-        .unwrap();
+    let mut model = common::model_with(params, CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
+    model.add_block(common::fixed_slab("slab")).unwrap();
     model
         .add_block(
             RigidBlock::cuboid(

@@ -13,6 +13,8 @@
 //!   exercises inclined contact planes, rotated principal frames and re-detection along a
 //!   slanted face.
 
+mod common;
+
 use voussoir::prelude::*;
 
 /// Normal joint stiffness (Pa/m).
@@ -65,8 +67,7 @@ fn incline_scene(incline: Incline, psi_deg: Real, phi_deg: Real, size: Vector) -
         gravity,
         ..ModelParameters::default()
     };
-    let mut model: Model = Model::new(params)?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(KN, KS, phi_deg)?)?;
+    let mut model = common::model_with(params, CoulombSlip::dry(KN, KS, phi_deg)?);
     let base = model.add_block(
         RigidBlock::cuboid(
             "base",
@@ -418,27 +419,13 @@ fn block_stands_when_base_ratio_above_slope() -> Result<()> {
 /// periods (a few ms). Returns (mean displacement since launch, closed-form distance, drift
 /// between the means of the two halves of the window).
 fn stopping_distance(phi_deg: Real, v0: Real, direction: Vector) -> Result<(Vector, Real, Vector)> {
-    let edge = 0.2;
-    let mut model: Model = Model::new(ModelParameters {
+    let params = ModelParameters {
         gravity: Vector::new(0.0, 0.0, -G),
         ..ModelParameters::default()
-    })?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(KN, KS, phi_deg)?)?;
-    model.add_block(
-        RigidBlock::cuboid(
-            "base",
-            Vector::new(-1.0, -1.0, -0.2),
-            Vector::new(1.0, 1.0, 0.0),
-            DENSITY,
-        )?
-        .with_fixity(Fixity::FIXED),
-    )?;
-    let id = model.add_block(RigidBlock::cuboid(
-        "cube",
-        Vector::new(-0.1, -0.1, 0.0),
-        Vector::new(0.1, 0.1, edge),
-        DENSITY,
-    )?)?;
+    };
+    let mut model = common::model_with(params, CoulombSlip::dry(KN, KS, phi_deg)?);
+    model.add_block(common::fixed_slab("base"))?;
+    let id = model.add_block(common::cube("cube", Vector::ZERO))?;
     settle(&mut model, id)?;
     model.set_damping(Damping::None)?;
     model.set_velocity(id, v0 * direction, Vector::ZERO)?;

@@ -2,6 +2,8 @@
 //! settling run the unbalanced-force ratio is small and no block has moved by more than a small
 //! fraction of its size (elastic settlement on the joint springs only).
 
+mod common;
+
 use voussoir::build::{barrel_vault, dome, multi_leaf_wall, BarrelVaultSpec, DomeSpec, MultiLeafSpec};
 use voussoir::prelude::*;
 
@@ -19,8 +21,7 @@ fn settle(blocks: Vec<RigidBlock>, gravity: Vector, spacing: f64) -> Result<(f64
         },
         ..ModelParameters::default()
     };
-    let mut model: Model = Model::new(params)?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(KN, 0.4 * KN, 35.0)?)?;
+    let mut model = common::model_with(params, CoulombSlip::dry(KN, 0.4 * KN, 35.0)?);
     let n = blocks.len();
     for b in blocks {
         model.add_block(b)?;

@@ -7,15 +7,16 @@
 //! sub-contacts' shear forces, the joint would drop the load and the block would slip by
 //! `P/(ks·A)` each time until the springs reloaded.
 
+mod common;
+
 use voussoir::prelude::*;
 
 #[test]
 fn a_stuck_joint_keeps_its_shear_force_through_redetection() -> Result<()> {
     let (phi_deg, rho, g) = (30.0_f64, 2500.0, 9.81);
     let mu = phi_deg.to_radians().tan();
-    let mut model: Model = Model::new(ModelParameters::default())?;
     let (kn, ks) = (1e9, 4e8);
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(kn, ks, phi_deg)?)?;
+    let mut model = common::model(CoulombSlip::dry(kn, ks, phi_deg)?);
     let travel = Vector::new(0.0, 0.1, 0.0);
     let base = model.add_block(
         RigidBlock::cuboid(
@@ -82,8 +83,7 @@ fn a_stuck_joint_keeps_its_shear_force_through_redetection() -> Result<()> {
 fn a_stuck_edge_contact_keeps_its_shear_force_through_redetection() -> Result<()> {
     let (phi_deg, rho, g) = (30.0_f64, 2500.0, 9.81);
     let mu = phi_deg.to_radians().tan();
-    let mut model: Model = Model::new(ModelParameters::default())?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, phi_deg)?)?;
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, phi_deg)?);
     let travel = Vector::new(0.0, 0.1, 0.0);
     let prism = |name: &str, y: Real| -> Result<RigidBlock> {
         let v = [

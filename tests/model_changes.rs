@@ -1,26 +1,15 @@
 //! Changing a model mid-run (laws, parameters, fixity) re-evaluates what depends on it
 //! (regressions from a review: these changes used to be ignored silently).
 
+mod common;
+
 use voussoir::prelude::*;
 
+/// A 0.2 m cube on the fixed slab (1 GPa/m joints, φ = 30°).
 fn cube_on_base() -> Result<(Model, BlockId)> {
-    let mut model: Model = Model::new(ModelParameters::default())?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
-    model.add_block(
-        RigidBlock::cuboid(
-            "base",
-            Vector::new(-1.0, -1.0, -0.2),
-            Vector::new(1.0, 1.0, 0.0),
-            2500.0,
-        )?
-        .with_fixity(Fixity::FIXED),
-    )?;
-    let cube = model.add_block(RigidBlock::cuboid(
-        "cube",
-        Vector::new(-0.1, -0.1, 0.0),
-        Vector::new(0.1, 0.1, 0.2),
-        2500.0,
-    )?)?;
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0)?);
+    model.add_block(common::fixed_slab("base"))?;
+    let cube = model.add_block(common::cube("cube", Vector::ZERO))?;
     Ok((model, cube))
 }
 

@@ -13,6 +13,8 @@
 //! Closed forms are written out from the geometry and the loads; nothing is read back from a
 //! previous run.
 
+mod common;
+
 use voussoir::law::JointStatus;
 use voussoir::prelude::*;
 
@@ -32,14 +34,7 @@ const MAX_STEPS: u64 = 200_000;
 fn model(kn: f64, density: SubcontactDensity) -> Model {
     let mut params = ModelParameters::default();
     params.contact.density = density;
-    let mut m: Model = Model::new(params).unwrap();
-    m.set_joint_law(
-        MaterialId(0),
-        MaterialId(0),
-        CoulombSlip::dry(kn, 0.4 * kn, PHI).unwrap(),
-    )
-    .unwrap();
-    m
+    common::model_with(params, CoulombSlip::dry(kn, 0.4 * kn, PHI).unwrap())
 }
 
 fn cuboid(name: &str, min: [f64; 3], max: [f64; 3]) -> RigidBlock {

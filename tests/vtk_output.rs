@@ -4,6 +4,8 @@
 //! `.ci/run`, which installs VTK's Python package) the files are also read by VTK itself, which
 //! checks cell counts, cell types, the total volume of the polyhedra and the sub-contact areas.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -12,8 +14,7 @@ use voussoir::prelude::*;
 
 #[test]
 fn vtu_frames_are_read_back_by_vtk() -> Result<()> {
-    let mut model: Model = Model::new(ModelParameters::default())?;
-    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0)?);
     model.add_block(
         RigidBlock::cuboid(
             "base",
