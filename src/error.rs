@@ -129,8 +129,18 @@ pub enum Error {
     },
 }
 
-/// Checks that `value` is finite and strictly positive.
-pub(crate) fn positive(name: &str, value: Real) -> Result<Real> {
+/// Checks that `value` is finite and strictly positive; the error names the parameter. For
+/// validating the parameters of laws, generators and scenarios written outside the crate.
+///
+/// ```
+/// use voussoir::error::positive;
+/// assert_eq!(positive("density", 2500.0), Ok(2500.0));
+/// assert!(positive("density", -1.0).unwrap_err().to_string().contains("density"));
+/// ```
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name`.
+pub fn positive(name: &str, value: Real) -> Result<Real> {
     if value.is_finite() && value > 0.0 {
         Ok(value)
     } else {
@@ -142,8 +152,11 @@ pub(crate) fn positive(name: &str, value: Real) -> Result<Real> {
     }
 }
 
-/// Checks that `value` is finite and not negative.
-pub(crate) fn non_negative(name: &str, value: Real) -> Result<Real> {
+/// Checks that `value` is finite and not negative; the error names the parameter.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name`.
+pub fn non_negative(name: &str, value: Real) -> Result<Real> {
     if value.is_finite() && value >= 0.0 {
         Ok(value)
     } else {
@@ -155,8 +168,11 @@ pub(crate) fn non_negative(name: &str, value: Real) -> Result<Real> {
     }
 }
 
-/// Checks that `value` lies in `[lo, hi)`.
-pub(crate) fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'static str) -> Result<Real> {
+/// Checks that `value` lies in `[lo, hi)`; the error names the parameter and says `expected`.
+///
+/// # Errors
+/// [`Error::InvalidParameter`] naming `name`.
+pub fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'static str) -> Result<Real> {
     if value.is_finite() && value >= lo && value < hi {
         Ok(value)
     } else {

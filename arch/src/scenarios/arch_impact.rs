@@ -31,7 +31,7 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
-use super::{in_range, non_negative, positive};
+use super::{in_range, non_negative, positive, stop_when};
 use voussoir::block::{Block, BlockId, Dof, Fixity, RigidBlock};
 use voussoir::build::arch::Arch;
 use voussoir::error::{Error, Result};
@@ -721,13 +721,9 @@ impl<F: FnMut(&Model) -> Result<()>> voussoir::model::Observer<CoulombSlip> for 
             self.collapse_time = Some(t);
         }
         // After a collapse, keep 0.1 s for the record, then stop.
-        Ok(
-            if t >= case.duration || self.collapse_time.is_some_and(|tc| t > tc + 0.1) {
-                ControlFlow::Break(())
-            } else {
-                ControlFlow::Continue(())
-            },
-        )
+        Ok(stop_when(
+            t >= case.duration || self.collapse_time.is_some_and(|tc| t > tc + 0.1),
+        ))
     }
 }
 

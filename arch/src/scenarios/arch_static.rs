@@ -284,11 +284,7 @@ impl<F: FnMut(&Model) -> Result<()>> voussoir::model::Observer<voussoir::law::Co
         }
         let fallen =
             self.peak.0 > 0.0 && smoothed_load < case.stop_fraction * self.peak.0 && displacement > self.peak.1;
-        Ok(if displacement >= case.max_displacement || fallen {
-            ControlFlow::Break(())
-        } else {
-            ControlFlow::Continue(())
-        })
+        Ok(super::stop_when(displacement >= case.max_displacement || fallen))
     }
 }
 

@@ -7,7 +7,7 @@ pub mod arch_static;
 
 use voussoir::build::arch::{Arch, ArchSpec};
 use voussoir::contact::DisplacementMode;
-use voussoir::error::{Error, Result};
+use voussoir::error::Result;
 use voussoir::geometry::{ContactParameters, SubcontactDensity};
 use voussoir::law::{CoulombSlip, MaterialId};
 use voussoir::math::{Real, Vector};
@@ -55,43 +55,13 @@ pub(crate) fn reference_arch_model(j: ArchJoints) -> Result<(Model, Arch)> {
     Ok((model, arch))
 }
 
-// The core's parameter checks are crate-private; the impact scenario's copies, same messages.
+pub(crate) use voussoir::error::{in_range, non_negative, positive};
 
-/// Checks that `value` is finite and positive.
-pub(crate) fn positive(name: &str, value: Real) -> Result<Real> {
-    if value.is_finite() && value > 0.0 {
-        Ok(value)
+/// The answer of a run's observer: stop once `done`.
+pub(crate) fn stop_when(done: bool) -> std::ops::ControlFlow<()> {
+    if done {
+        std::ops::ControlFlow::Break(())
     } else {
-        Err(Error::InvalidParameter {
-            name: name.to_owned(),
-            value,
-            expected: "must be positive and finite",
-        })
-    }
-}
-
-/// Checks that `value` is finite and not negative.
-pub(crate) fn non_negative(name: &str, value: Real) -> Result<Real> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(Error::InvalidParameter {
-            name: name.to_owned(),
-            value,
-            expected: "must be finite and not negative",
-        })
-    }
-}
-
-/// Checks that `value` lies in `[lo, hi)`.
-pub(crate) fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'static str) -> Result<Real> {
-    if value.is_finite() && value >= lo && value < hi {
-        Ok(value)
-    } else {
-        Err(Error::InvalidParameter {
-            name: name.to_owned(),
-            value,
-            expected,
-        })
+        std::ops::ControlFlow::Continue(())
     }
 }
