@@ -123,7 +123,7 @@ struct SubContactEntry<S> {
 impl<L: ConstitutiveLaw> Model<L> {
     /// Contact `k` as a checkpoint stores it.
     fn joint_entry(&self, k: usize) -> JointEntry<L::State> {
-        let (p, r) = (&self.pairs[k], &self.references[k]);
+        let (p, r) = (&self.state.pairs[k], &self.state.references[k]);
         let range = p.range();
         JointEntry {
             blocks: (p.a, p.b),
@@ -140,10 +140,10 @@ impl<L: ConstitutiveLaw> Model<L> {
             reference_host_rotation: r.ref_host_rotation,
             area: r.area,
             bound_area: r.bound_area,
-            wrench: self.wrenches[k],
-            subcontacts: self.subs[range.clone()]
+            wrench: self.state.wrenches[k],
+            subcontacts: self.state.subs[range.clone()]
                 .iter()
-                .zip(&self.sub_records[range])
+                .zip(&self.state.sub_records[range])
                 .map(|(s, rec)| SubContactEntry {
                     key: rec.key,
                     plane: s.plane,
@@ -246,37 +246,41 @@ where
     /// [`Error::Unsupported`] for a custom integrator; [`Error::Io`] if serialisation fails (it
     /// does not for the shipped laws).
     pub fn to_checkpoint_string(&self) -> Result<String> {
-        let Some(damping) = self.integrator.checkpoint_damping() else {
+        let Some(damping) = self.state.integrator.checkpoint_damping() else {
             return Err(Error::Unsupported {
                 what: format!(
                     "checkpoint of a model with a custom integrator ({:?}), which a checkpoint cannot restore",
-                    self.integrator
+                    self.state.integrator
                 ),
             });
         };
         let snap = Snapshot::<L> {
             format: FORMAT.into(),
             version: VERSION,
-            params: self.params,
+            params: self.state.params,
             damping,
-            blocks: self.blocks.clone(),
-            joints: self.joints.clone(),
-            contacts: (0..self.pairs.len()).map(|k| self.joint_entry(k)).collect(),
-            ref_poses: self.ref_poses.clone(),
-            dt: self.dt,
-            critical: self.critical,
-            step: self.step,
-            time: self.time,
+            blocks: self.state.blocks.clone(),
+            joints: self.state.joints.clone(),
+            contacts: (0..self.state.pairs.len()).map(|k| self.joint_entry(k)).collect(),
+            ref_poses: self.state.ref_poses.clone(),
+            dt: self.state.dt,
+            critical: self.state.critical,
+            step: self.state.step,
+            time: self.state.time,
             energy: self.energies(),
-            started: self.started,
-            unbalanced_ratio: self.unbalanced_ratio.is_finite().then_some(self.unbalanced_ratio),
-            detections: self.detections,
-            last_forces: self.records.iter().map(|r| (r.reaction, r.damping)).collect(),
-            drift: self.drift,
-            refine_until: self.refine_until,
-            refine_omega2: self.refine_omega2,
-            refining: self.refining.clone(),
-            pending_detection: self.changes.need_full_detection(),
+            started: self.state.started,
+            unbalanced_ratio: self
+                .state
+                .unbalanced_ratio
+                .is_finite()
+                .then_some(self.state.unbalanced_ratio),
+            detections: self.state.detections,
+            last_forces: self.state.records.iter().map(|r| (r.reaction, r.damping)).collect(),
+            drift: self.state.drift,
+            refine_until: self.state.refine_until,
+            refine_omega2: self.state.refine_omega2,
+            refining: self.state.refining.clone(),
+            pending_detection: self.state.changes.need_full_detection(),
         };
         serde_json::to_string(&snap).map_err(|e| Error::Io {
             path: "(checkpoint)".into(),
@@ -404,22 +408,24 @@ where
                 .map_err(|e| corrupt(&format!("blocks[{i}]"), &e.to_string()))?;
             model.add_block(b)?;
         }
-        model.joints = snap.joints;
-        model.integrator = Box::new(CentralDifference::new(snap.damping));
-        model.pairs = pairs;
-        model.references = references;
-        model.wrenches = wrenches;
-        model.subs = subs;
-        model.sub_records = sub_records;
-        for (k, p) in model.pairs.iter_mut().enumerate() {
-            let (a, b) = (&model.blocks[p.a as usize], &model.blocks[p.b as usize]);
+        model.state.joints = snap.joints;
+        model.state.integrator = Box::new(CentralDifference::new(snap.damping));
+        model.state.pairs = pairs;
+        model.state.references = references;
+        model.state.wrenches = wrenches;
+        model.state.subs = subs;
+        model.state.sub_records = sub_records;
+        for (k, p) in model.state.pairs.iter_mut().enumerate() {
+            let (a, b) = (&model.state.blocks[p.a as usize], &model.state.blocks[p.b as usize]);
             p.cache_local_faces(Block::shape(a), Block::shape(b));
             // Dashpot forces still held must be seen (and their work booked) by the next step.
-            p.dashpots |= model.sub_records[p.range()].iter().any(|r| r.dashpot != Vector::ZERO);
+            p.dashpots |= model.state.sub_records[p.range()]
+                .iter()
+                .any(|r| r.dashpot != Vector::ZERO);
             // The stored spring moments are those of the stored forces, up to summation order.
             if !p
                 .springs
-                .matches(&ForceMoments::of_springs(&p.axes(), &model.subs[p.range()]))
+                .matches(&ForceMoments::of_springs(&p.axes(), &model.state.subs[p.range()]))
             {
                 return Err(corrupt(
                     &format!("contacts[{k}].springs"),
@@ -427,34 +433,34 @@ where
                 ));
             }
         }
-        model.ref_poses = snap.ref_poses;
-        model.dt = snap.dt;
-        model.drift = if snap.drift > 0.0 && snap.started {
+        model.state.ref_poses = snap.ref_poses;
+        model.state.dt = snap.dt;
+        model.state.drift = if snap.drift > 0.0 && snap.started {
             snap.drift
         } else {
             0.0
         };
-        model.refine_until = snap.refine_until;
-        model.refine_omega2 = snap.refine_omega2;
-        model.refining = snap.refining;
-        model.refining.sort_unstable();
-        model.refining.dedup();
-        model.critical = snap.critical;
-        model.step = snap.step;
-        model.time = snap.time;
-        model.energy = snap.energy;
-        model.started = snap.started;
-        model.unbalanced_ratio = snap.unbalanced_ratio.unwrap_or(Real::INFINITY);
-        model.detections = snap.detections;
-        for (r, &(reaction, damping)) in model.records.iter_mut().zip(&snap.last_forces) {
+        model.state.refine_until = snap.refine_until;
+        model.state.refine_omega2 = snap.refine_omega2;
+        model.state.refining = snap.refining;
+        model.state.refining.sort_unstable();
+        model.state.refining.dedup();
+        model.state.critical = snap.critical;
+        model.state.step = snap.step;
+        model.state.time = snap.time;
+        model.state.energy = snap.energy;
+        model.state.started = snap.started;
+        model.state.unbalanced_ratio = snap.unbalanced_ratio.unwrap_or(Real::INFINITY);
+        model.state.detections = snap.detections;
+        for (r, &(reaction, damping)) in model.state.records.iter_mut().zip(&snap.last_forces) {
             r.reaction = reaction;
             r.damping = damping;
         }
-        model.changes.clear();
-        if !model.started || snap.pending_detection {
-            model.changes.insert(super::changes::Changes::DETECTION);
+        model.state.changes.clear();
+        if !model.state.started || snap.pending_detection {
+            model.state.changes.insert(super::changes::Changes::DETECTION);
         }
-        model.rebuild_block_index();
+        model.state.rebuild_block_index(&mut model.pipeline);
         Ok(model)
     }
 

@@ -3,7 +3,8 @@
 use rayon::prelude::*;
 
 use super::changes::Changes;
-use super::{Model, BLOCK_CHUNK};
+use super::pipeline::Pipeline;
+use super::{ModelState, BLOCK_CHUNK};
 use crate::block::{Block, BlockId, RigidBlock};
 use crate::contact::{
     AnchorPlane, ContactPair, ContactReference, ContactWrench, DisplacementMode, ForceMoments, SubContact,
@@ -51,16 +52,16 @@ impl<S> Default for DetectionScratch<S> {
     }
 }
 
-impl<L: ConstitutiveLaw> Model<L> {
+impl<L: ConstitutiveLaw> ModelState<L> {
     /// The step's first pass over the blocks: their rotation matrices, which the contact pass
     /// reads instead of turning every contact's normals by quaternions, and (`check`) whether
     /// any material point of a block moved more than the re-detection trigger since the block's
     /// last detection. (After a step of a blockwise integrator the block pass has done this
     /// already, see [`DetectionScratch::prepared`].)
-    pub(super) fn prepare_blocks(&mut self, check: bool) -> bool {
+    pub(super) fn prepare_blocks(&mut self, pipeline: &mut Pipeline<L::State>, check: bool) -> bool {
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
-        self.pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
-        self.pipeline
+        pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        pipeline
             .rotations
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(self.blocks.par_chunks(BLOCK_CHUNK))
@@ -71,11 +72,11 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// Re-detects contacts: pairs where a block moved beyond the trigger get a fresh narrow phase
     /// with sub-contact history carried over by key; other pairs are kept as they are.
-    pub(super) fn detect(&mut self) -> Result<()> {
+    pub(super) fn detect(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
         let params = self.params.contact;
         let full = self.changes.need_full_detection() || self.params.mode == DisplacementMode::Small;
         let trigger = params.redetect_fraction * params.tolerance;
-        let sc = &mut self.pipeline.detection;
+        let sc = &mut pipeline.detection;
         sc.moved.clear();
         sc.moved.extend(
             self.blocks
@@ -168,39 +169,37 @@ impl<L: ConstitutiveLaw> Model<L> {
             }
         }
         self.detections += 1;
-        self.rebuild_block_index();
+        self.rebuild_block_index(pipeline);
         // A forced full detection follows a change of laws, parameters or fixity: the step is
         // re-evaluated then too, as after a re-detection that found stiffer contacts. The flag
         // is set (or stays set) if that fails, so the error repeats rather than the run going on
         // with an unstable step.
         if stiffer || full || self.critical.is_none() {
             self.changes.insert(Changes::DETECTION);
-            self.refresh_time_step()?;
+            self.refresh_time_step(pipeline)?;
         }
         self.changes.clear();
         Ok(())
     }
 
-    pub(super) fn rebuild_block_index(&mut self) {
+    pub(super) fn rebuild_block_index(&mut self, pipeline: &mut Pipeline<L::State>) {
         let n = self.blocks.len();
-        self.pipeline.block_offsets.clear();
-        self.pipeline.block_offsets.resize(n + 1, 0);
+        pipeline.block_offsets.clear();
+        pipeline.block_offsets.resize(n + 1, 0);
         for p in &self.pairs {
-            self.pipeline.block_offsets[p.a as usize + 1] += 1;
-            self.pipeline.block_offsets[p.b as usize + 1] += 1;
+            pipeline.block_offsets[p.a as usize + 1] += 1;
+            pipeline.block_offsets[p.b as usize + 1] += 1;
         }
         for i in 0..n {
-            self.pipeline.block_offsets[i + 1] += self.pipeline.block_offsets[i];
+            pipeline.block_offsets[i + 1] += pipeline.block_offsets[i];
         }
-        self.pipeline.block_contacts.clear();
-        self.pipeline
-            .block_contacts
-            .resize(self.pipeline.block_offsets[n] as usize, 0);
-        let mut fill: Vec<u32> = self.pipeline.block_offsets[..n].to_vec();
+        pipeline.block_contacts.clear();
+        pipeline.block_contacts.resize(pipeline.block_offsets[n] as usize, 0);
+        let mut fill: Vec<u32> = pipeline.block_offsets[..n].to_vec();
         // Each entry is `2 × contact + side`, side 1 when the block is the contact's `b`.
         for (c, p) in self.pairs.iter().enumerate() {
             for (k, side) in [(p.a as usize, 0), (p.b as usize, 1)] {
-                self.pipeline.block_contacts[fill[k] as usize] = 2 * c as u32 + side;
+                pipeline.block_contacts[fill[k] as usize] = 2 * c as u32 + side;
                 fill[k] += 1;
             }
         }

@@ -9,6 +9,7 @@ mod energy;
 mod motion;
 mod observe;
 mod pipeline;
+mod step;
 mod time_step;
 
 use rayon::prelude::*;
@@ -20,8 +21,7 @@ pub use observe::Observer;
 
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::contact::{
-    ContactPair, ContactReference, ContactView, ContactWrench, DisplacementMode, KernelContext, SubContact,
-    SubContactRecord,
+    ContactPair, ContactReference, ContactView, ContactWrench, DisplacementMode, SubContact, SubContactRecord,
 };
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
@@ -30,7 +30,6 @@ use crate::law::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
 use crate::math::{is_finite_vector, Pose, Real, Vector};
 
 use changes::Changes;
-use contact_pass::{ContactPass, ContactSlices, PairSums, CONTACT_CHUNK};
 use pipeline::Pipeline;
 
 /// Global parameters of a model, with documented defaults.
@@ -114,46 +113,53 @@ impl ModelParameters {
 /// # Ok::<(), voussoir::Error>(())
 /// ```
 pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
-    params: ModelParameters,
-    blocks: Vec<RigidBlock>,
-    joints: JointTable<L>,
-    integrator: Box<dyn Integrator>,
-    pairs: Vec<ContactPair>,
+    /// Everything a run continues from (and a checkpoint stores).
+    state: ModelState<L>,
+    /// What the step computes afresh, and buffers it reuses: no state of the model.
+    pipeline: Pipeline<L::State>,
+}
+
+/// The model's state: blocks, laws, contacts with their history, time and energies; the
+/// stages of the step are its methods, each given the [`Pipeline`] it may use as scratch.
+pub(super) struct ModelState<L: ConstitutiveLaw> {
+    pub params: ModelParameters,
+    pub blocks: Vec<RigidBlock>,
+    pub joints: JointTable<L>,
+    pub integrator: Box<dyn Integrator>,
+    pub pairs: Vec<ContactPair>,
     /// The contacts' reference geometry and areas, index for index with `pairs`.
-    references: Vec<ContactReference>,
-    subs: Vec<SubContact<L::State>>,
+    pub references: Vec<ContactReference>,
+    pub subs: Vec<SubContact<L::State>>,
     /// The sub-contacts' records (key, slip, dashpot force), index for index with `subs`.
-    sub_records: Vec<SubContactRecord>,
-    records: Vec<StepRecord>,
+    pub sub_records: Vec<SubContactRecord>,
+    pub records: Vec<StepRecord>,
     /// The contacts' resultants and moments, index for index with `pairs`: written by the
     /// contact pass, read by the per-block gather and the accessors (kept out of `ContactPair`,
     /// whose stream they would lengthen by 72 bytes per contact). Detection carries a kept
     /// contact's wrench and starts a new one at zero; checkpointed.
-    wrenches: Vec<ContactWrench>,
-    ref_poses: Vec<Pose>,
+    pub wrenches: Vec<ContactWrench>,
+    pub ref_poses: Vec<Pose>,
     /// The step: `safety × critical` (or the fixed one), as set at the last evaluation.
-    dt: Real,
+    pub dt: Real,
     /// The step that brought the blocks to their poses (`Δt_{n−½}`): `dt`, or shorter around
     /// impacts (see [`ModelParameters::impact_step`]).
-    drift: Real,
+    pub drift: Real,
     /// Impact refinement: the time until which it holds, and the largest squared frequency
     /// bound of the blocks that asked for it (0 when not refining).
-    refine_until: Real,
-    refine_omega2: Real,
+    pub refine_until: Real,
+    pub refine_omega2: Real,
     /// The contacts (as sorted block pairs) the impact probe marked since the refinement began:
     /// the step is not relaxed while one of them is loaded and moving fast.
-    refining: Vec<(u32, u32)>,
-    critical: Option<CriticalStep>,
-    step: u64,
-    time: Real,
-    energy: Energies,
-    started: bool,
+    pub refining: Vec<(u32, u32)>,
+    pub critical: Option<CriticalStep>,
+    pub step: u64,
+    pub time: Real,
+    pub energy: Energies,
+    pub started: bool,
     /// What the setters changed since the last step (read first by [`Model::step`]).
-    changes: Changes,
-    unbalanced_ratio: Real,
-    detections: u64,
-    /// What the step computes afresh, and buffers it reuses: no state of the model.
-    pipeline: Pipeline<L::State>,
+    pub changes: Changes,
+    pub unbalanced_ratio: Real,
+    pub detections: u64,
 }
 
 /// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).
@@ -183,12 +189,12 @@ impl Timings {
 impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Model")
-            .field("blocks", &self.blocks.len())
-            .field("contacts", &self.pairs.len())
-            .field("subcontacts", &self.subs.len())
-            .field("step", &self.step)
-            .field("time", &self.time)
-            .field("dt", &self.dt)
+            .field("blocks", &self.state.blocks.len())
+            .field("contacts", &self.state.pairs.len())
+            .field("subcontacts", &self.state.subs.len())
+            .field("step", &self.state.step)
+            .field("time", &self.state.time)
+            .field("dt", &self.state.dt)
             .finish()
     }
 }
@@ -243,30 +249,32 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn new(params: ModelParameters) -> Result<Self> {
         params.validate()?;
         Ok(Self {
-            params,
-            blocks: Vec::new(),
-            joints: JointTable::new(),
-            integrator: Box::new(CentralDifference::default()),
-            pairs: Vec::new(),
-            references: Vec::new(),
-            subs: Vec::new(),
-            sub_records: Vec::new(),
-            records: Vec::new(),
-            wrenches: Vec::new(),
-            ref_poses: Vec::new(),
-            dt: 0.0,
-            drift: 0.0,
-            refine_until: 0.0,
-            refine_omega2: 0.0,
-            refining: Vec::new(),
-            critical: None,
-            step: 0,
-            time: 0.0,
-            energy: Energies::default(),
-            started: false,
-            changes: Changes::DETECTION,
-            unbalanced_ratio: Real::INFINITY,
-            detections: 0,
+            state: ModelState {
+                params,
+                blocks: Vec::new(),
+                joints: JointTable::new(),
+                integrator: Box::new(CentralDifference::default()),
+                pairs: Vec::new(),
+                references: Vec::new(),
+                subs: Vec::new(),
+                sub_records: Vec::new(),
+                records: Vec::new(),
+                wrenches: Vec::new(),
+                ref_poses: Vec::new(),
+                dt: 0.0,
+                drift: 0.0,
+                refine_until: 0.0,
+                refine_omega2: 0.0,
+                refining: Vec::new(),
+                critical: None,
+                step: 0,
+                time: 0.0,
+                energy: Energies::default(),
+                started: false,
+                changes: Changes::DETECTION,
+                unbalanced_ratio: Real::INFINITY,
+                detections: 0,
+            },
             pipeline: Pipeline::default(),
         })
     }
@@ -280,13 +288,13 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn add_block(&mut self, mut block: RigidBlock) -> Result<BlockId> {
         block.validate()?;
         block.radius = block.shape().radius();
-        let id = BlockId(self.blocks.len() as u32);
-        self.ref_poses.push(block.state.pose);
-        self.blocks.push(block);
+        let id = BlockId(self.state.blocks.len() as u32);
+        self.state.ref_poses.push(block.state.pose);
+        self.state.blocks.push(block);
         self.pipeline.forces.push(Wrench::default());
-        self.records.push(StepRecord::default());
+        self.state.records.push(StepRecord::default());
         self.pipeline.bounds.push(StiffnessBound::default());
-        self.changes.insert(Changes::BLOCKS);
+        self.state.changes.insert(Changes::BLOCKS);
         Ok(id)
     }
 
@@ -295,18 +303,18 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// # Errors
     /// The law's validation error.
     pub fn set_joint_law(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
-        self.joints.insert(a, b, law)?;
-        self.changes.insert(Changes::LAWS);
+        self.state.joints.insert(a, b, law)?;
+        self.state.changes.insert(Changes::LAWS);
         Ok(())
     }
 
     /// Replaces the integrator.
     pub fn set_integrator(&mut self, integrator: impl Integrator + 'static) -> Result<()> {
         integrator.damping().validate()?;
-        let old = std::mem::replace(&mut self.integrator, Box::new(integrator));
-        if let Err(e) = self.refresh_time_step() {
-            self.integrator = old;
-            let _ = self.refresh_time_step();
+        let old = std::mem::replace(&mut self.state.integrator, Box::new(integrator));
+        if let Err(e) = self.state.refresh_time_step(&mut self.pipeline) {
+            self.state.integrator = old;
+            let _ = self.state.refresh_time_step(&mut self.pipeline);
             return Err(e);
         }
         Ok(())
@@ -319,11 +327,11 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// step is no longer stable with the new damping; [`Error::Unsupported`] while a custom
     /// integrator is set (which this would silently replace: use [`Model::set_integrator`]).
     pub fn set_damping(&mut self, damping: Damping) -> Result<()> {
-        if self.integrator.checkpoint_damping().is_none() {
+        if self.state.integrator.checkpoint_damping().is_none() {
             return Err(Error::Unsupported {
                 what: format!(
                     "set_damping would replace the custom integrator {:?}; set a new one with set_integrator",
-                    self.integrator
+                    self.state.integrator
                 ),
             });
         }
@@ -336,14 +344,14 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// As [`ModelParameters::validate`].
     pub fn set_parameters(&mut self, params: ModelParameters) -> Result<()> {
         params.validate()?;
-        self.params = params;
-        self.changes.insert(Changes::PARAMETERS);
+        self.state.params = params;
+        self.state.changes.insert(Changes::PARAMETERS);
         Ok(())
     }
 
     /// The global parameters.
     pub fn parameters(&self) -> &ModelParameters {
-        &self.params
+        &self.state.params
     }
 
     /// Sets the constant external load (force, and moment about the centroid) on a block.
@@ -373,11 +381,11 @@ impl<L: ConstitutiveLaw> Model<L> {
             return Err(e);
         }
         // A released block may touch blocks it had no contact with while both were fixed.
-        self.changes.insert(Changes::FIXITY);
-        if let Err(e) = self.refresh_time_step() {
+        self.state.changes.insert(Changes::FIXITY);
+        if let Err(e) = self.state.refresh_time_step(&mut self.pipeline) {
             let b = self.block_mut(id)?;
             *b = b.clone().with_fixity(old);
-            let _ = self.refresh_time_step();
+            let _ = self.state.refresh_time_step(&mut self.pipeline);
             return Err(e);
         }
         Ok(())
@@ -399,16 +407,19 @@ impl<L: ConstitutiveLaw> Model<L> {
         *b = b.clone().with_velocity(velocity, angular_velocity);
         let after = b.kinetic_energy();
         // Kinetic energy given by the user counts as energy put in.
-        if self.started {
-            self.energy.initial_kinetic += after - before;
-            self.energy.kinetic += after - before;
+        if self.state.started {
+            self.state.energy.initial_kinetic += after - before;
+            self.state.energy.kinetic += after - before;
         }
         Ok(())
     }
 
     fn block_mut(&mut self, id: BlockId) -> Result<&mut RigidBlock> {
-        let count = self.blocks.len();
-        self.blocks.get_mut(id.index()).ok_or(Error::UnknownBlock { id, count })
+        let count = self.state.blocks.len();
+        self.state
+            .blocks
+            .get_mut(id.index())
+            .ok_or(Error::UnknownBlock { id, count })
     }
 
     /// A block by id.
@@ -416,81 +427,85 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// # Errors
     /// [`Error::UnknownBlock`].
     pub fn block(&self, id: BlockId) -> Result<&RigidBlock> {
-        self.blocks.get(id.index()).ok_or(Error::UnknownBlock {
+        self.state.blocks.get(id.index()).ok_or(Error::UnknownBlock {
             id,
-            count: self.blocks.len(),
+            count: self.state.blocks.len(),
         })
     }
 
     /// All blocks, indexed by [`BlockId::index`].
     pub fn blocks(&self) -> &[RigidBlock] {
-        &self.blocks
+        &self.state.blocks
     }
 
     /// The joint laws.
     pub fn joints(&self) -> &JointTable<L> {
-        &self.joints
+        &self.state.joints
     }
 
     /// The current contacts, each with its sub-contacts.
     pub fn contacts(&self) -> impl ExactSizeIterator<Item = ContactView<'_, L::State>> + '_ {
-        (0..self.pairs.len()).map(move |k| self.view(k))
+        (0..self.state.pairs.len()).map(move |k| self.view(k))
     }
 
     /// The contact between two blocks, if any.
     pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<ContactView<'_, L::State>> {
         let key = (a.0.min(b.0), a.0.max(b.0));
-        self.pairs
+        self.state
+            .pairs
             .binary_search_by_key(&key, |p| (p.a, p.b))
             .ok()
             .map(|k| self.view(k))
     }
 
     fn view(&self, k: usize) -> ContactView<'_, L::State> {
-        let p = &self.pairs[k];
-        let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
+        let p = &self.state.pairs[k];
+        let (sa, sb) = (
+            &self.state.blocks[p.a as usize].state,
+            &self.state.blocks[p.b as usize].state,
+        );
         ContactView::new(
             p,
-            &self.subs[p.range()],
-            &self.sub_records[p.range()],
-            p.frame(&self.references[k], &sa.pose, &sb.pose, self.params.mode),
-            self.wrenches[k],
+            &self.state.subs[p.range()],
+            &self.state.sub_records[p.range()],
+            p.frame(&self.state.references[k], &sa.pose, &sb.pose, self.state.params.mode),
+            self.state.wrenches[k],
         )
     }
 
     /// Total number of sub-contacts.
     pub fn subcontact_count(&self) -> usize {
-        self.subs.len()
+        self.state.subs.len()
     }
 
     /// Steps taken.
     pub fn step_count(&self) -> u64 {
-        self.step
+        self.state.step
     }
 
     /// Simulated time (s).
     pub fn time(&self) -> Real {
-        self.time
+        self.state.time
     }
 
     /// The time step in use (s); zero before the first step.
     pub fn dt(&self) -> Real {
-        self.dt
+        self.state.dt
     }
 
     /// The duration of the last step (s): [`dt`](Self::dt), or shorter while the step was refined
     /// around an impact (see [`ModelParameters::impact_step`]); `dt` before the first step.
     pub fn last_step(&self) -> Real {
-        if self.drift > 0.0 {
-            self.drift
+        if self.state.drift > 0.0 {
+            self.state.drift
         } else {
-            self.dt
+            self.state.dt
         }
     }
 
     /// The critical time step and the block that limits it (after the first step).
     pub fn critical_step(&self) -> Option<CriticalStep> {
-        self.critical
+        self.state.critical
     }
 
     /// Energies since the start.
@@ -498,7 +513,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The elastic energy stored in the joints is not needed to step, so it is summed over the
     /// sub-contacts here, when asked for: a call costs about one pass over the sub-contacts.
     pub fn energies(&self) -> Energies {
-        let mut e = self.energy;
+        let mut e = self.state.energy;
         e.elastic = self.elastic_energy();
         e
     }
@@ -506,8 +521,9 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Elastic energy in the joint springs (J): per contact in sub-contact order, contacts in
     /// fixed chunks, chunks in order, so the sum does not depend on the thread count.
     fn elastic_energy(&self) -> Real {
-        let laws = self.joints.laws();
+        let laws = self.state.joints.laws();
         let chunk_sums: Vec<Real> = self
+            .state
             .pairs
             .par_chunks(1024)
             .map(|chunk| {
@@ -515,7 +531,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     .iter()
                     .map(|p| {
                         let law = &laws[p.law as usize];
-                        self.subs[p.range()]
+                        self.state.subs[p.range()]
                             .iter()
                             .map(|s| law.elastic_energy(s.area, &s.force, &s.state))
                             .sum::<Real>()
@@ -529,18 +545,18 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The accumulated energy terms without the elastic and friction terms (which
     /// [`Model::energies`] fills in).
     pub(crate) fn energy_accumulators(&self) -> &Energies {
-        &self.energy
+        &self.state.energy
     }
 
     /// Number of contact detections run so far.
     pub fn detection_count(&self) -> u64 {
-        self.detections
+        self.state.detections
     }
 
     /// Unbalanced-force ratio of the last step: the largest out-of-balance force on a free block
     /// divided by the mean contact force (infinite before the first step or without contacts).
     pub fn unbalanced_force_ratio(&self) -> Real {
-        self.unbalanced_ratio
+        self.state.unbalanced_ratio
     }
 
     /// Force and moment the supports or prescribed velocities applied to a block in the last step.
@@ -549,7 +565,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// [`Error::UnknownBlock`].
     pub fn reaction(&self, id: BlockId) -> Result<Wrench> {
         self.block(id)?;
-        Ok(self.records[id.index()].reaction)
+        Ok(self.state.records[id.index()].reaction)
     }
 
     /// Total contact force and moment (about its centroid) on a block in the last step.
@@ -564,7 +580,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     fn contact_wrench_of(&self, i: usize) -> Wrench {
         let entries = &self.pipeline.block_contacts
             [self.pipeline.block_offsets[i] as usize..self.pipeline.block_offsets[i + 1] as usize];
-        motion::add_contact_wrenches(Wrench::default(), entries, &self.wrenches)
+        motion::add_contact_wrenches(Wrench::default(), entries, &self.state.wrenches)
     }
 
     /// Time spent per stage (wall clock).
@@ -579,7 +595,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// The integrator's damping model.
     pub fn damping(&self) -> Damping {
-        self.integrator.damping()
+        self.state.integrator.damping()
     }
 
     /// One step.
@@ -589,184 +605,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// [`Error::TimeStepTooLarge`] for a fixed step above the critical one;
     /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway.
     pub fn step(&mut self) -> Result<()> {
-        let started = std::time::Instant::now();
-        let large = self.params.mode == DisplacementMode::Large;
-        // The changes since the last step come first: any of them asks for a full detection,
-        // and makes what the last block pass prepared possibly stale.
-        let changed = self.changes.need_full_detection();
-        let moved = match self.pipeline.detection.prepared.take() {
-            Some(moved) if self.started && !changed => moved,
-            _ => self.prepare_blocks(large && self.started && !changed),
-        };
-        if !self.started {
-            self.start()?;
-        } else if large {
-            if changed || moved {
-                self.detect()?;
-            }
-        } else if changed {
-            // Small displacements keep the initial contact geometry: only the step is re-evaluated.
-            self.refresh_time_step()?;
-            self.changes.clear();
-        }
-        if self.drift == 0.0 {
-            // The first step: the initial velocities stand for those of the half step before.
-            self.drift = self.dt;
-        }
-        let detected = std::time::Instant::now();
-        let (impact, busy) = self.compute_forces();
-        let previous = self.drift;
-        let drift = self.next_drift(impact, busy);
-        let forces = std::time::Instant::now();
-        let diverged = self.advance_blocks(0.5 * (previous + drift), drift);
-        self.drift = drift;
-        let t = &mut self.pipeline.timings;
-        t.detection += (detected - started).as_secs_f64();
-        t.contacts += (forces - detected).as_secs_f64();
-        t.integration += forces.elapsed().as_secs_f64();
-        t.steps += 1;
-        self.step += 1;
-        self.time += drift;
-        if let Some(i) = diverged {
-            return Err(self.divergence_error(i));
-        }
-        Ok(())
-    }
-
-    fn start(&mut self) -> Result<()> {
-        self.params.validate()?;
-        self.integrator.damping().validate()?;
-        self.changes.insert(Changes::DETECTION);
-        self.detect()?;
-        self.energy.initial_kinetic = self.blocks.iter().map(|b| b.kinetic_energy()).sum();
-        self.energy.kinetic = self.energy.initial_kinetic;
-        self.started = true;
-        Ok(())
-    }
-
-    /// The step to take from the current poses, `Δt_{n+½}`, given the largest squared frequency
-    /// bound of the blocks whose contacts are about to close or open fast (0: none) and whether
-    /// a loaded impacting contact moves fast (`busy`): `dt`, or, from an impact,
-    /// `impact_step × 2/ω` for the fastest block that asked for it, until the refinement's hold
-    /// (three of that block's critical steps after the last probe that fired, which spans the
-    /// middle of a flat impact, where the sub-contacts are deep and the probe is quiet) has
-    /// passed and none of the contacts the probe marked is both loaded and fast. The step thus
-    /// changes while the impacting contacts are open, or once the motion is quiet.
-    fn next_drift(&mut self, impact: Real, busy: bool) -> Real {
-        let (Some(r), TimeStep::Auto { .. }) = (self.params.impact_step, self.params.time_step) else {
-            return self.dt;
-        };
-        if impact > 0.0 {
-            let hold = 3.0 * 2.0 / impact.sqrt();
-            self.refine_until = self.refine_until.max(self.time + hold);
-            self.refine_omega2 = self.refine_omega2.max(impact);
-            for (k, s) in self.pipeline.pair_sums.iter().enumerate() {
-                if s.fired_count as usize <= s.fired.len() {
-                    self.refining.extend_from_slice(&s.fired[..s.fired_count as usize]);
-                } else {
-                    let end = ((k + 1) * CONTACT_CHUNK).min(self.pairs.len());
-                    self.refining
-                        .extend(self.pairs[k * CONTACT_CHUNK..end].iter().map(|p| (p.a, p.b)));
-                }
-            }
-            self.refining.sort_unstable();
-            self.refining.dedup();
-        }
-        if self.refine_omega2 > 0.0 && (self.time < self.refine_until || busy) {
-            self.dt.min(r * 2.0 / self.refine_omega2.sqrt())
-        } else {
-            self.refine_omega2 = 0.0;
-            self.refining.clear();
-            self.dt
-        }
-    }
-
-    /// The contact pass; returns the largest squared frequency bound of the blocks of the
-    /// contacts the impact probe marked (0: none), and whether a loaded contact it marked
-    /// since the refinement began moves fast.
-    fn compute_forces(&mut self) -> (Real, bool) {
-        // The probe: normal speeds beyond that of a fall through the contact tolerance,
-        // `√(2 g tol)` (a block settling on its joints moves much slower), crossing the kink
-        // within two steps.
-        let probe = matches!(self.params.time_step, TimeStep::Auto { .. }) && self.params.impact_step.is_some();
-        let impact_speed = if probe {
-            (2.0 * self.params.gravity.length() * self.params.contact.tolerance).sqrt()
-        } else {
-            Real::INFINITY
-        };
-        let ctx = KernelContext {
-            dt: self.drift,
-            impact_speed,
-            impact_horizon: 2.0 * self.dt,
-            stiffness_damping: self.integrator.damping().stiffness_coefficient(),
-            mode: self.params.mode,
-        };
-        // The records run index for index with the sub-contacts (kept so by detection and
-        // checkpoint load).
-        assert_eq!(
-            self.sub_records.len(),
-            self.subs.len(),
-            "sub-contact records out of step"
-        );
-        assert_eq!(
-            self.pipeline.rotations.len(),
-            self.blocks.len(),
-            "rotation matrices out of step"
-        );
-        assert_eq!(self.wrenches.len(), self.pairs.len(), "contact wrenches out of step");
-        let pass = ContactPass {
-            blocks: &self.blocks,
-            rotations: &self.pipeline.rotations,
-            references: &self.references,
-            laws: self.joints.laws(),
-            bounds: &self.pipeline.bounds,
-            refining: &self.refining,
-            ctx,
-        };
-        // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed
-        // per fixed chunk of contacts, so that the totals do not depend on the thread count.
-        self.pipeline.pair_sums.clear();
-        self.pipeline
-            .pair_sums
-            .resize(self.pairs.len().div_ceil(CONTACT_CHUNK), PairSums::default());
-        if !self.pairs.is_empty() {
-            let first_sub = self.pairs[0].first as usize;
-            pass.run_all(
-                ContactSlices {
-                    first: 0,
-                    pairs: &mut self.pairs,
-                    wrenches: &mut self.wrenches,
-                    sums: &mut self.pipeline.pair_sums,
-                    subs: &mut self.subs[first_sub..],
-                    records: &mut self.sub_records[first_sub..],
-                },
-                crate::dispatch::has_avx2(),
-            );
-        }
-        (
-            self.pipeline.pair_sums.iter().map(|s| s.impact).fold(0.0, Real::max),
-            self.pipeline.pair_sums.iter().any(|s| s.busy),
-        )
-    }
-
-    fn divergence_error(&self, i: usize) -> Error {
-        let s = &self.blocks[i].state;
-        let r = self.blocks[i].shape().radius();
-        let speed = s
-            .velocity
-            .length_squared()
-            .max(s.angular_velocity.length_squared() * r * r)
-            .sqrt();
-        Error::Diverged {
-            step: self.step,
-            time: self.time,
-            block: BlockId(i as u32),
-            reason: if speed.is_finite() && is_finite_state(s) {
-                format!("speed {speed:.3e} m/s exceeds max_speed {} m/s", self.params.max_speed)
-            } else {
-                "position or velocity is not finite".into()
-            },
-        }
+        self.state.step(&mut self.pipeline)
     }
 
     /// Runs `n` steps.
@@ -785,7 +624,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// # Errors
     /// As [`Model::step`].
     pub fn run_until_time(&mut self, t: Real) -> Result<()> {
-        while self.time < t {
+        while self.state.time < t {
             self.step()?;
         }
         Ok(())
@@ -814,14 +653,14 @@ impl<L: ConstitutiveLaw> Model<L> {
         positive("equilibrium target ratio", target)?;
         for k in 1..=max_steps {
             self.step()?;
-            if self.unbalanced_ratio < target {
+            if self.state.unbalanced_ratio < target {
                 return Ok(k);
             }
         }
         Err(Error::NotConverged {
             what: "unbalanced-force ratio target",
             steps: max_steps,
-            last: self.unbalanced_ratio,
+            last: self.state.unbalanced_ratio,
         })
     }
 }
@@ -829,7 +668,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::update_contact;
+    use crate::contact::{update_contact, KernelContext};
     use crate::law::JointStatus;
 
     /// The AVX2 builds of the contact pass and the integrator and the portable ones give
@@ -897,25 +736,26 @@ mod tests {
     /// compared, sliding, open, and in point contacts.
     fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &Model, law: &L) -> [usize; 4] {
         let ctx = KernelContext {
-            dt: model.dt,
+            dt: model.state.dt,
             impact_speed: Real::INFINITY,
             impact_horizon: 0.0,
             stiffness_damping: 0.0,
-            mode: model.params.mode,
+            mode: model.state.params.mode,
         };
-        let (mut grouped_subs, mut single_subs) = (model.subs.clone(), model.subs.clone());
-        let (mut grouped_records, mut single_records) = (model.sub_records.clone(), model.sub_records.clone());
-        let (mut grouped_pairs, mut single_pairs) = (model.pairs.clone(), model.pairs.clone());
+        let (mut grouped_subs, mut single_subs) = (model.state.subs.clone(), model.state.subs.clone());
+        let (mut grouped_records, mut single_records) =
+            (model.state.sub_records.clone(), model.state.sub_records.clone());
+        let (mut grouped_pairs, mut single_pairs) = (model.state.pairs.clone(), model.state.pairs.clone());
         let mut counts = [0; 4];
-        for k in 0..model.pairs.len() {
-            let r = model.pairs[k].range();
-            let (a, b) = (model.pairs[k].a as usize, model.pairs[k].b as usize);
+        for k in 0..model.state.pairs.len() {
+            let r = model.state.pairs[k].range();
+            let (a, b) = (model.state.pairs[k].a as usize, model.state.pairs[k].b as usize);
             let (ra, rb) = (
-                crate::math::Matrix::from_quat(model.blocks[a].state.pose.rotation),
-                crate::math::Matrix::from_quat(model.blocks[b].state.pose.rotation),
+                crate::math::Matrix::from_quat(model.state.blocks[a].state.pose.rotation),
+                crate::math::Matrix::from_quat(model.state.blocks[b].state.pose.rotation),
             );
-            let (sa, sb) = ((&model.blocks[a].state, &ra), (&model.blocks[b].state, &rb));
-            let point = matches!(model.pairs[k].kind, crate::geometry::ContactKind::Point { .. });
+            let (sa, sb) = ((&model.state.blocks[a].state, &ra), (&model.state.blocks[b].state, &rb));
+            let point = matches!(model.state.pairs[k].kind, crate::geometry::ContactKind::Point { .. });
             // The grouped loop runs without dashpot forces; the single loop when the contact may
             // hold some (none are held here, so it books zero dashpot forces).
             let (mut grouped_wrench, mut single_wrench) = (ContactWrench::default(), ContactWrench::default());
@@ -938,7 +778,7 @@ mod tests {
                 pairs[k].dashpots = dashpots;
                 *wrench = update_contact(
                     &mut pairs[k],
-                    &model.references[k],
+                    &model.state.references[k],
                     &mut subs[r.clone()],
                     &mut records[r.clone()],
                     sa,
@@ -1003,7 +843,7 @@ mod tests {
     fn grouped_and_single_sub_contact_loops_agree() {
         let mut wall = crate::scenes::benchmark_wall(300).expect("wall");
         wall.run_steps(40).expect("run");
-        let coulomb = wall.joints.laws()[0];
+        let coulomb = wall.state.joints.laws()[0];
         for counts in [
             compare_loops(&wall, &coulomb),
             compare_loops(&wall, &WithoutRegime(coulomb)),
@@ -1024,7 +864,7 @@ mod tests {
             params.contact.face_angle_tolerance = 15f64.to_radians();
             let mut column = toppling_column(params);
             let mut totals = [0; 4];
-            let coulomb = column.joints.laws()[0];
+            let coulomb = column.state.joints.laws()[0];
             for _ in 0..8 {
                 column.run_steps(150).expect("run");
                 for counts in [
@@ -1075,27 +915,27 @@ mod tests {
         let b = cube("b", 0.2).with_fixity(crate::block::Fixity::velocity(Vector::ZERO));
         model.add_block(b).expect("b");
         model.run_steps(1).expect("detection");
-        assert_eq!(model.pairs.len(), 1, "one joint");
-        let (normal, range) = (model.pairs[0].normal, model.pairs[0].range());
+        assert_eq!(model.state.pairs.len(), 1, "one joint");
+        let (normal, range) = (model.state.pairs[0].normal, model.state.pairs[0].range());
         assert!(normal.z.abs() < 0.6, "a steep joint: {normal}");
         // Turn the tangents 40° about the normal and load the springs elastically.
         let fresh = JointAxes::from_normal(normal);
         let turned = crate::math::Rotation::from_axis_angle(normal, 40f64.to_radians()) * fresh.tangent;
-        model.pairs[0].tangent = turned;
-        for (i, sub) in model.subs[range].iter_mut().enumerate() {
+        model.state.pairs[0].tangent = turned;
+        for (i, sub) in model.state.subs[range].iter_mut().enumerate() {
             sub.force.normal = 100.0 + i as Real;
             sub.force.shear = crate::math::Vector2::new(30.0 - i as Real, 5.0 + 2.0 * i as Real);
             sub.status = JointStatus::Elastic;
         }
-        let subs = model.subs.clone();
-        model.pairs[0].refresh_springs(&subs);
+        let subs = model.state.subs.clone();
+        model.state.pairs[0].refresh_springs(&subs);
         let world_shears = |m: &Model| -> Vec<(SubKey, Vector)> {
             let view = m.contacts().next().expect("the joint");
             view.subcontacts().map(|s| (s.key(), s.shear_force())).collect()
         };
         let before = world_shears(&model);
-        model.changes.insert(Changes::DETECTION);
-        model.detect().expect("re-detection");
+        model.state.changes.insert(Changes::DETECTION);
+        model.state.detect(&mut model.pipeline).expect("re-detection");
         let after = world_shears(&model);
         assert_eq!(before.len(), after.len());
         let mut worst: Real = 0.0;
@@ -1106,7 +946,7 @@ mod tests {
         assert!(worst < 1e-14, "shear forces changed by {worst} (relative)");
         // What fresh axes would have given: the test can tell.
         let misread = before[0].1.length() * 2.0 * (20f64.to_radians()).sin();
-        let first = model.subs[model.pairs[0].range()][0].force.shear;
+        let first = model.state.subs[model.state.pairs[0].range()][0].force.shear;
         assert!((fresh.shear(first) - before[0].1).length() > 0.5 * misread);
     }
 

@@ -11,7 +11,8 @@
 use rayon::prelude::*;
 
 use super::detection::prepare_chunk;
-use super::{diverged, BlockSums, Model, BLOCK_CHUNK};
+use super::pipeline::Pipeline;
+use super::{diverged, BlockSums, ModelState, BLOCK_CHUNK};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::contact::{ContactWrench, DisplacementMode};
 use crate::integrate::{Integrator, StepDurations, StepRecord};
@@ -122,7 +123,7 @@ impl BlockPass<'_> {
     }
 }
 
-impl<L: ConstitutiveLaw> Model<L> {
+impl<L: ConstitutiveLaw> ModelState<L> {
     /// Gathers every block's forces, moves the blocks and books the energy; returns the first
     /// block whose state is no longer finite or faster than `max_speed`.
     ///
@@ -132,11 +133,16 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// exact identity of central difference for translation. Sums are taken per chunk of
     /// [`BLOCK_CHUNK`] blocks in block order, then over the chunks in order: the results do not
     /// depend on the thread count.
-    pub(super) fn advance_blocks(&mut self, kick: Real, drift: Real) -> Option<usize> {
+    pub(super) fn advance_blocks(
+        &mut self,
+        pipeline: &mut Pipeline<L::State>,
+        kick: Real,
+        drift: Real,
+    ) -> Option<usize> {
         let pass = BlockPass {
             wrenches: &self.wrenches,
-            contacts: &self.pipeline.block_contacts,
-            offsets: &self.pipeline.block_offsets,
+            contacts: &pipeline.block_contacts,
+            offsets: &pipeline.block_offsets,
             gravity: self.params.gravity,
             dt: self.drift,
             drift_over_kick: if kick == drift { 1.0 } else { drift / kick },
@@ -145,22 +151,22 @@ impl<L: ConstitutiveLaw> Model<L> {
             trigger: (self.params.mode == DisplacementMode::Large)
                 .then_some(self.params.contact.redetect_fraction * self.params.contact.tolerance),
         };
-        self.pipeline.block_sums.clear();
-        self.pipeline
+        pipeline.block_sums.clear();
+        pipeline
             .block_sums
             .resize(self.blocks.len().div_ceil(BLOCK_CHUNK), BlockSums::default());
         let integrator: &dyn Integrator = &*self.integrator;
         let step = StepDurations { kick, drift };
         // Also the next step's first stage, while the blocks are in cache: their rotation
         // matrices and movement check (`prepare_blocks`).
-        self.pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
         self.blocks
             .par_chunks_mut(BLOCK_CHUNK)
-            .zip(self.pipeline.forces.par_chunks_mut(BLOCK_CHUNK))
+            .zip(pipeline.forces.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.records.par_chunks_mut(BLOCK_CHUNK))
-            .zip(self.pipeline.rotations.par_chunks_mut(BLOCK_CHUNK))
+            .zip(pipeline.rotations.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
-            .zip(self.pipeline.block_sums.par_iter_mut())
+            .zip(pipeline.block_sums.par_iter_mut())
             .enumerate()
             .for_each(|(k, (((((blocks, forces), records), rotations), refs), sums))| {
                 let first_block = k * BLOCK_CHUNK;
@@ -169,18 +175,18 @@ impl<L: ConstitutiveLaw> Model<L> {
                 pass.settle(first_block, blocks, records, sums);
                 sums.moved = prepare_chunk(rotations, blocks, refs, pass.trigger);
             });
-        self.pipeline.detection.prepared = Some(self.pipeline.block_sums.iter().any(|s| s.moved));
-        self.gather_block_sums()
+        pipeline.detection.prepared = Some(pipeline.block_sums.iter().any(|s| s.moved));
+        self.gather_block_sums(pipeline)
     }
 
     /// Adds the chunk sums of the block pass to the energies in chunk order, sets the
     /// unbalanced-force ratio, and returns the first diverged block.
-    fn gather_block_sums(&mut self) -> Option<usize> {
+    fn gather_block_sums(&mut self, pipeline: &mut Pipeline<L::State>) -> Option<usize> {
         let mut max_unbalanced: Real = 0.0;
         let mut kinetic = 0.0;
         let mut first_diverged = None;
         let e = &mut self.energy;
-        for s in &self.pipeline.block_sums {
+        for s in &pipeline.block_sums {
             max_unbalanced = max_unbalanced.max(s.max_unbalanced);
             e.gravity_work += s.gravity_work;
             e.load_work += s.load_work;
@@ -190,12 +196,12 @@ impl<L: ConstitutiveLaw> Model<L> {
             first_diverged = first_diverged.or(s.diverged);
         }
         e.kinetic = kinetic;
-        for s in &self.pipeline.pair_sums {
+        for s in &pipeline.pair_sums {
             e.joint_work += s.work;
             e.friction += s.dissipated;
             e.damping += s.dashpot_work;
         }
-        let force_magnitudes: Real = self.pipeline.pair_sums.iter().map(|s| s.force_magnitude).sum();
+        let force_magnitudes: Real = pipeline.pair_sums.iter().map(|s| s.force_magnitude).sum();
         let mean_contact = if self.pairs.is_empty() {
             0.0
         } else {

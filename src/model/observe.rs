@@ -77,7 +77,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// # Errors
     /// As [`Model::run_observed`].
     pub fn run_until_time_observed(&mut self, t: Real, observer: &mut impl Observer<L>) -> Result<bool> {
-        while self.time < t {
+        while self.state.time < t {
             self.step()?;
             if observer.after_step(self)?.is_break() {
                 return Ok(true);

@@ -1,16 +1,17 @@
 //! The model's time step: the contacts' stiffness handed to the integrator's stability limit
 //! ([`crate::integrate::Integrator::critical_step`]), then the step the parameters ask for.
 
-use super::Model;
+use super::pipeline::Pipeline;
+use super::ModelState;
 use crate::error::{Error, Result};
 use crate::integrate::{AreaMoments, ContactStiffness, TimeStep};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Real, Vector};
 
-impl<L: ConstitutiveLaw> Model<L> {
+impl<L: ConstitutiveLaw> ModelState<L> {
     /// Re-evaluates the critical step from the current contacts and each block's potential
     /// contact on its largest face, then sets `dt`.
-    pub(super) fn refresh_time_step(&mut self) -> Result<()> {
+    pub(super) fn refresh_time_step(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
         if self.blocks.is_empty() {
             return Ok(());
         }
@@ -45,8 +46,8 @@ impl<L: ConstitutiveLaw> Model<L> {
                 k.normal + 2.0 * k.shear
             })
             .fold(0.0, Real::max);
-        crate::integrate::block_bounds(&self.blocks, &contacts, k_max, &mut self.pipeline.bounds);
-        self.critical = self.integrator.critical_step(&self.pipeline.bounds);
+        crate::integrate::block_bounds(&self.blocks, &contacts, k_max, &mut pipeline.bounds);
+        self.critical = self.integrator.critical_step(&pipeline.bounds);
         let Some(crit) = self.critical else {
             // No stiffness anywhere: free flight; keep a previous step or a small default.
             if self.dt == 0.0 {
