@@ -108,7 +108,7 @@ pub mod prelude {
     pub use crate::error::{Error, Result};
     pub use crate::geometry::{ContactParameters, SubcontactDensity};
     pub use crate::integrate::{CentralDifference, Damping, Integrator, TimeStep};
-    pub use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, JointTable, LinearElastic, MaterialId};
+    pub use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, LawTable, LinearElastic, MaterialId};
     pub use crate::math::{Pose, Real, Rotation, Vector};
     pub use crate::model::{Energies, Model, ModelParameters, Observer};
     pub use crate::monitor::{Component, EnergyTerm, Monitor, MonitorId, Probe, Recorder};

@@ -126,7 +126,7 @@ pub enum Monitor {
         /// Component.
         component: Component,
     },
-    /// Resultant force (N) of the joint between two blocks, on the second one (zero when they
+    /// Resultant force (N) of the contact between two blocks, on the second one (zero when they
     /// are not in contact). Scene files written before the rename say `JointForce`.
     #[cfg_attr(feature = "serde", serde(alias = "JointForce"))]
     ContactResultant {

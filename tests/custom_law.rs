@@ -436,7 +436,7 @@ fn bonded_tile_pushed_sideways_softens_to_friction() {
     let joint = model.contact_between(slab, block).unwrap();
     assert!(joint
         .subcontacts()
-        .all(|s| model.joints().laws()[joint.law_index()].is_failed(s.law_state())));
+        .all(|s| model.law_table().laws()[joint.law_index()].is_failed(s.law_state())));
     // Energy: dissipation as in closed form, and the balance closes.
     assert!(
         (e.friction - dissipated_closed).abs() < 0.03 * dissipated_closed,

@@ -224,7 +224,7 @@ fn non_positive_stiffness() {
         "{e:?}"
     );
     assert!(
-        model.joints().get(MaterialId(0), MaterialId(1)).is_none(),
+        model.law_table().get(MaterialId(0), MaterialId(1)).is_none(),
         "a rejected law must not be stored"
     );
 }

@@ -110,7 +110,7 @@ fn any_law_model_matches_each_law_alone_bit_for_bit() {
     let top = mixed
         .contact_between(stone_ids[2], stone_ids[3])
         .expect("the top cube stays on its stack");
-    let law = mixed.joints().laws()[top.law_index()];
+    let law = mixed.law_table().laws()[top.law_index()];
     assert!(matches!(law, AnyLaw::Coulomb(_)));
     assert!(
         top.subcontacts().any(|s| law.is_failed(s.law_state())),

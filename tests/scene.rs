@@ -48,7 +48,7 @@ fn model_round_trips_through_a_scene() -> Result<()> {
         assert_eq!(a.fixity(), b.fixity());
         assert_eq!(a.load(), b.load());
     }
-    assert_eq!(model.joints().laws(), again.joints().laws());
+    assert_eq!(model.law_table().laws(), again.law_table().laws());
     assert!(recorder.monitors().eq(recorder_again.monitors()));
     assert_eq!(recorder.interval(), recorder_again.interval());
     Ok(())

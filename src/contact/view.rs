@@ -12,10 +12,10 @@ use crate::ids::BlockId;
 use crate::law::{JointAxes, JointStatus};
 use crate::math::{Pose, Real, Vector, Vector2};
 
-/// A law-free read interface of a joint between two blocks: what outputs and analyses need,
+/// A law-free read interface of a contact between two blocks: what outputs and analyses need,
 /// whatever the joint law.
 ///
-/// [`ContactView`] implements it; [`crate::analysis`] reads joints through it.
+/// [`ContactView`] implements it; [`crate::analysis`] reads the masonry joints of an arch through it.
 ///
 /// ```
 /// use voussoir::contact::Contact;
@@ -63,7 +63,7 @@ pub struct SubContactSample {
     pub status: JointStatus,
 }
 
-/// A borrowed view of one joint (a block pair in contact) and its sub-contacts, as of the last
+/// A borrowed view of one contact (two blocks that touch) and its sub-contacts, as of the last
 /// step.
 ///
 /// ```
@@ -140,7 +140,7 @@ impl<'a, S> ContactView<'a, S> {
     pub fn normal_force(&self) -> Real {
         self.pair.normal_force
     }
-    /// Index of the joint law in the model's [`crate::law::JointTable`].
+    /// Index of the joint law in the model's [`crate::law::LawTable`].
     pub fn law_index(&self) -> usize {
         self.pair.law as usize
     }

@@ -175,7 +175,7 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
             parameters: *model.parameters(),
             damping: model.damping(),
             joints: model
-                .joints()
+                .law_table()
                 .entries()
                 .map(|(a, b, law)| JointSpec {
                     materials: [a, b],

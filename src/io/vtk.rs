@@ -107,7 +107,7 @@ pub fn write_blocks<B: Block>(path: &Path, blocks: &[B], initial: impl Fn(usize)
 /// [`crate::Error::Io`] naming the file.
 pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> Result<()> {
     let n = model.subcontact_count();
-    let law = model.joints().laws();
+    let law = model.law_table().laws();
     let mut points = Vec::with_capacity(3 * n);
     let mut shear = Vec::with_capacity(3 * n);
     let (mut normal_force, mut normal_stress, mut area, mut gap, mut slip) = (

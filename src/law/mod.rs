@@ -293,10 +293,10 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
 /// The joint law of each pair of block materials (the pair is unordered).
 ///
 /// ```
-/// use voussoir::law::{CoulombSlip, JointTable, MaterialId};
+/// use voussoir::law::{CoulombSlip, LawTable, MaterialId};
 /// let stone = MaterialId(0);
 /// let steel = MaterialId(1);
-/// let mut joints = JointTable::new();
+/// let mut joints = LawTable::new();
 /// joints.insert(stone, stone, CoulombSlip::dry(4e9, 1.6e9, 30.5)?)?;
 /// joints.insert(stone, steel, CoulombSlip::dry(4e9, 1.6e9, 0.0)?)?;
 /// assert!(joints.get(steel, stone).is_some());
@@ -304,13 +304,13 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
 /// ```
 #[derive(Debug, Clone)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub struct JointTable<L> {
+pub struct LawTable<L> {
     laws: Vec<L>,
     /// `((min material, max material), law index)`, sorted.
     index: Vec<((MaterialId, MaterialId), u32)>,
 }
 
-impl<L> Default for JointTable<L> {
+impl<L> Default for LawTable<L> {
     fn default() -> Self {
         Self {
             laws: Vec::new(),
@@ -319,7 +319,7 @@ impl<L> Default for JointTable<L> {
     }
 }
 
-impl<L: ConstitutiveLaw> JointTable<L> {
+impl<L: ConstitutiveLaw> LawTable<L> {
     /// An empty table.
     pub fn new() -> Self {
         Self::default()

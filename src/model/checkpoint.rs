@@ -16,13 +16,13 @@ use crate::contact::{
 use crate::error::{io_error, Error, Result};
 use crate::geometry::{ContactKind, SubKey};
 use crate::integrate::{CentralDifference, CriticalStep, Damping};
-use crate::law::{ConstitutiveLaw, JointTable};
+use crate::law::{ConstitutiveLaw, LawTable};
 use crate::law::{JointForce, JointStatus};
 use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
 use crate::model::Energies;
 
 const FORMAT: &str = "voussoir-checkpoint";
-/// Version 9 stores joints through [`JointEntry`], apart from the step's storage layout, so
+/// Version 9 stores joints through [`ContactEntry`], apart from the step's storage layout, so
 /// that a layout change no longer changes the format.
 const VERSION: u32 = 9;
 
@@ -44,9 +44,9 @@ struct Snapshot<L: ConstitutiveLaw> {
     params: ModelParameters,
     damping: Damping,
     blocks: Vec<RigidBlock>,
-    joints: JointTable<L>,
+    joints: LawTable<L>,
     /// The contacts, sorted by block pair, each with its sub-contacts.
-    contacts: Vec<JointEntry<L::State>>,
+    contacts: Vec<ContactEntry<L::State>>,
     ref_poses: Vec<Pose>,
     dt: Real,
     critical: Option<CriticalStep>,
@@ -80,7 +80,7 @@ struct Snapshot<L: ConstitutiveLaw> {
 /// sub-contacts, independent of how the step lays them out in memory.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct JointEntry<S> {
+struct ContactEntry<S> {
     blocks: (u32, u32),
     kind: ContactKind,
     host_is_a: bool,
@@ -122,10 +122,10 @@ struct SubContactEntry<S> {
 
 impl<L: ConstitutiveLaw> Model<L> {
     /// Contact `k` as a checkpoint stores it.
-    fn joint_entry(&self, k: usize) -> JointEntry<L::State> {
+    fn contact_entry(&self, k: usize) -> ContactEntry<L::State> {
         let (p, r) = (&self.state.pairs[k], &self.state.references[k]);
         let range = p.range();
-        JointEntry {
+        ContactEntry {
             blocks: (p.a, p.b),
             kind: p.kind,
             host_is_a: p.host_is_a,
@@ -164,7 +164,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 /// wrenches, the sub-contacts and their records (each contact's range in order).
 #[allow(clippy::type_complexity)]
 fn into_storage<S>(
-    entries: Vec<JointEntry<S>>,
+    entries: Vec<ContactEntry<S>>,
 ) -> (
     Vec<ContactPair>,
     Vec<ContactReference>,
@@ -260,8 +260,8 @@ where
             params: self.state.params,
             damping,
             blocks: self.state.blocks.clone(),
-            joints: self.state.joints.clone(),
-            contacts: (0..self.state.pairs.len()).map(|k| self.joint_entry(k)).collect(),
+            joints: self.state.laws.clone(),
+            contacts: (0..self.state.pairs.len()).map(|k| self.contact_entry(k)).collect(),
             ref_poses: self.state.ref_poses.clone(),
             dt: self.state.dt,
             critical: self.state.critical,
@@ -408,7 +408,7 @@ where
                 .map_err(|e| corrupt(&format!("blocks[{i}]"), &e.to_string()))?;
             model.add_block(b)?;
         }
-        model.state.joints = snap.joints;
+        model.state.laws = snap.joints;
         model.state.integrator = Box::new(CentralDifference::new(snap.damping));
         model.state.pairs = pairs;
         model.state.references = references;

@@ -135,7 +135,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 continue;
             }
             let law = self
-                .joints
+                .laws
                 .index_of(bi.material(), bj.material())
                 .ok_or(Error::MissingJointLaw {
                     a: bi.material(),

@@ -26,7 +26,7 @@ use crate::contact::{
 use crate::error::{positive, Error, Result};
 use crate::geometry::ContactParameters;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, Integrator, StepRecord, StiffnessBound, TimeStep};
-use crate::law::{ConstitutiveLaw, CoulombSlip, JointTable, MaterialId};
+use crate::law::{ConstitutiveLaw, CoulombSlip, LawTable, MaterialId};
 use crate::math::{is_finite_vector, Pose, Real, Vector};
 
 use changes::Changes;
@@ -124,7 +124,7 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
 pub(super) struct ModelState<L: ConstitutiveLaw> {
     pub params: ModelParameters,
     pub blocks: Vec<RigidBlock>,
-    pub joints: JointTable<L>,
+    pub laws: LawTable<L>,
     pub integrator: Box<dyn Integrator>,
     pub pairs: Vec<ContactPair>,
     /// The contacts' reference geometry and areas, index for index with `pairs`.
@@ -252,7 +252,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             state: ModelState {
                 params,
                 blocks: Vec::new(),
-                joints: JointTable::new(),
+                laws: LawTable::new(),
                 integrator: Box::new(CentralDifference::default()),
                 pairs: Vec::new(),
                 references: Vec::new(),
@@ -303,7 +303,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// # Errors
     /// The law's validation error.
     pub fn set_joint_law(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
-        self.state.joints.insert(a, b, law)?;
+        self.state.laws.insert(a, b, law)?;
         self.state.changes.insert(Changes::LAWS);
         Ok(())
     }
@@ -439,8 +439,8 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     /// The joint laws.
-    pub fn joints(&self) -> &JointTable<L> {
-        &self.state.joints
+    pub fn law_table(&self) -> &LawTable<L> {
+        &self.state.laws
     }
 
     /// The current contacts, each with its sub-contacts.
@@ -521,7 +521,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Elastic energy in the joint springs (J): per contact in sub-contact order, contacts in
     /// fixed chunks, chunks in order, so the sum does not depend on the thread count.
     fn elastic_energy(&self) -> Real {
-        let laws = self.state.joints.laws();
+        let laws = self.state.laws.laws();
         let chunk_sums: Vec<Real> = self
             .state
             .pairs
@@ -843,7 +843,7 @@ mod tests {
     fn grouped_and_single_sub_contact_loops_agree() {
         let mut wall = crate::scenes::benchmark_wall(300).expect("wall");
         wall.run_steps(40).expect("run");
-        let coulomb = wall.state.joints.laws()[0];
+        let coulomb = wall.state.laws.laws()[0];
         for counts in [
             compare_loops(&wall, &coulomb),
             compare_loops(&wall, &WithoutRegime(coulomb)),
@@ -864,7 +864,7 @@ mod tests {
             params.contact.face_angle_tolerance = 15f64.to_radians();
             let mut column = toppling_column(params);
             let mut totals = [0; 4];
-            let coulomb = column.state.joints.laws()[0];
+            let coulomb = column.state.laws.laws()[0];
             for _ in 0..8 {
                 column.run_steps(150).expect("run");
                 for counts in [

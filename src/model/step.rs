@@ -144,7 +144,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             blocks: &self.blocks,
             rotations: &pipeline.rotations,
             references: &self.references,
-            laws: self.joints.laws(),
+            laws: self.laws.laws(),
             bounds: &pipeline.bounds,
             refining: &self.refining,
             ctx,

@@ -15,7 +15,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if self.blocks.is_empty() {
             return Ok(());
         }
-        let laws = self.joints.laws();
+        let laws = self.laws.laws();
         let mut contacts = Vec::with_capacity(self.pairs.len());
         for (p, reference) in self.pairs.iter().zip(self.references.iter_mut()) {
             let subs = &self.subs[p.range()];
