@@ -47,6 +47,7 @@
 //! | [`ids`] | typed ids |
 //! | [`contact`] | the read API of contacts (views, the [`Contact`] trait) and the contact kernel |
 //! | [`law`] | the [`ConstitutiveLaw`] trait and the shipped laws |
+//! | [`loading`] | quasi-static loading: servo-controlled displacement |
 //! | [`integrate`] | the [`Integrator`] trait, central difference, damping, critical step |
 //! | [`model`] | the [`Model`]: state, the step's stages, runs and observers, energies, checkpoints |
 //! | [`monitor`] | observation: the [`monitor::Probe`] trait, built-in monitors, the recorder and histories |
@@ -84,6 +85,7 @@ pub mod integrate;
 #[cfg_attr(docsrs, doc(cfg(feature = "io")))]
 pub mod io;
 pub mod law;
+pub mod loading;
 pub mod math;
 pub mod model;
 pub mod monitor;

@@ -391,6 +391,42 @@ impl<L: ConstitutiveLaw> Model<L> {
         Ok(())
     }
 
+    /// Changes the values of a block's prescribed translation velocities (m/s), keeping which
+    /// degrees of freedom are free, fixed or prescribed: each translation of the block that is
+    /// prescribed ([`Dof::Velocity`](crate::block::Dof::Velocity)) takes the matching component
+    /// of `velocity`; free and fixed ones are left as they are. Unlike [`Model::set_fixity`] this
+    /// changes no contact and asks for no detection, so a controller may call it every step
+    /// (see [`crate::loading::Servo`]).
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`]; [`Error::NonFinite`]; [`Error::InvalidParameter`] when no
+    /// translation of the block is prescribed.
+    pub fn set_prescribed_velocity(&mut self, id: BlockId, velocity: Vector) -> Result<()> {
+        if !is_finite_vector(velocity) {
+            return Err(Error::NonFinite {
+                what: format!("prescribed velocity of block {id}"),
+            });
+        }
+        let b = self.block_mut(id)?;
+        let mut fixity = *b.fixity();
+        let mut any = false;
+        for (d, v) in fixity.translation.iter_mut().zip(velocity.to_array()) {
+            if let crate::block::Dof::Velocity(old) = d {
+                *old = v;
+                any = true;
+            }
+        }
+        if !any {
+            return Err(Error::InvalidParameter {
+                name: format!("prescribed velocity of block {id}"),
+                value: velocity.length(),
+                expected: "a block with a translation at prescribed velocity (Dof::Velocity)",
+            });
+        }
+        *b = b.clone().with_fixity(fixity);
+        Ok(())
+    }
+
     /// Sets a block's velocity (m/s) and angular velocity (rad/s). During a run, the change of
     /// kinetic energy counts as energy put in ([`Energies::initial_kinetic`]).
     ///
