@@ -15,7 +15,7 @@ use voussoir::contact::DisplacementMode;
 
 use super::{finite, BoxError, Outputs, Run};
 use crate::plot::{Curve, LinePlot, Reference};
-use crate::scenarios::arch_static::{run, StaticCase, StaticResult};
+use crate::scenarios::arch_static::{run, ServoLoading, StaticCase, StaticResult};
 
 /// Peak load of the test (kN).
 const EXPERIMENT_PEAK_KN: f64 = 2.71;
@@ -40,6 +40,13 @@ pub struct StaticOptions {
         default_value = "27,30,30.5,35"
     )]
     pub friction: Vec<f64>,
+    /// Quasi-static loading by servo (voussoir::loading::Servo): the plate advances by this
+    /// many metres per step from settled states only, in every case but the rate study
+    #[arg(long, value_name = "M", value_parser = finite)]
+    pub servo: Option<f64>,
+    /// Unbalanced-force ratio at which the servo advances the plate
+    #[arg(long, value_name = "RATIO", value_parser = finite, default_value = "1e-3")]
+    pub servo_ratio: f64,
 }
 
 impl Run for StaticOptions {
@@ -53,8 +60,22 @@ and the paper's parameter studies, in parallel";
     }
 }
 
-/// The study cases of the paper, plus the capacity-versus-friction sweep.
+/// The study cases of the paper, plus the capacity-versus-friction sweep (under servo loading
+/// with `--servo`, the rate study aside).
 fn cases(o: &StaticOptions) -> Vec<StaticCase> {
+    let mut cases = paper_cases(o);
+    if let Some(increment) = o.servo {
+        for c in cases.iter_mut().filter(|c| !c.label.starts_with("rate")) {
+            c.servo = Some(ServoLoading {
+                increment,
+                max_unbalanced_ratio: o.servo_ratio,
+            });
+        }
+    }
+    cases
+}
+
+fn paper_cases(o: &StaticOptions) -> Vec<StaticCase> {
     let base = StaticCase::baseline();
     let mut cases = vec![base.clone()];
     if o.baseline_only {

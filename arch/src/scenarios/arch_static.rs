@@ -15,13 +15,18 @@ use std::time::Instant;
 use serde::{Deserialize, Serialize};
 
 use voussoir::analysis::{classify_joints, JointRef, JointState, Mechanism, MechanismCriteria};
-use voussoir::block::{BlockId, Dof, Fixity, RigidBlock};
+use voussoir::block::{Block, BlockId, Dof, Fixity, RigidBlock};
 use voussoir::build::arch::Arch;
 use voussoir::contact::DisplacementMode;
 use voussoir::error::Result;
 use voussoir::integrate::Damping;
+use voussoir::loading::Servo;
 use voussoir::math::{Pose, Real, Rotation, Vector};
 use voussoir::model::Model;
+
+/// Plate travel between the samples of a servo-loaded case (m): the rate-loaded cases sample
+/// every 2e-5 s × rate… of travel, i.e. 20 µm at 1e-2 m/s.
+const SERVO_SAMPLE_TRAVEL: Real = 2e-5;
 
 /// One analysis case. [`StaticCase::baseline`] holds the paper's values.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -63,6 +68,20 @@ pub struct StaticCase {
     /// 0.8 mm of travel at 1e-2 m/s. A window of at least one period removes that inertial
     /// oscillation; the raw peak is reported too.
     pub smoothing_window: Real,
+    /// Quasi-static loading by servo ([`voussoir::loading::Servo`]) instead of `rate`: the
+    /// plate advances by `increment` per step from settled states only. `None` (the default):
+    /// the plate moves at `rate`.
+    #[serde(default)]
+    pub servo: Option<ServoLoading>,
+}
+
+/// Servo settings of a static case.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ServoLoading {
+    /// Plate advance per advancing step (m).
+    pub increment: Real,
+    /// Unbalanced-force ratio at or below which the plate advances.
+    pub max_unbalanced_ratio: Real,
 }
 
 impl StaticCase {
@@ -86,6 +105,7 @@ impl StaticCase {
             plate_thickness: 0.02,
             plate_density: 7850.0,
             smoothing_window: 1e-3,
+            servo: None,
         }
     }
 }
@@ -227,6 +247,10 @@ struct StaticRun<'a, F> {
     t0: Real,
     frame_every: Option<Real>,
     on_frame: &'a mut F,
+    /// Under servo loading: the servo and the plate's height before loading (the travel is
+    /// measured; samples are taken at settled states every 20 µm of travel).
+    servo: Option<(Servo, Real)>,
+    next_travel: Real,
     curve: Vec<Sample>,
     peak: (Real, Real),
     raw_peak: Real,
@@ -238,12 +262,24 @@ struct StaticRun<'a, F> {
 
 impl<F: FnMut(&Model) -> Result<()>> voussoir::model::Observer<voussoir::law::CoulombSlip> for StaticRun<'_, F> {
     fn after_step(&mut self, model: &Model) -> Result<ControlFlow<()>> {
-        if !(model.step_count() - self.step0).is_multiple_of(self.sample_every) {
-            return Ok(ControlFlow::Continue(()));
-        }
         let case = self.case;
         let t = model.time() - self.t0;
-        let displacement = case.rate * t;
+        let displacement = match self.servo {
+            Some((servo, y0)) => {
+                let travel = y0 - model.blocks()[self.plate.index()].state().pose.translation.y;
+                if !servo.settled(model) || travel < self.next_travel {
+                    return Ok(ControlFlow::Continue(()));
+                }
+                self.next_travel = travel + SERVO_SAMPLE_TRAVEL;
+                travel
+            }
+            None => {
+                if !(model.step_count() - self.step0).is_multiple_of(self.sample_every) {
+                    return Ok(ControlFlow::Continue(()));
+                }
+                case.rate * t
+            }
+        };
         // The resultant acts on the plate (the higher id); the load on the arch is its opposite
         // reaction, i.e. the upward force on the plate.
         let load = model
@@ -308,7 +344,9 @@ pub fn run(
     } = build(case)?;
     let settle_steps = model.run_to_equilibrium(case.settle_ratio, 200_000)?;
     let settle_ratio = model.unbalanced_force_ratio();
-    model.set_fixity(plate, plate_fixity(-case.rate))?;
+    if case.servo.is_none() {
+        model.set_fixity(plate, plate_fixity(-case.rate))?;
+    }
     let criteria = MechanismCriteria::default();
     let left = arch.extrados_midpoint(1);
     let right = arch.extrados_midpoint(arch.spec.voussoirs);
@@ -328,6 +366,8 @@ pub fn run(
         t0: model.time(),
         frame_every,
         on_frame: &mut on_frame,
+        servo: None,
+        next_travel: 0.0,
         curve: Vec::new(),
         peak: (0.0, 0.0),
         raw_peak: 0.0,
@@ -338,7 +378,16 @@ pub fn run(
     };
     // Until the observer stops the run: the maximum displacement, or the load fallen after the
     // peak.
-    model.run_observed(u64::MAX, &mut run)?;
+    match case.servo {
+        Some(s) => {
+            let servo = Servo::new(plate, -Vector::Y, s.increment, s.max_unbalanced_ratio)?;
+            run.servo = Some((servo, model.blocks()[plate.index()].state().pose.translation.y));
+            servo.run(&mut model, u64::MAX, &mut run)?;
+        }
+        None => {
+            model.run_observed(u64::MAX, &mut run)?;
+        }
+    }
     let StaticRun {
         curve,
         peak,
