@@ -111,6 +111,9 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A model with no blocks was asked to step (time could not advance: a run would never end).
+    #[error("the model has no blocks: add one before stepping")]
+    EmptyModel,
     /// An operation this model cannot do as set up, e.g. checkpointing a custom integrator.
     #[error("unsupported: {what}")]
     Unsupported {

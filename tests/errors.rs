@@ -771,3 +771,46 @@ fn edited_block_states_are_checked_on_add() {
     assert!(matches!(&e, Error::NonFinite { .. }), "{e:?}");
     assert_names(&e.to_string(), &["angular momentum", "edited"]);
 }
+
+/// A model with no blocks cannot advance time: stepping it is an error, not a run that never
+/// ends (it used to loop forever with `dt` 0).
+#[test]
+fn an_empty_model_does_not_hang() {
+    let mut model: Model = Model::new(ModelParameters::default()).unwrap();
+    assert!(matches!(model.step(), Err(Error::EmptyModel)));
+    assert!(matches!(model.run_until_time(1.0), Err(Error::EmptyModel)));
+    assert!(matches!(model.run_steps(3), Err(Error::EmptyModel)));
+}
+
+/// A run to a NaN or infinite time is refused (a NaN end time used to return at once with
+/// `Ok`, an infinite one to run for ever).
+#[test]
+fn non_finite_end_times_are_errors() {
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
+    model.add_block(common::fixed_slab("base")).unwrap();
+    for t in [f64::NAN, f64::INFINITY] {
+        let e = model.run_until_time(t).unwrap_err();
+        assert!(matches!(&e, Error::NonFinite { .. }), "{e:?}");
+        assert_names(&e.to_string(), &["end time"]);
+        let mut never = |_: &Model| Ok(std::ops::ControlFlow::Continue(()));
+        let e = model.run_until_time_observed(t, &mut never).unwrap_err();
+        assert!(matches!(&e, Error::NonFinite { .. }), "{e:?}");
+    }
+    assert_eq!(model.step_count(), 0);
+}
+
+/// Two laws for one pair of materials in a scene file: an error naming both entries, not the
+/// last one silently winning.
+#[test]
+fn duplicate_joint_laws_in_a_scene_are_errors() {
+    use voussoir::io::scene::Scene;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples/block-on-base.json");
+    let text = std::fs::read_to_string(path).expect("example file");
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let mut second = json["joints"][0].clone();
+    second["law"]["friction_deg"] = serde_json::json!(40.0);
+    json["joints"].as_array_mut().expect("joints").push(second);
+    let scene = Scene::<CoulombSlip>::from_json(&json.to_string()).expect("parses");
+    let e = scene.build().unwrap_err();
+    assert_names(&e.to_string(), &["joints[1]", "joints[0]"]);
+}

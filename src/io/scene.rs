@@ -234,6 +234,19 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
         let mut model = Model::new(self.parameters).map_err(at("parameters".into()))?;
         model.set_damping(self.damping).map_err(at("damping".into()))?;
         for (k, j) in self.joints.iter().enumerate() {
+            let pair = (j.materials[0].min(j.materials[1]), j.materials[0].max(j.materials[1]));
+            if let Some(first) = self.joints[..k]
+                .iter()
+                .position(|o| (o.materials[0].min(o.materials[1]), o.materials[0].max(o.materials[1])) == pair)
+            {
+                return Err(Error::Checkpoint {
+                    path: format!("joints[{k}].materials"),
+                    message: format!(
+                        "the pair of materials {} and {} already has a law at joints[{first}]",
+                        pair.0, pair.1
+                    ),
+                });
+            }
             model
                 .set_joint_law(j.materials[0], j.materials[1], j.law.clone())
                 .map_err(at(format!("joints[{k}].law")))?;

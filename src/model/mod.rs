@@ -637,6 +637,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// One step.
     ///
     /// # Errors
+    /// [`Error::EmptyModel`] for a model without blocks;
     /// [`Error::MissingJointLaw`] when blocks of materials with no law touch;
     /// [`Error::TimeStepTooLarge`] for a fixed step above the critical one;
     /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway.
@@ -658,8 +659,13 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Runs until the simulated time reaches `t` (s).
     ///
     /// # Errors
-    /// As [`Model::step`].
+    /// [`Error::NonFinite`] for a NaN or infinite `t`; otherwise as [`Model::step`].
     pub fn run_until_time(&mut self, t: Real) -> Result<()> {
+        if !t.is_finite() {
+            return Err(Error::NonFinite {
+                what: format!("end time {t} of run_until_time"),
+            });
+        }
         while self.state.time < t {
             self.step()?;
         }

@@ -75,8 +75,14 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// `observer` after each step; returns whether the observer stopped it.
     ///
     /// # Errors
-    /// As [`Model::run_observed`].
+    /// [`crate::Error::NonFinite`] for a NaN or infinite `t`; otherwise as
+    /// [`Model::run_observed`].
     pub fn run_until_time_observed(&mut self, t: Real, observer: &mut impl Observer<L>) -> Result<bool> {
+        if !t.is_finite() {
+            return Err(crate::error::Error::NonFinite {
+                what: format!("end time {t} of run_until_time_observed"),
+            });
+        }
         while self.state.time < t {
             self.step()?;
             if observer.after_step(self)?.is_break() {

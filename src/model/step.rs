@@ -15,6 +15,9 @@ use crate::math::Real;
 impl<L: ConstitutiveLaw> ModelState<L> {
     /// One step: the stages in order, each given the state and the pipeline it uses.
     pub(super) fn step(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
+        if self.blocks.is_empty() {
+            return Err(Error::EmptyModel);
+        }
         let started = std::time::Instant::now();
         let large = self.params.mode == DisplacementMode::Large;
         // The changes since the last step come first: any of them asks for a full detection,
