@@ -814,3 +814,33 @@ fn duplicate_joint_laws_in_a_scene_are_errors() {
     let e = scene.build().unwrap_err();
     assert_names(&e.to_string(), &["joints[1]", "joints[0]"]);
 }
+
+/// Sub-contact grids too dense to allocate are refused with the parameter (and the block)
+/// named, instead of aborting on a failed allocation of 65535² sub-contacts per face or
+/// running for minutes.
+#[test]
+fn sub_contact_grids_too_dense_are_errors() {
+    let dense = |density| ModelParameters {
+        contact: ContactParameters {
+            density,
+            ..ContactParameters::default()
+        },
+        ..ModelParameters::default()
+    };
+    let e = Model::<CoulombSlip>::new(dense(SubcontactDensity::PerEdge(65535))).unwrap_err();
+    assert_names(&e.to_string(), &["contact.density.per_edge", "65535"]);
+    assert!(Model::<CoulombSlip>::new(dense(SubcontactDensity::PerEdge(1000))).is_ok());
+    // A spacing is checked against each block as it comes.
+    let mut model: Model = Model::new(dense(SubcontactDensity::Spacing(1e-9))).unwrap();
+    let e = model.add_block(common::cube("stone", Vector::ZERO)).unwrap_err();
+    assert_names(&e.to_string(), &["contact.density.spacing", "stone"]);
+    assert!(model.blocks().is_empty());
+    // ... and against the blocks already there when the parameters change.
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
+    model.add_block(common::cube("stone", Vector::ZERO)).unwrap();
+    let e = model
+        .set_parameters(dense(SubcontactDensity::Spacing(1e-7)))
+        .unwrap_err();
+    assert_names(&e.to_string(), &["contact.density.spacing", "stone"]);
+    assert_eq!(*model.parameters(), ModelParameters::default());
+}

@@ -9,6 +9,6 @@ mod polyhedron;
 pub use broad_phase::BroadPhase;
 pub use narrow_phase::{
     detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, SubKey,
-    SubcontactDensity, SubcontactSeed,
+    SubcontactDensity, SubcontactSeed, MAX_SUBCONTACTS_PER_EDGE,
 };
 pub use polyhedron::{Face, MassProperties, PlacedPolyhedron, Polyhedron};

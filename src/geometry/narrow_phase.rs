@@ -20,9 +20,14 @@ pub enum SubcontactDensity {
     /// `n` sub-contacts along each edge of the host face's bounding rectangle (`n × n` cells);
     /// the reference paper uses 15.
     PerEdge(u16),
-    /// Nodes at most this far apart (m); at most 65,535 nodes along a face edge.
+    /// Nodes at most this far apart (m); at most [`MAX_SUBCONTACTS_PER_EDGE`] nodes along a
+    /// face edge of any block.
     Spacing(Real),
 }
+
+/// The most sub-contacts along an edge of a face (`n × n` per face): 1,000, a million per
+/// face. A denser grid is refused rather than allocated (the reference paper uses 15).
+pub const MAX_SUBCONTACTS_PER_EDGE: u16 = 1000;
 
 /// Two faces further apart than the face angle tolerance but within this angle (rad, 60°) still
 /// form a face-face contact when the larger face covers the smaller one whole: an edge or a
@@ -72,6 +77,29 @@ impl Default for ContactParameters {
 }
 
 impl ContactParameters {
+    /// Checks that a [`SubcontactDensity::Spacing`] leaves at most
+    /// [`MAX_SUBCONTACTS_PER_EDGE`] sub-contacts along the faces of a block of circumradius
+    /// `radius` (m), named `block` in the error.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] naming the block.
+    pub fn check_block(&self, radius: Real, block: &str) -> Result<()> {
+        if let SubcontactDensity::Spacing(h) = self.density {
+            let nodes = (2.0 * radius / h).ceil() + 1.0;
+            if nodes.is_nan() || nodes > MAX_SUBCONTACTS_PER_EDGE as Real {
+                return Err(crate::Error::InvalidParameter {
+                    name: format!(
+                        "contact.density.spacing for block {block:?} ({:.3} m across)",
+                        2.0 * radius
+                    ),
+                    value: h,
+                    expected: "must leave at most 1000 sub-contacts along a face edge (MAX_SUBCONTACTS_PER_EDGE)",
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Checks every field.
     ///
     /// # Errors
@@ -94,7 +122,13 @@ impl ContactParameters {
         )?;
         match self.density {
             SubcontactDensity::PerEdge(n) => {
-                positive("contact.density.per_edge", n as Real)?;
+                in_range(
+                    "contact.density.per_edge",
+                    n as Real,
+                    1.0,
+                    MAX_SUBCONTACTS_PER_EDGE as Real + 1.0,
+                    "must lie in 1..=1000 (MAX_SUBCONTACTS_PER_EDGE)",
+                )?;
             }
             SubcontactDensity::Spacing(h) => {
                 positive("contact.density.spacing", h)?;

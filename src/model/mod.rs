@@ -284,9 +284,14 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// # Errors
     /// [`Error::NonFinite`] for a NaN or infinite velocity, position, rotation, load or
     /// prescribed velocity; [`Error::InvalidParameter`] for a rotation that is not a unit
-    /// quaternion.
+    /// quaternion, or a block too large for the sub-contact spacing
+    /// ([`crate::geometry::MAX_SUBCONTACTS_PER_EDGE`] along a face edge).
     pub fn add_block(&mut self, mut block: RigidBlock) -> Result<BlockId> {
         block.validate()?;
+        self.state
+            .params
+            .contact
+            .check_block(block.shape().radius(), block.name())?;
         block.radius = block.shape().radius();
         let id = BlockId(self.state.blocks.len() as u32);
         self.state.ref_poses.push(block.state.pose);
@@ -344,6 +349,9 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// As [`ModelParameters::validate`].
     pub fn set_parameters(&mut self, params: ModelParameters) -> Result<()> {
         params.validate()?;
+        for b in &self.state.blocks {
+            params.contact.check_block(b.shape().radius(), b.name())?;
+        }
         self.state.params = params;
         self.state.changes.insert(Changes::PARAMETERS);
         Ok(())
