@@ -78,6 +78,8 @@ pub mod build;
 pub mod contact;
 mod dispatch;
 pub mod error;
+#[cfg(feature = "serde")]
+mod file;
 pub mod geometry;
 pub mod ids;
 pub mod integrate;

@@ -23,10 +23,5 @@ pub fn write_json(path: &Path, value: &impl serde::Serialize) -> crate::Result<(
         path: path.display().to_string(),
         message: e.to_string(),
     })?;
-    if let Some(dir) = path.parent() {
-        if !dir.as_os_str().is_empty() {
-            std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
-        }
-    }
-    std::fs::write(path, text).map_err(|e| io_error(path, &e))
+    crate::file::write_atomically(path, text.as_bytes())
 }

@@ -133,12 +133,7 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
     /// [`Error::Io`] naming the file.
     pub fn save(&self, path: &Path) -> Result<()> {
         let text = self.to_json()?;
-        if let Some(dir) = path.parent() {
-            if !dir.as_os_str().is_empty() {
-                std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
-            }
-        }
-        std::fs::write(path, text).map_err(|e| io_error(path, &e))
+        crate::file::write_atomically(path, text.as_bytes())
     }
 
     /// The definition of a model in its current pose (velocities and loads included), without

@@ -5,13 +5,10 @@
 //! and ParaView.
 
 use std::fmt::Write as _;
-use std::fs;
-use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::block::Block;
 use crate::error::Result;
-use crate::io::io_error;
 use crate::law::{ConstitutiveLaw, JointStatus};
 use crate::math::Real;
 use crate::model::Model;
@@ -229,13 +226,7 @@ fn base64_into(out: &mut String, data: &[u8]) {
 }
 
 fn write_file(path: &Path, text: &str) -> Result<()> {
-    if let Some(dir) = path.parent() {
-        if !dir.as_os_str().is_empty() {
-            fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
-        }
-    }
-    let mut f = fs::File::create(path).map_err(|e| io_error(path, &e))?;
-    f.write_all(text.as_bytes()).map_err(|e| io_error(path, &e))
+    crate::file::write_atomically(path, text.as_bytes())
 }
 
 /// A ParaView time series: each frame writes `<name>_blocks_<k>.vtu` and

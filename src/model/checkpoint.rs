@@ -470,12 +470,7 @@ where
     /// [`Error::Io`] naming the file.
     pub fn save_checkpoint(&self, path: &Path) -> Result<()> {
         let text = self.to_checkpoint_string()?;
-        if let Some(dir) = path.parent() {
-            if !dir.as_os_str().is_empty() {
-                std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
-            }
-        }
-        std::fs::write(path, text).map_err(|e| io_error(path, &e))
+        crate::file::write_atomically(path, text.as_bytes())
     }
 
     /// Reads a checkpoint file.
