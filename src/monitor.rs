@@ -273,10 +273,18 @@ impl<L: ConstitutiveLaw> Recorder<L> {
     /// Adds a built-in monitor as the next column.
     ///
     /// # Errors
-    /// [`crate::Error::UnknownBlock`] if the monitor refers to a block `model` does not have.
+    /// [`crate::Error::UnknownBlock`] if the monitor refers to a block `model` does not have;
+    /// [`crate::Error::NonFinite`] for a NaN or infinite point.
     pub fn add_monitor(&mut self, model: &Model<L>, name: &str, monitor: Monitor) -> Result<MonitorId> {
         for id in monitor.blocks() {
             model.block(id)?;
+        }
+        if let Monitor::Displacement { point, .. } | Monitor::Velocity { point, .. } = monitor {
+            if !crate::math::is_finite_vector(point) {
+                return Err(crate::Error::NonFinite {
+                    what: format!("point of monitor {name:?}"),
+                });
+            }
         }
         Ok(self.push(name, Column::Monitor(monitor)))
     }

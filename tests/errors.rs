@@ -844,3 +844,70 @@ fn sub_contact_grids_too_dense_are_errors() {
     assert_names(&e.to_string(), &["contact.density.spacing", "stone"]);
     assert_eq!(*model.parameters(), ModelParameters::default());
 }
+
+/// Laws are validated wherever they come from: a stiffness the critical step cannot rest on
+/// (NaN, negative) is refused by `set_joint_law`, and a checkpoint's laws are validated as they
+/// load (a negative stiffness used to load, and a NaN one made the step fall back to 1e-4 s).
+#[test]
+fn laws_are_validated_on_every_path() {
+    use voussoir::law::{JointForce, JointStatus, JointStep, JointStiffness};
+    #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+    struct Broken(f64);
+    impl ConstitutiveLaw for Broken {
+        type State = ();
+        fn stiffness(&self) -> JointStiffness {
+            JointStiffness {
+                normal: self.0,
+                shear: 1e8,
+            }
+        }
+        fn update(&self, s: &JointStep, f: &mut JointForce, _: &mut ()) -> JointStatus {
+            f.normal = -1e9 * s.normal_displacement * s.area;
+            JointStatus::Elastic
+        }
+        fn elastic_energy(&self, _: f64, _: &JointForce, _: &()) -> f64 {
+            0.0
+        }
+    }
+    for k in [f64::NAN, -1e9, f64::INFINITY] {
+        let mut model: Model<Broken> = Model::new(ModelParameters::default()).unwrap();
+        let e = model
+            .set_joint_law(MaterialId(0), MaterialId(0), Broken(k))
+            .unwrap_err();
+        assert_names(&e.to_string(), &["stiffness().normal"]);
+    }
+    // A linear elastic law edited to a negative stiffness in a checkpoint.
+    let mut model: Model<LinearElastic> = Model::new(ModelParameters::default()).unwrap();
+    let law = LinearElastic {
+        normal_stiffness: 1e9,
+        shear_stiffness: 4e8,
+    };
+    model.set_joint_law(MaterialId(0), MaterialId(0), law).unwrap();
+    model.add_block(common::fixed_slab("base")).unwrap();
+    let text = model.to_checkpoint_string().unwrap();
+    let bad = text.replacen(
+        "\"normal_stiffness\":1000000000.0",
+        "\"normal_stiffness\":-1000000000.0",
+        1,
+    );
+    assert_ne!(bad, text);
+    let e = Model::<LinearElastic>::from_checkpoint_str(&bad).unwrap_err();
+    assert_names(&e.to_string(), &["joints.laws[0]", "normal_stiffness"]);
+}
+
+/// A monitor at a NaN point is refused when added (it used to record NaN).
+#[test]
+fn monitors_at_non_finite_points_are_errors() {
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
+    let base = model.add_block(common::fixed_slab("base")).unwrap();
+    let monitor = Monitor::Displacement {
+        block: base,
+        point: Vector::new(f64::NAN, 0.0, 0.0),
+        component: Component::X,
+    };
+    let e = voussoir::monitor::Recorder::new(1)
+        .add_monitor(&model, "nan point", monitor)
+        .unwrap_err();
+    assert!(matches!(&e, Error::NonFinite { .. }), "{e:?}");
+    assert_names(&e.to_string(), &["nan point"]);
+}

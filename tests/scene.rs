@@ -96,3 +96,14 @@ fn bad_fields_are_reported_with_their_path() -> Result<()> {
     }
     Ok(())
 }
+
+/// A scene file saved with a UTF-8 byte-order mark (as some editors write) reads as without
+/// (it used to fail with "expected value at line 1 column 1").
+#[test]
+fn a_byte_order_mark_is_accepted() -> Result<()> {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/examples/block-on-base.json"))
+        .expect("example file");
+    let scene = Scene::<CoulombSlip>::from_json(&format!("\u{feff}{text}"))?;
+    assert_eq!(scene.build()?.blocks().len(), 2);
+    Ok(())
+}

@@ -100,6 +100,8 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
     /// # Errors
     /// [`Error::Checkpoint`] with the path (for example `blocks[2].density`).
     pub fn from_json(text: &str) -> Result<Self> {
+        // A byte-order mark, as some editors write, is not part of the JSON.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let de = &mut serde_json::Deserializer::from_str(text);
         serde_path_to_error::deserialize(de).map_err(|e| Error::Checkpoint {
             path: e.path().to_string(),

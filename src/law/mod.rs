@@ -290,6 +290,16 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     }
 }
 
+/// A law's own validation, and a stiffness the critical step can rest on (finite, not
+/// negative).
+pub(crate) fn check_law<L: ConstitutiveLaw>(law: &L) -> Result<()> {
+    law.validate()?;
+    let k = law.stiffness();
+    crate::error::non_negative("stiffness().normal", k.normal)?;
+    crate::error::non_negative("stiffness().shear", k.shear)?;
+    Ok(())
+}
+
 /// The joint law of each pair of block materials (the pair is unordered).
 ///
 /// ```
@@ -328,9 +338,10 @@ impl<L: ConstitutiveLaw> LawTable<L> {
     /// Sets the law between materials `a` and `b` (either order), replacing any previous one.
     ///
     /// # Errors
-    /// The law's own [`ConstitutiveLaw::validate`] error.
+    /// The law's own [`ConstitutiveLaw::validate`] error; [`crate::Error::InvalidParameter`]
+    /// for a stiffness that is negative or not finite (the critical step rests on it).
     pub fn insert(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
-        law.validate()?;
+        check_law(&law)?;
         let key = (a.min(b), a.max(b));
         match self.index.binary_search_by_key(&key, |e| e.0) {
             Ok(k) => self.laws[self.index[k].1 as usize] = law,

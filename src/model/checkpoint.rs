@@ -346,6 +346,10 @@ where
         if !snap.joints.check() {
             return Err(corrupt("joints", "law index out of range"));
         }
+        // Laws are validated as on `set_joint_law` (serde only checks their shape).
+        for (k, law) in snap.joints.laws().iter().enumerate() {
+            crate::law::check_law(law).map_err(|e| corrupt(&format!("joints.laws[{k}]"), &e.to_string()))?;
+        }
         if snap.ref_poses.len() != n {
             return Err(corrupt("ref_poses", "one pose per block expected"));
         }
