@@ -111,6 +111,21 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// Two blocks overlap at the start of a run by more than the contact tolerance.
+    #[error(
+        "blocks {a} and {b} overlap by {depth:.3e} m at the start, more than the contact tolerance {tolerance} m: \
+         move them apart"
+    )]
+    InitialOverlap {
+        /// First block.
+        a: BlockId,
+        /// Second block.
+        b: BlockId,
+        /// Depth of the overlap (m).
+        depth: Real,
+        /// The contact tolerance (m).
+        tolerance: Real,
+    },
     /// A model with no blocks was asked to step (time could not advance: a run would never end).
     #[error("the model has no blocks: add one before stepping")]
     EmptyModel,

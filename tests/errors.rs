@@ -911,3 +911,26 @@ fn monitors_at_non_finite_points_are_errors() {
     assert!(matches!(&e, Error::NonFinite { .. }), "{e:?}");
     assert_names(&e.to_string(), &["nan point"]);
 }
+
+/// Blocks that start overlapping deeper than the contact tolerance are an error naming both
+/// (two free cubes overlapping by half used to fly apart at 107 m/s each, 2.3e5 J from
+/// nothing); an overlap within the tolerance is a contact, as always.
+#[test]
+fn initial_overlap_beyond_the_tolerance_is_an_error() {
+    for (lift, overlapping) in [(-0.1, true), (-0.002, true), (-0.0005, false), (0.0, false)] {
+        let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
+        model.add_block(common::fixed_slab("base")).unwrap();
+        let cube = model
+            .add_block(common::cube("cube", Vector::new(0.0, 0.0, lift)))
+            .unwrap();
+        match model.step() {
+            Err(Error::InitialOverlap { a, b, depth, .. }) => {
+                assert!(overlapping, "lift {lift}");
+                assert_eq!((a, b), (BlockId(0), cube));
+                assert!((depth + lift).abs() < 1e-9, "{depth} vs {lift}");
+            }
+            Ok(()) => assert!(!overlapping, "lift {lift} should be refused"),
+            Err(e) => panic!("{e}"),
+        }
+    }
+}

@@ -645,7 +645,8 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// One step.
     ///
     /// # Errors
-    /// [`Error::EmptyModel`] for a model without blocks;
+    /// [`Error::EmptyModel`] for a model without blocks; [`Error::InitialOverlap`] at the
+    /// first step for blocks that overlap by more than the contact tolerance;
     /// [`Error::MissingJointLaw`] when blocks of materials with no law touch;
     /// [`Error::TimeStepTooLarge`] for a fixed step above the critical one;
     /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway.
