@@ -257,9 +257,14 @@ impl RigidBlock {
 
     /// Sets the fixity.
     pub fn with_fixity(mut self, fixity: Fixity) -> Self {
+        self.replace_fixity(fixity);
+        self
+    }
+
+    /// Sets the fixity in place (and the cached `free` flag), without copying the block.
+    pub(crate) fn replace_fixity(&mut self, fixity: Fixity) {
         self.fixity = fixity;
         self.free = fixity.is_free();
-        self
     }
 
     /// Whether no degree of freedom is constrained ([`Fixity::is_free`], cached next to the
@@ -271,10 +276,15 @@ impl RigidBlock {
 
     /// Sets the initial velocity (m/s) and angular velocity (rad/s, world frame).
     pub fn with_velocity(mut self, velocity: Vector, angular_velocity: Vector) -> Self {
+        self.replace_velocity(velocity, angular_velocity);
+        self
+    }
+
+    /// Sets the velocities in place (and the angular momentum), without copying the block.
+    pub(crate) fn replace_velocity(&mut self, velocity: Vector, angular_velocity: Vector) {
         self.state.velocity = velocity;
         self.state.angular_velocity = angular_velocity;
         self.state.angular_momentum = self.world_inertia_times(angular_velocity);
-        self
     }
 
     /// Moves the block rigidly: `pose` is applied on top of its current placement.

@@ -383,16 +383,16 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn set_fixity(&mut self, id: BlockId, fixity: Fixity) -> Result<()> {
         let b = self.block_mut(id)?;
         let old = b.fixity().to_owned();
-        *b = b.clone().with_fixity(fixity);
+        b.replace_fixity(fixity);
         if let Err(e) = b.validate() {
-            *b = b.clone().with_fixity(old);
+            b.replace_fixity(old);
             return Err(e);
         }
         // A released block may touch blocks it had no contact with while both were fixed.
         self.state.changes.insert(Changes::FIXITY);
         if let Err(e) = self.state.refresh_time_step(&mut self.pipeline) {
             let b = self.block_mut(id)?;
-            *b = b.clone().with_fixity(old);
+            b.replace_fixity(old);
             let _ = self.state.refresh_time_step(&mut self.pipeline);
             return Err(e);
         }
@@ -431,7 +431,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 expected: "a block with a translation at prescribed velocity (Dof::Velocity)",
             });
         }
-        *b = b.clone().with_fixity(fixity);
+        b.replace_fixity(fixity);
         Ok(())
     }
 
@@ -448,7 +448,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         }
         let b = self.block_mut(id)?;
         let before = b.kinetic_energy();
-        *b = b.clone().with_velocity(velocity, angular_velocity);
+        b.replace_velocity(velocity, angular_velocity);
         let after = b.kinetic_energy();
         // Kinetic energy given by the user counts as energy put in.
         if self.state.started {
