@@ -16,7 +16,27 @@
 //! advances) for capacities, pushover curves and softening branches. Use a plain prescribed
 //! velocity ([`crate::block::Fixity::velocity`]) when the rate is part of the problem (impact,
 //! a test run at a known speed). Check the answer of any quasi-static run by halving the
-//! increment and the threshold ([`Servo::refined`]): a converged answer does not move.
+//! increment and the threshold ([`Servo::refined`], [`Servo::check_convergence`]): a converged
+//! answer does not move.
+//!
+//! Choosing the parameters:
+//! - **`max_unbalanced_ratio`** sets how close to equilibrium each state is: it is the
+//!   parameter the answer depends on most. Where joints slide or hinges form, the path between
+//!   equilibria matters (friction is path-dependent), and a loose threshold loads the structure
+//!   a little dynamically; 1e-3 is a sensible start, and [`Servo::check_convergence`] says
+//!   whether it is tight enough.
+//! - **`increment`** sets how far apart the equilibria are: small against the displacements
+//!   of interest (the answer is read every many increments), not so small that the run is
+//!   made of increments. The cost of settling after an increment grows only with its
+//!   logarithm, so a larger increment is cheaper per metre of travel.
+//! - **The time step.** Inertia plays no part in a quasi-static answer, so the step's margin
+//!   below the stability limit, which impacts and changing contacts need, is not needed
+//!   either: [`crate::integrate::TimeStep::Auto`] with `safety` 0.8–0.9 (the limit is an
+//!   upper bound of the frequencies, `docs/theory.md`) halves the steps of a servo run against
+//!   the default 0.5. Check that the answer does not change.
+//! - **Mass scaling** (3DEC's static mode) is not offered: in an assembly of similar blocks,
+//!   such as an arch, it barely changes the ratio of the highest to the lowest frequency, which
+//!   is what settling costs.
 //!
 //! ```
 //! use std::ops::ControlFlow;
@@ -116,6 +136,41 @@ impl Servo {
         }
     }
 
+    /// Runs a quasi-static analysis with this servo and with [`refined`](Self::refined), in
+    /// parallel, and returns the quantity each run reports (a peak load, a displacement): the
+    /// check of a quasi-static answer ([`Convergence::relative_change`]).
+    ///
+    /// `run` builds and runs the whole analysis under the servo it is given; it must not
+    /// depend on anything else that changes between the calls.
+    ///
+    /// # Errors
+    /// The first error of either run.
+    ///
+    /// # Example
+    /// ```
+    /// use voussoir::ids::BlockId;
+    /// use voussoir::loading::Servo;
+    ///
+    /// let servo = Servo::new(BlockId(2), voussoir::math::Vector::NEG_Z, 1e-6, 1e-3)?;
+    /// // A stand-in for an analysis whose answer drifts with the threshold by 2 % per 1e-3.
+    /// let peak = |s: Servo| Ok::<_, voussoir::Error>(1000.0 * (1.0 + 20.0 * s.max_unbalanced_ratio));
+    /// let c = servo.check_convergence(peak)?;
+    /// assert_eq!((c.value, c.refined), (1020.0, 1010.0));
+    /// assert!((c.relative_change() - 10.0 / 1020.0).abs() < 1e-15);
+    /// assert!(c.converged(0.03) && !c.converged(0.005));
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    pub fn check_convergence<F>(&self, run: F) -> Result<Convergence>
+    where
+        F: Fn(Servo) -> Result<Real> + Sync,
+    {
+        let (value, refined) = rayon::join(|| run(*self), || run(self.refined()));
+        Ok(Convergence {
+            value: value?,
+            refined: refined?,
+        })
+    }
+
     /// Whether the model is settled by this servo's measure (the last step's unbalanced-force
     /// ratio at most the threshold): the states to read a quasi-static answer from.
     pub fn settled<L: ConstitutiveLaw>(&self, model: &Model<L>) -> bool {
@@ -155,5 +210,35 @@ impl Servo {
             }
         }
         Ok(false)
+    }
+}
+
+/// A quantity from a quasi-static run and from the same run refined (half the increment and
+/// threshold of a servo, or half the rate of a rate-loaded run): how far the answer is from
+/// converged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Convergence {
+    /// The quantity from the run.
+    pub value: Real,
+    /// The quantity from the refined run.
+    pub refined: Real,
+}
+
+impl Convergence {
+    /// `|refined − value| / |value|` (infinite for a zero `value` with a non-zero `refined`,
+    /// zero when both are zero).
+    pub fn relative_change(&self) -> Real {
+        let change = (self.refined - self.value).abs();
+        if change == 0.0 {
+            0.0
+        } else {
+            change / self.value.abs()
+        }
+    }
+
+    /// Whether the refinement moved the quantity by at most `tolerance` (relative).
+    pub fn converged(&self, tolerance: Real) -> bool {
+        self.relative_change() <= tolerance
     }
 }

@@ -59,7 +59,10 @@ fn curve(
 }
 
 fn servo(increment: f64, ratio: f64) -> Vec<(f64, f64)> {
-    let servo = Servo::new(BlockId(2), Vector::new(0.0, 0.0, -1.0), increment, ratio).expect("servo");
+    servo_curve(Servo::new(BlockId(2), Vector::new(0.0, 0.0, -1.0), increment, ratio).expect("servo"))
+}
+
+fn servo_curve(servo: Servo) -> Vec<(f64, f64)> {
     curve(
         |m| servo.settled(m),
         |model, _plate, observe| {
@@ -123,4 +126,26 @@ fn a_plate_at_constant_speed_measures_inertia_that_the_servo_does_not() {
     println!("plate at 1 m/s: slope error {e_plain:.3e}; servo: {e_servo:.3e}");
     assert!(e_servo < 0.01, "{e_servo}");
     assert!(e_plain > 5.0 * e_servo, "{e_plain} vs {e_servo}");
+}
+
+/// `Servo::check_convergence` runs the analysis and its refinement: the plate force at 100 µm
+/// moves by far less than 1 % (two settled states of a linear problem), and both runs follow
+/// the closed form.
+#[test]
+fn the_convergence_check_runs_the_refined_servo_too() {
+    let servo = Servo::new(BlockId(2), Vector::new(0.0, 0.0, -1.0), 0.2e-6, 1e-3).expect("servo");
+    let seen = std::sync::Mutex::new(Vec::new());
+    let c = servo
+        .check_convergence(|s| {
+            seen.lock().expect("lock").push(s);
+            let c = servo_curve(s);
+            assert!(slope_error(&c) < 0.01, "{s:?}: {}", slope_error(&c));
+            Ok(c[c.len() - 1].1)
+        })
+        .expect("check");
+    let mut seen = seen.into_inner().expect("lock");
+    seen.sort_by(|a, b| a.increment.total_cmp(&b.increment));
+    assert_eq!(seen, [servo.refined(), servo]);
+    println!("force at 100 µm: {} N, refined {} N", c.value, c.refined);
+    assert!(c.converged(0.01), "{c:?}");
 }

@@ -1,7 +1,7 @@
 //! The quasi-static arch test: behaviour that must hold whatever the calibration.
 //!
-//! Runs five cases of `scenarios::arch_static` in parallel (about 20 s in release on 2 cores),
-//! loading to 6 mm (the baseline peaks near 1 mm).
+//! Runs six cases of `scenarios::arch_static` in parallel, quasi-statically (servo loading, the
+//! default), loading to 6 mm (about 10 s in release on 2 cores).
 
 use rayon::prelude::*;
 use voussoir::contact::DisplacementMode;
@@ -23,9 +23,14 @@ fn static_arch_behaves_like_an_arch() {
     let cases = [
         case("27", |c| c.friction_deg = 27.0),
         case("30.5", |_| {}),
-        case("35", |c| c.friction_deg = 35.0),
+        case("40", |c| c.friction_deg = 40.0),
         case("small", |c| c.mode = DisplacementMode::Small),
-        case("slow", |c| c.rate = 5e-3),
+        case("30.5 refined", |_| {}).refined(),
+        StaticCase {
+            max_displacement: 6e-3,
+            stop_fraction: 0.0,
+            ..StaticCase::rate_study(5e-2)
+        },
     ];
     let r: Vec<StaticResult> = cases
         .par_iter()
@@ -42,7 +47,10 @@ fn static_arch_behaves_like_an_arch() {
             x.curve.last().map_or(0.0, |s| s.smoothed_load / 1e3)
         );
     }
-    let (p27, p305, p35) = (r[0].peak_load, r[1].peak_load, r[2].peak_load);
+    let (p27, p305, p40) = (r[0].peak_load, r[1].peak_load, r[2].peak_load);
+    // The test: 2.71 kN. The model's parameters are the paper's, not fitted to this number, so
+    // the tolerance is that of the issue (±20 %); measured: 2.79 kN (+3.0 %).
+    assert!((p305 / 2710.0 - 1.0).abs() < 0.20, "baseline peak {p305} N vs 2710 N");
     // The load rises from zero to (nearly) its peak at a small displacement: the arch is stiff
     // before the mechanism forms. (Where the mechanism slides, the load then stays on a plateau
     // within round-off-sensitive wiggles of 2 %, so the displacement at the very peak is not a
@@ -66,39 +74,43 @@ fn static_arch_behaves_like_an_arch() {
             near_peak
         );
     }
-    // With hinges only (35°), the four-hinge mechanism softens: the load falls after the peak.
-    // (At this loading rate the 35° case is near the change of mechanism that slower rates show,
-    // where joint 13 slides, issue 17; the softening is checked when the mechanism at the peak
-    // is hinges only.)
-    let end35 = r[2].curve.last().expect("samples").smoothed_load;
-    if r[2].mechanism_at_peak.sliding_joints.is_empty() {
-        assert!(
-            end35 < 0.9 * p35,
-            "35°: end load {end35} not below 90 % of the peak {p35}"
-        );
-    }
+    // With hinges only (40°), the four-hinge mechanism softens: the load falls after the peak
+    // (measured: to 50 % of it by 4.4 mm).
+    assert!(
+        r[2].mechanism_at_peak.sliding_joints.is_empty(),
+        "40°: {}",
+        r[2].mechanism_at_peak.describe()
+    );
+    let end40 = r[2].curve.last().expect("samples").load;
+    assert!(
+        end40 < 0.9 * p40,
+        "40°: end load {end40} not below 90 % of the peak {p40}"
+    );
     // Capacity grows with the friction angle.
-    assert!(p27 < p305 && p305 < p35, "peaks {p27} {p305} {p35}");
+    assert!(p27 < p305 && p305 < p40, "peaks {p27} {p305} {p40}");
     // At 27° a joint slides at the peak (the paper: pure sliding).
     assert!(
         !r[0].mechanism_at_peak.sliding_joints.is_empty(),
         "27°: {}",
         r[0].mechanism_at_peak.describe()
     );
-    // Small and large displacements give close peaks (the peak is at ~1 mm, where geometry has
-    // barely changed): within 10 %.
+    // Small and large displacements give close peaks (the load reaches its plateau at 1–2 mm,
+    // where geometry has barely changed): within 5 % (measured over 12 mm: 0.6 %).
     assert!(
-        (r[3].peak_load / p305 - 1.0).abs() < 0.10,
+        (r[3].peak_load / p305 - 1.0).abs() < 0.05,
         "small {} vs large {}",
         r[3].peak_load,
         p305
     );
-    // Halving the rate from 1e-2 to 5e-3 m/s changes the quasi-static peak by less than 10 %
-    // (measured: 3 %); the inertial oscillation is what remains.
+    // Quasi-static: half the servo's increment and threshold move the peak by less than the
+    // 3 % `arch_static` holds every default case to (measured over 12 mm: 0.7 %).
     assert!(
-        (r[4].peak_load / p305 - 1.0).abs() < 0.10,
-        "slow {} vs {}",
+        (r[4].peak_load / p305 - 1.0).abs() < 0.03,
+        "refined {} vs {}",
         r[4].peak_load,
         p305
     );
+    // Loaded at 5e-2 m/s (the rate the paper ran its studies at), inertia more than doubles
+    // the peak (measured: 6.0 kN); the servo's answer is what a slow test measures.
+    assert!(r[5].peak_load > 1.5 * p305, "5e-2 m/s: {} vs {}", r[5].peak_load, p305);
 }

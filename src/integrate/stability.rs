@@ -6,7 +6,7 @@
 use super::{Stiffness6, StiffnessBound};
 use crate::block::{Block, RigidBlock};
 use crate::law::JointStiffness;
-use crate::math::{Real, Rotation, Vector};
+use crate::math::{Real, Vector};
 
 /// What the stability bound needs of one contact: its blocks, normal, spring stiffness and the
 /// area moments of its sub-contact points about `origin` (world).
@@ -32,19 +32,10 @@ pub(crate) fn block_bounds(
     k_max: Real,
     bounds: &mut [StiffnessBound],
 ) {
-    // Mass scaling of each movable block: translations by 1/√m, rotations by R I^{-1/2} Rᵀ.
-    let scaling: Vec<Option<(Real, Rotation, Vector)>> = blocks
+    // Mass scaling of each movable block, restricted to its free degrees of freedom.
+    let scaling: Vec<Option<Normalisation>> = blocks
         .iter()
-        .map(|b| {
-            (!all_constrained(b)).then(|| {
-                let mp = b.mass_properties();
-                (
-                    1.0 / mp.mass.sqrt(),
-                    b.state.pose.rotation,
-                    Vector::ONE / mp.principal_inertia.map(Real::sqrt),
-                )
-            })
-        })
+        .map(|b| (!all_constrained(b)).then(|| Normalisation::of(b)))
         .collect();
     let n = blocks.len();
     let mut own = vec![Stiffness6::default(); n];
@@ -53,12 +44,9 @@ pub(crate) fn block_bounds(
     for c in contacts {
         let k = c.stiffness;
         let side = |i: usize| -> Option<Stiffness6> {
-            let (inv_sqrt_m, rot, inv_sqrt_i) = scaling[i]?;
+            let scaling = scaling[i].as_ref()?;
             let centre = blocks[i].state.pose.translation - c.origin;
-            Some(
-                c.moments
-                    .stiffness(centre, c.normal, k.normal, k.shear, inv_sqrt_m, rot, inv_sqrt_i),
-            )
+            Some(c.moments.stiffness(centre, c.normal, k.normal, k.shear, scaling))
         };
         let (a, b) = (c.a, c.b);
         let (ka, kb) = (side(a), side(b));
@@ -86,6 +74,42 @@ pub(crate) fn block_bounds(
             let face = b.shape().faces().iter().map(|f| f.area).fold(0.0, Real::max);
             k_max * face * (1.0 / mp.mass + b.shape().radius().powi(2) / mp.principal_inertia.min_element())
         };
+    }
+}
+
+/// The mass normalisation of one block's stiffness, `K ↦ T K Tᵀ`, restricted to its free
+/// degrees of freedom: translations by `1/√m` (zero where prescribed), rotations by
+/// `S P` with `S = R I^{-1/2} Rᵀ` and `P` zeroing the prescribed world rotations. The
+/// eigenvalues of `S P K P S` are those of `K_FF (I⁻¹)_FF`, the free rotations' dynamics as
+/// central difference integrates them (`ω = I⁻¹ L`, then the prescribed components
+/// overwritten): a prescribed degree of freedom does not vibrate, and its stiffness must not
+/// shorten the step (a loading plate with prescribed rotations would otherwise bound its
+/// neighbour's frequency with a rotation that cannot happen).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Normalisation {
+    /// `1/√m` on each free world translation, zero on a prescribed one.
+    pub translation: Vector,
+    /// `S = R I^{-1/2} Rᵀ`.
+    pub rotation: crate::math::Matrix,
+    /// The diagonal of `P`: one on each free world rotation, zero on a prescribed one.
+    pub free_rotations: Vector,
+}
+
+impl Normalisation {
+    fn of(b: &RigidBlock) -> Self {
+        use crate::math::Matrix;
+        let mp = b.mass_properties();
+        let f = b.fixity();
+        let free = |dofs: &[crate::block::Dof; 3]| {
+            Vector::from_array(dofs.map(|d| if d.prescribed().is_some() { 0.0 } else { 1.0 }))
+        };
+        let r = Matrix::from_quat(b.state.pose.rotation);
+        let s = r * Matrix::from_diagonal(Vector::ONE / mp.principal_inertia.map(Real::sqrt)) * r.transpose();
+        Self {
+            translation: free(&f.translation) / mp.mass.sqrt(),
+            rotation: s,
+            free_rotations: free(&f.rotation),
+        }
     }
 }
 
@@ -125,20 +149,11 @@ impl AreaMoments {
         self.s2 += crate::math::Matrix::from_cols(p * (p.x * area), p * (p.y * area), p * (p.z * area));
     }
 
-    /// `M^{-1/2} K M^{-1/2}` of the contact's springs acting on a block with centroid `x`:
-    /// with `C = ks·I + (kn − ks)·n nᵀ` per unit area and `r = p − x`,
+    /// `T K Tᵀ` of the contact's springs acting on a block with centroid `x`, `T` the block's
+    /// [`Normalisation`] (`M^{-1/2}` on its free degrees of freedom): with
+    /// `C = ks·I + (kn − ks)·n nᵀ` per unit area and `r = p − x`,
     /// `K = Σ A [C, C[r]ᵀ; [r]C, [r] C [r]ᵀ]` (`[r]` the cross-product matrix).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn stiffness(
-        &self,
-        x: Vector,
-        n: Vector,
-        kn: Real,
-        ks: Real,
-        inv_sqrt_m: Real,
-        rot: Rotation,
-        inv_sqrt_i: Vector,
-    ) -> Stiffness6 {
+    pub(crate) fn stiffness(&self, x: Vector, n: Vector, kn: Real, ks: Real, scaling: &Normalisation) -> Stiffness6 {
         use crate::math::Matrix;
         let c = Matrix::from_diagonal(Vector::splat(ks)) + outer(n, n) * (kn - ks);
         // Moments about the centroid.
@@ -163,13 +178,18 @@ impl AreaMoments {
                 k_rr += (*ei * c * ej.transpose()) * a2.col(j)[i];
             }
         }
-        // Scale: translations by 1/√m, rotations by S = R diag(I^{-1/2}) Rᵀ.
-        let r = Matrix::from_quat(rot);
-        let s = r * Matrix::from_diagonal(inv_sqrt_i) * r.transpose();
-        let m2 = inv_sqrt_m * inv_sqrt_m;
-        let tt = k_tt * m2;
-        let rt = s * k_rt * inv_sqrt_m;
-        let rr = s * k_rr * s;
+        // Scale: translations by D = diag(1/√m), rotations by S P (zero where prescribed);
+        // for a free block the products are those of `k/m`, `S k /√m` and `S k S`.
+        let t = scaling.translation;
+        let p = Matrix::from_diagonal(scaling.free_rotations);
+        let (sp, ps) = (scaling.rotation * p, p * scaling.rotation);
+        let tt = Matrix::from_cols(
+            k_tt.x_axis * (t * t.x),
+            k_tt.y_axis * (t * t.y),
+            k_tt.z_axis * (t * t.z),
+        );
+        let rt = sp * k_rt * Matrix::from_diagonal(t);
+        let rr = sp * k_rr * ps;
         let mut out = Stiffness6::default();
         for i in 0..3 {
             for j in 0..3 {
@@ -219,7 +239,12 @@ mod tests {
                 direct.add_spring(&[t.x, t.y, t.z, w.x, w.y, w.z], k * a);
             }
         }
-        let assembled = m.stiffness(x, n, kn, ks, inv_sqrt_m, rot, inv_sqrt_i);
+        let scaling = Normalisation {
+            translation: Vector::splat(inv_sqrt_m),
+            rotation: s,
+            free_rotations: Vector::ONE,
+        };
+        let assembled = m.stiffness(x, n, kn, ks, &scaling);
         for i in 0..6 {
             for j in 0..6 {
                 let (u, v) = (assembled.0[i][j], direct.0[i][j]);
@@ -230,5 +255,65 @@ mod tests {
             }
         }
         assert!((assembled.max_eigenvalue() - direct.max_eigenvalue()).abs() < 1e-6 * direct.max_eigenvalue());
+    }
+
+    /// A prescribed degree of freedom does not vibrate. A cube on a fixed base (the base adds
+    /// no coupling) is bounded with its rotations prescribed by its translations alone, exactly
+    /// `kn·A/m`; with them free, by its rocking too (`kn·I_A/I` about an edge of the face is
+    /// above `kn·A/m` for a cube), and with one of them prescribed, in between.
+    #[test]
+    fn prescribed_degrees_of_freedom_do_not_bound_the_step() {
+        use crate::block::{Dof, Fixity, RigidBlock};
+        use crate::law::JointStiffness;
+        let (kn, ks) = (1e9, 0.4e9);
+        let base = RigidBlock::cuboid(
+            "base",
+            Vector::new(-1.0, -1.0, -0.1),
+            Vector::new(1.0, 1.0, 0.0),
+            2500.0,
+        )
+        .expect("base")
+        .with_fixity(Fixity::FIXED);
+        let cube =
+            RigidBlock::cuboid("cube", Vector::new(-0.1, -0.1, 0.0), Vector::new(0.1, 0.1, 0.2), 2500.0).expect("cube");
+        let mass = cube.mass_properties().mass;
+        let mut moments = AreaMoments::default();
+        for i in 0..3 {
+            for j in 0..3 {
+                let p = Vector::new(-0.1 + 0.1 * i as Real, -0.1 + 0.1 * j as Real, 0.0);
+                moments.add(p, 0.04 / 9.0);
+            }
+        }
+        let contact = ContactStiffness {
+            a: 0,
+            b: 1,
+            normal: Vector::Z,
+            stiffness: JointStiffness { normal: kn, shear: ks },
+            origin: Vector::ZERO,
+            moments,
+        };
+        let bound = |rotation: [Dof; 3]| {
+            let fixity = Fixity {
+                rotation,
+                ..Fixity::FREE
+            };
+            let blocks = [base.clone(), cube.clone().with_fixity(fixity)];
+            let mut bounds = [StiffnessBound::default(); 2];
+            block_bounds(&blocks, &[contact], kn + 2.0 * ks, &mut bounds);
+            assert_eq!(bounds[0].omega_squared, 0.0);
+            bounds[1].omega_squared
+        };
+        let translations_only = bound([Dof::Fixed; 3]);
+        let expected = kn * 0.04 / mass;
+        assert!(
+            (translations_only - expected).abs() < 1e-9 * expected,
+            "{translations_only} vs kn·A/m = {expected}"
+        );
+        let one_free = bound([Dof::Fixed, Dof::Free, Dof::Fixed]);
+        let all_free = bound([Dof::Free; 3]);
+        assert!(
+            translations_only < one_free && one_free <= all_free * (1.0 + 1e-12),
+            "{translations_only} < {one_free} <= {all_free}"
+        );
     }
 }

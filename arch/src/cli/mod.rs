@@ -172,7 +172,7 @@ impl Outputs {
         &self,
         name: Option<&str>,
         every: f64,
-        run: impl FnOnce(Option<f64>, &mut dyn FnMut(&Model) -> voussoir::Result<()>) -> voussoir::Result<T>,
+        run: impl FnOnce(Option<f64>, &mut (dyn FnMut(&Model) -> voussoir::Result<()> + Send)) -> voussoir::Result<T>,
     ) -> voussoir::Result<T> {
         match name.filter(|_| self.paraview) {
             Some(name) => {

@@ -407,6 +407,7 @@ pub fn build(case: &ImpactCase) -> Result<ImpactModel> {
         ks: case.ks,
         friction_deg: case.friction_deg,
         mode: voussoir::contact::DisplacementMode::Large,
+        time_step: voussoir::integrate::TimeStep::default(),
     })?;
     let (steel, frame) = (super::STEEL, super::FRAME);
     let stone_law = CoulombSlip::dry(case.kn, case.ks, case.friction_deg)?;

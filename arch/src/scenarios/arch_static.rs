@@ -6,8 +6,11 @@
 //! it is free to translate horizontally and to rotate in the plane of the arch (the roller and
 //! bearing of the test), so the load it transmits is vertical. The plate–stone joint has the
 //! stone joint's law. The arch is first settled under gravity with local damping, then the plate
-//! is driven down at the loading rate with local damping on, until the plate has travelled
-//! `max_displacement` or the load has fallen below `stop_fraction` of its peak.
+//! is driven down quasi-statically by a servo ([`voussoir::loading::Servo`]: it advances only
+//! from settled states, and the load is read at them), or at a constant rate for the study of
+//! inertia effects ([`StaticCase::rate_study`]), with local damping on, until the plate has
+//! travelled `max_displacement` or the load has fallen below `stop_fraction` of its peak.
+//! [`run_converged`] also runs the case refined and reports how much its peak moves.
 
 use std::ops::ControlFlow;
 use std::time::Instant;
@@ -20,7 +23,7 @@ use voussoir::build::arch::Arch;
 use voussoir::contact::DisplacementMode;
 use voussoir::error::Result;
 use voussoir::integrate::Damping;
-use voussoir::loading::Servo;
+use voussoir::loading::{Convergence, Servo};
 use voussoir::math::{Pose, Real, Rotation, Vector};
 use voussoir::model::Model;
 
@@ -39,7 +42,7 @@ pub struct StaticCase {
     pub kn: Real,
     /// Shear stiffness (Pa/m).
     pub ks: Real,
-    /// Plate velocity (m/s, downwards).
+    /// Plate velocity (m/s, downwards) when the case is loaded at a rate (`servo` is `None`).
     pub rate: Real,
     /// Large or small displacements.
     pub mode: DisplacementMode,
@@ -61,18 +64,29 @@ pub struct StaticCase {
     pub plate_thickness: Real,
     /// Plate density (kg/m³, steel).
     pub plate_density: Real,
-    /// Window of plate travel (m) over which the load is averaged for the quasi-static peak.
+    /// Window of plate travel (m) over which the load is averaged for the peak; zero (the
+    /// default, servo loading): no averaging, the peak is that of the settled states.
     ///
-    /// Once hinges form the arch moves as a mechanism, and local damping (proportional to the
-    /// out-of-balance force, which is small in a mechanism) lets it oscillate at about 10 Hz:
-    /// 0.8 mm of travel at 1e-2 m/s. A window of at least one period removes that inertial
-    /// oscillation; the raw peak is reported too.
+    /// Loaded at a rate, once hinges form the arch moves as a mechanism, and local damping
+    /// (proportional to the out-of-balance force, which is small in a mechanism) lets it
+    /// oscillate at about 10 Hz: 0.8 mm of travel at 1e-2 m/s. The rate study averages over a
+    /// window of one period (1 mm) to remove that inertial oscillation; the raw peak is
+    /// reported too.
     pub smoothing_window: Real,
-    /// Quasi-static loading by servo ([`voussoir::loading::Servo`]) instead of `rate`: the
-    /// plate advances by `increment` per step from settled states only. `None` (the default):
-    /// the plate moves at `rate`.
+    /// Quasi-static loading by servo ([`voussoir::loading::Servo`]): the plate advances by
+    /// `increment` per step from settled states only (the default). `None`: the plate moves at
+    /// `rate` (the rate study of inertia effects).
     #[serde(default)]
     pub servo: Option<ServoLoading>,
+    /// Safety factor of the automatic time step (the fraction of the stability limit): 0.9
+    /// under servo loading, where inertia plays no part; the model's default 0.5 for the rate
+    /// study.
+    #[serde(default = "default_safety")]
+    pub time_step_safety: Real,
+}
+
+fn default_safety() -> Real {
+    0.5
 }
 
 /// Servo settings of a static case.
@@ -84,9 +98,20 @@ pub struct ServoLoading {
     pub max_unbalanced_ratio: Real,
 }
 
+impl ServoLoading {
+    /// The default cases' servo: 20 µm increments from states with an unbalanced-force ratio
+    /// at most 1e-3 (halving both moves every default case's peak by less than 3 %,
+    /// `docs/benchmarks/arch-static.md`).
+    pub const DEFAULT: Self = Self {
+        increment: 2e-5,
+        max_unbalanced_ratio: 1e-3,
+    };
+}
+
 impl StaticCase {
-    /// The paper's model: φ = 30.5°, kn = 4 GPa/m, ks = 1.6 GPa/m, 1e-2 m/s, large displacements,
-    /// width 0.15 m (adopted), 15 sub-contacts per edge, local damping 0.8.
+    /// The paper's model: φ = 30.5°, kn = 4 GPa/m, ks = 1.6 GPa/m, large displacements, width
+    /// 0.15 m (adopted), 15 sub-contacts per edge, local damping 0.8, loaded quasi-statically
+    /// ([`ServoLoading::DEFAULT`], time step at 0.9 of the limit, no averaging).
     pub fn baseline() -> Self {
         Self {
             label: "baseline".into(),
@@ -104,9 +129,45 @@ impl StaticCase {
             plate_length: 0.10,
             plate_thickness: 0.02,
             plate_density: 7850.0,
+            smoothing_window: 0.0,
+            servo: Some(ServoLoading::DEFAULT),
+            time_step_safety: 0.9,
+        }
+    }
+
+    /// The baseline loaded at `rate` (m/s) as the paper's study of inertia effects: the plate
+    /// moves at constant speed, the time step is the model's default (0.5 of the limit) and
+    /// the load is averaged over 1 mm of travel. Labelled `rate … m/s`.
+    pub fn rate_study(rate: Real) -> Self {
+        Self {
+            label: format!("rate {rate} m/s"),
+            rate,
             smoothing_window: 1e-3,
             servo: None,
+            time_step_safety: default_safety(),
+            ..Self::baseline()
         }
+    }
+
+    /// The same case refined, for the convergence check: half the servo's increment and
+    /// threshold ([`Servo::refined`]), or half the rate.
+    pub fn refined(&self) -> Self {
+        let mut refined = self.clone();
+        match &mut refined.servo {
+            Some(s) => {
+                *s = ServoLoading {
+                    increment: 0.5 * s.increment,
+                    max_unbalanced_ratio: 0.5 * s.max_unbalanced_ratio,
+                }
+            }
+            None => refined.rate *= 0.5,
+        }
+        refined
+    }
+
+    /// Whether the case belongs to the rate study (loaded at a rate, not quasi-statically).
+    pub fn is_rate_study(&self) -> bool {
+        self.servo.is_none()
     }
 }
 
@@ -191,6 +252,9 @@ pub fn build(case: &StaticCase) -> Result<StaticModel> {
         ks: case.ks,
         friction_deg: case.friction_deg,
         mode: case.mode,
+        time_step: voussoir::integrate::TimeStep::Auto {
+            safety: case.time_step_safety,
+        },
     })?;
     model.set_damping(Damping::Local {
         alpha: case.local_damping,
@@ -416,6 +480,26 @@ pub fn run(
         subcontacts: model.subcontact_count(),
         wall_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// Runs a case and its refinement ([`StaticCase::refined`]) in parallel: the case's result
+/// (with its frames) and the convergence of its peak load (N).
+///
+/// # Errors
+/// As [`run`], for either run.
+pub fn run_converged(
+    case: &StaticCase,
+    frame_every: Option<Real>,
+    on_frame: impl FnMut(&Model) -> Result<()> + Send,
+) -> Result<(StaticResult, Convergence)> {
+    let refined = case.refined();
+    let (result, refined) = rayon::join(|| run(case, frame_every, on_frame), || run(&refined, None, |_| Ok(())));
+    let (result, refined) = (result?, refined?);
+    let convergence = Convergence {
+        value: result.peak_load,
+        refined: refined.peak_load,
+    };
+    Ok((result, convergence))
 }
 
 /// Convenience for callers that want the block of the plate by name.

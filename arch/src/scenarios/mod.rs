@@ -9,6 +9,7 @@ use voussoir::build::arch::{Arch, ArchSpec};
 use voussoir::contact::DisplacementMode;
 use voussoir::error::Result;
 use voussoir::geometry::{ContactParameters, SubcontactDensity};
+use voussoir::integrate::TimeStep;
 use voussoir::law::{CoulombSlip, MaterialId};
 use voussoir::math::{Real, Vector};
 use voussoir::model::{Model, ModelParameters};
@@ -29,6 +30,7 @@ pub(crate) struct ArchJoints {
     pub ks: Real,
     pub friction_deg: Real,
     pub mode: DisplacementMode,
+    pub time_step: TimeStep,
 }
 
 /// The reference arch in a model with gravity along −y and the dry Coulomb joint between every
@@ -42,6 +44,7 @@ pub(crate) fn reference_arch_model(j: ArchJoints) -> Result<(Model, Arch)> {
             ..ContactParameters::default()
         },
         mode: j.mode,
+        time_step: j.time_step,
         ..ModelParameters::default()
     };
     let mut model: Model = Model::new(params)?;
