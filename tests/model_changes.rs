@@ -60,3 +60,19 @@ fn released_block_finds_its_contact_at_once() -> Result<()> {
     assert_eq!(model.contacts().len(), 1);
     Ok(())
 }
+
+/// The contact wrench of a block the model has not detected contacts for yet (before the first
+/// step, or a block added since) is zero, not an index out of bounds (found by the scene fuzzer).
+#[test]
+fn contact_wrench_before_detection_is_zero() {
+    let mut model = common::model(CoulombSlip::dry(1e9, 1e9, 30.0).expect("law"));
+    let base = model.add_block(common::fixed_slab("base")).expect("base");
+    let cube = model.add_block(common::cube("cube", Vector::ZERO)).expect("cube");
+    assert_eq!(model.contact_wrench(cube).expect("wrench"), Wrench::default());
+    model.step().expect("step");
+    let added = model
+        .add_block(common::cube("second", Vector::new(0.5, 0.0, 0.0)))
+        .expect("added");
+    assert_eq!(model.contact_wrench(added).expect("wrench"), Wrench::default());
+    assert!(model.contact_wrench(base).expect("wrench").force.z < 0.0);
+}

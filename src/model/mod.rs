@@ -225,13 +225,12 @@ struct BlockSums {
 fn diverged(b: &RigidBlock, max_speed2: Real) -> bool {
     let s = &b.state;
     let r = b.radius;
-    let speed2 = s
-        .velocity
-        .length_squared()
-        .max(s.angular_velocity.length_squared() * r * r);
+    // Each on its own: `max` would hide a NaN of one behind the other.
+    let (v2, w2) = (s.velocity.length_squared(), s.angular_velocity.length_squared() * r * r);
     let (t, q) = (s.pose.translation, s.pose.rotation);
     let pose_sum = ((t.x + t.y) + t.z) + ((q.x + q.y) + (q.z + q.w));
-    speed2.is_nan() || speed2 > max_speed2 || !pose_sum.is_finite()
+    let l = s.angular_momentum;
+    !(v2 <= max_speed2 && w2 <= max_speed2 && pose_sum.is_finite() && (l.x + l.y + l.z).is_finite())
 }
 
 fn is_finite_state(s: &crate::block::BlockState) -> bool {
@@ -622,8 +621,13 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     fn contact_wrench_of(&self, i: usize) -> Wrench {
-        let entries = &self.pipeline.block_contacts
-            [self.pipeline.block_offsets[i] as usize..self.pipeline.block_offsets[i + 1] as usize];
+        // Before the first detection (no step yet, or a block added since), the block has no
+        // contacts the model knows of.
+        let offsets = &self.pipeline.block_offsets;
+        let (Some(&start), Some(&end)) = (offsets.get(i), offsets.get(i + 1)) else {
+            return Wrench::default();
+        };
+        let entries = &self.pipeline.block_contacts[start as usize..end as usize];
         motion::add_contact_wrenches(Wrench::default(), entries, &self.state.wrenches)
     }
 
