@@ -6,6 +6,7 @@ mod checkpoint;
 mod contact_pass;
 mod detection;
 mod energy;
+mod excitation;
 mod motion;
 mod observe;
 mod pipeline;
@@ -160,6 +161,8 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     pub changes: Changes,
     pub unbalanced_ratio: Real,
     pub detections: u64,
+    /// Base motions, by block ([`Model::set_base_motion`]).
+    pub motions: Vec<excitation::AppliedMotion>,
 }
 
 /// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).
@@ -273,6 +276,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 changes: Changes::DETECTION,
                 unbalanced_ratio: Real::INFINITY,
                 detections: 0,
+                motions: Vec::new(),
             },
             pipeline: Pipeline::default(),
         })

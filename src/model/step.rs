@@ -46,6 +46,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let (impact, busy) = self.compute_forces(pipeline);
         let previous = self.drift;
         let drift = self.next_drift(pipeline, impact, busy);
+        self.apply_base_motions(drift);
         let forces = std::time::Instant::now();
         let diverged = self.advance_blocks(pipeline, 0.5 * (previous + drift), drift);
         self.drift = drift;

@@ -1,0 +1,394 @@
+//! Base excitation: a block's translations following a prescribed time history (an
+//! accelerogram on a shaking table, a recorded ground velocity), the way masonry is assessed
+//! for earthquakes.
+//!
+//! A [`TimeHistory`] is a scalar signal sampled at increasing times and interpolated linearly
+//! between its samples (zero outside them). A [`BaseMotion`] gives a block's three world
+//! translations a history each, as an acceleration, a velocity or a displacement. The model
+//! moves the block so that its displacement at the end of every step is the exact integral of
+//! the history ([`BaseMotion::displacement`]): over a step from `t` to `t + Δt` the block's
+//! prescribed velocity is `(u(t + Δt) − u(t)) / Δt`. A piecewise-linear acceleration integrates
+//! to a piecewise-cubic displacement exactly, so the base does not drift however long the
+//! record, and the step may change (around impacts) without error.
+
+use crate::error::{Error, Result};
+use crate::math::{Real, Vector};
+
+/// A scalar signal sampled at strictly increasing times, linear between samples and zero
+/// outside `[first time, last time]`.
+///
+/// # Example
+/// ```
+/// use voussoir::loading::TimeHistory;
+///
+/// let a = TimeHistory::new(vec![0.0, 1.0, 2.0], vec![0.0, 2.0, 0.0])?;
+/// assert_eq!(a.value_at(0.5), 1.0);
+/// assert_eq!(a.value_at(3.0), 0.0);
+/// // A CSV accelerogram in g, scaled to m/s²: time in column 0, acceleration in column 1.
+/// let record = "t [s],a [g]\n0.0,0.0\n0.01,0.1\n0.02,-0.05\n";
+/// let a = TimeHistory::from_csv(record, 0, 1, 9.81)?;
+/// assert!((a.value_at(0.01) - 0.981).abs() < 1e-12);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "TimeHistoryData"))]
+#[cfg_attr(feature = "serde", serde(into = "TimeHistoryData"))]
+pub struct TimeHistory {
+    times: Vec<Real>,
+    values: Vec<Real>,
+    /// `(∫h, ∫∫h)` from the first sample to each sample.
+    integrals: Vec<(Real, Real)>,
+}
+
+/// The serialised form, validated into a [`TimeHistory`] on load.
+#[cfg(feature = "serde")]
+#[derive(serde::Serialize, serde::Deserialize)]
+struct TimeHistoryData {
+    times: Vec<Real>,
+    values: Vec<Real>,
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<TimeHistoryData> for TimeHistory {
+    type Error = Error;
+    fn try_from(d: TimeHistoryData) -> Result<Self> {
+        Self::new(d.times, d.values)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl From<TimeHistory> for TimeHistoryData {
+    fn from(h: TimeHistory) -> Self {
+        Self {
+            times: h.times,
+            values: h.values,
+        }
+    }
+}
+
+impl TimeHistory {
+    /// A history from its samples.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for fewer than two samples, lengths that differ, times
+    /// that do not strictly increase; [`Error::NonFinite`] for a non-finite time or value.
+    pub fn new(times: Vec<Real>, values: Vec<Real>) -> Result<Self> {
+        if times.len() != values.len() {
+            return Err(Error::InvalidParameter {
+                name: "time history".into(),
+                value: values.len() as Real,
+                expected: "as many values as times",
+            });
+        }
+        if times.len() < 2 {
+            return Err(Error::InvalidParameter {
+                name: "time history".into(),
+                value: times.len() as Real,
+                expected: "at least two samples",
+            });
+        }
+        for (i, (&t, &v)) in times.iter().zip(&values).enumerate() {
+            if !t.is_finite() || !v.is_finite() {
+                return Err(Error::NonFinite {
+                    what: format!("time history sample {i} (t = {t}, value = {v})"),
+                });
+            }
+            if i > 0 && t <= times[i - 1] {
+                return Err(Error::InvalidParameter {
+                    name: format!("time history: time of sample {i}"),
+                    value: t,
+                    expected: "times that strictly increase",
+                });
+            }
+        }
+        let mut integrals = Vec::with_capacity(times.len());
+        let (mut v, mut u) = (0.0, 0.0);
+        integrals.push((v, u));
+        for k in 0..times.len() - 1 {
+            (v, u) = segment_integral(
+                times[k + 1] - times[k],
+                values[k],
+                values[k + 1],
+                times[k + 1] - times[k],
+                v,
+                u,
+            );
+            integrals.push((v, u));
+        }
+        Ok(Self {
+            times,
+            values,
+            integrals,
+        })
+    }
+
+    /// `amplitude · sin(2π f t)` from 0 to `duration`, sampled `samples_per_period` times per
+    /// period (a shaking-table test).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a non-positive frequency, duration or sample count, or
+    /// one that would take more than ten million samples; [`Error::NonFinite`] for a non-finite
+    /// amplitude.
+    pub fn sine(amplitude: Real, frequency: Real, duration: Real, samples_per_period: u32) -> Result<Self> {
+        crate::error::positive("sine frequency", frequency)?;
+        crate::error::positive("sine duration", duration)?;
+        crate::error::positive("sine samples per period", Real::from(samples_per_period))?;
+        if !amplitude.is_finite() {
+            return Err(Error::NonFinite {
+                what: "sine amplitude".into(),
+            });
+        }
+        let samples = (duration * frequency * Real::from(samples_per_period)).ceil();
+        if samples > 1e7 {
+            return Err(Error::InvalidParameter {
+                name: "sine samples".into(),
+                value: samples,
+                expected: "at most ten million samples",
+            });
+        }
+        let n = samples as usize;
+        let h = duration / n as Real;
+        let times: Vec<Real> = (0..=n).map(|i| i as Real * h).collect();
+        let values = times
+            .iter()
+            .map(|t| amplitude * (2.0 * std::f64::consts::PI * frequency * t).sin())
+            .collect();
+        Self::new(times, values)
+    }
+
+    /// A history from two columns of CSV text (comma, semicolon, tab or blank separated; lines
+    /// that do not parse as numbers in both columns, such as a header, are skipped, as are
+    /// blank lines and lines starting with `#`), its values multiplied by `scale` (9.81 for a
+    /// record in g).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] naming the line of a row that has the columns but a value
+    /// that is not a number after the first numeric row, and as [`TimeHistory::new`].
+    pub fn from_csv(text: &str, time_column: usize, value_column: usize, scale: Real) -> Result<Self> {
+        if !scale.is_finite() {
+            return Err(Error::NonFinite {
+                what: "time history scale".into(),
+            });
+        }
+        let (mut times, mut values) = (Vec::new(), Vec::new());
+        for (line_no, line) in text.lines().enumerate() {
+            let line = line.trim().trim_start_matches('\u{feff}');
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let fields: Vec<&str> = line.split([',', ';', '\t', ' ']).filter(|f| !f.is_empty()).collect();
+            let parse = |c: usize| fields.get(c).map(|f| f.trim().parse::<Real>());
+            match (parse(time_column), parse(value_column)) {
+                (Some(Ok(t)), Some(Ok(v))) => {
+                    times.push(t);
+                    values.push(v * scale);
+                }
+                _ if times.is_empty() => {} // a header
+                _ => {
+                    return Err(Error::InvalidParameter {
+                        name: format!("time history CSV line {}: `{line}`", line_no + 1),
+                        value: (line_no + 1) as Real,
+                        expected: "a number in the time and value columns",
+                    })
+                }
+            }
+        }
+        Self::new(times, values)
+    }
+
+    /// Reads [`TimeHistory::from_csv`] from a file.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file, and as [`TimeHistory::from_csv`].
+    pub fn from_csv_file(path: &std::path::Path, time_column: usize, value_column: usize, scale: Real) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| crate::error::io_error(path, &e))?;
+        Self::from_csv(&text, time_column, value_column, scale)
+    }
+
+    /// The sample times (s).
+    pub fn times(&self) -> &[Real] {
+        &self.times
+    }
+
+    /// The sample values.
+    pub fn values(&self) -> &[Real] {
+        &self.values
+    }
+
+    /// The last sample time (s).
+    pub fn end(&self) -> Real {
+        self.times[self.times.len() - 1]
+    }
+
+    /// The segment `[t_k, t_{k+1}]` holding `t` (`None` outside the samples).
+    fn segment(&self, t: Real) -> Option<usize> {
+        if !(t >= self.times[0] && t <= self.end()) {
+            return None;
+        }
+        // The last k with t_k ≤ t, at most n − 2.
+        let k = self.times.partition_point(|&x| x <= t).saturating_sub(1);
+        Some(k.min(self.times.len() - 2))
+    }
+
+    /// The value at `t`: linear between samples, zero outside them.
+    pub fn value_at(&self, t: Real) -> Real {
+        let Some(k) = self.segment(t) else { return 0.0 };
+        let (t0, t1) = (self.times[k], self.times[k + 1]);
+        let (v0, v1) = (self.values[k], self.values[k + 1]);
+        v0 + (v1 - v0) * (t - t0) / (t1 - t0)
+    }
+}
+
+/// How a [`BaseMotion`]'s histories are read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum MotionKind {
+    /// Accelerations (m/s²), from rest at the first sample.
+    Acceleration,
+    /// Velocities (m/s).
+    Velocity,
+    /// Displacements (m) from the block's position when the motion was set.
+    Displacement,
+}
+
+/// A block's world translations following prescribed histories: the base of a wall on a
+/// shaking table. Axes without a history stand still. The block's translations along the axes
+/// with a history must be prescribed ([`crate::block::Dof::Velocity`]); the model sets their
+/// velocity every step ([`crate::Model::set_base_motion`]).
+///
+/// # Example
+/// A base shaken horizontally at 0.3 g and 3 Hz: its displacement at any time is the exact
+/// double integral of the acceleration.
+/// ```
+/// use voussoir::loading::{BaseMotion, MotionKind, TimeHistory};
+///
+/// let (a0, f) = (0.3 * 9.81, 3.0);
+/// let shake = TimeHistory::sine(a0, f, 2.0, 200)?;
+/// let motion = BaseMotion::new(MotionKind::Acceleration, [Some(shake), None, None])?;
+/// // From rest, u(t) = a0/ω² (ωt − sin ωt): 2.0 s is six whole periods.
+/// let w = 2.0 * std::f64::consts::PI * f;
+/// let exact = a0 / (w * w) * (w * 2.0);
+/// assert!((motion.displacement(2.0).x - exact).abs() < 1e-4 * exact);
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct BaseMotion {
+    /// What the histories are.
+    pub kind: MotionKind,
+    /// One history per world axis (x, y, z); `None`: that axis stands still.
+    pub axes: [Option<TimeHistory>; 3],
+}
+
+impl BaseMotion {
+    /// A motion from its histories.
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] when no axis has a history.
+    pub fn new(kind: MotionKind, axes: [Option<TimeHistory>; 3]) -> Result<Self> {
+        if axes.iter().all(Option::is_none) {
+            return Err(Error::InvalidParameter {
+                name: "base motion".into(),
+                value: 0.0,
+                expected: "a history on at least one axis",
+            });
+        }
+        Ok(Self { kind, axes })
+    }
+
+    /// The displacement at time `t` (m) from the position at time 0: the exact integral of
+    /// the piecewise-linear history (twice for an acceleration, from rest).
+    pub fn displacement(&self, t: Real) -> Vector {
+        let mut u = [0.0; 3];
+        for (u, h) in u.iter_mut().zip(&self.axes) {
+            if let Some(h) = h {
+                *u = match self.kind {
+                    MotionKind::Displacement => h.value_at(t),
+                    MotionKind::Velocity => integral(h, t).0,
+                    MotionKind::Acceleration => integral(h, t).1,
+                };
+            }
+        }
+        Vector::from_array(u)
+    }
+
+    /// The mean velocity over `[t, t + dt]` (m/s), the prescribed velocity of a step.
+    pub fn mean_velocity(&self, t: Real, dt: Real) -> Vector {
+        (self.displacement(t + dt) - self.displacement(t)) / dt
+    }
+
+    /// The axes with a history.
+    pub fn driven_axes(&self) -> [bool; 3] {
+        self.axes.each_ref().map(Option::is_some)
+    }
+}
+
+/// The integrals `(v, u)` after `s` into a segment of length `length` whose values go from
+/// `a0` to `a1`, starting from `(v, u)`: with `a(τ) = a0 + (a1 − a0) τ / length`,
+/// `v + a0 s + slope s²/2` and `u + v s + a0 s²/2 + slope s³/6`.
+fn segment_integral(s: Real, a0: Real, a1: Real, length: Real, v: Real, u: Real) -> (Real, Real) {
+    let slope = (a1 - a0) / length;
+    (
+        v + a0 * s + slope * s * s / 2.0,
+        u + v * s + a0 * s * s / 2.0 + slope * s * s * s / 6.0,
+    )
+}
+
+/// `(∫₀ᵗ h, ∫₀ᵗ∫₀ˢ h)` of a piecewise-linear history that is zero before its first sample
+/// and after its last: exact (the first is piecewise quadratic, the second piecewise cubic),
+/// from the integrals at the samples (a binary search and a few operations per call).
+fn integral(h: &TimeHistory, t: Real) -> (Real, Real) {
+    if t <= h.times[0] {
+        return (0.0, 0.0);
+    }
+    match h.segment(t) {
+        Some(k) => {
+            let (v, u) = h.integrals[k];
+            let length = h.times[k + 1] - h.times[k];
+            segment_integral(t - h.times[k], h.values[k], h.values[k + 1], length, v, u)
+        }
+        None => {
+            // After the last sample the history is zero: the velocity stays.
+            let (v, u) = h.integrals[h.integrals.len() - 1];
+            (v, u + v * (t - h.end()))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A constant acceleration integrates to `a t` and `a t²/2` exactly.
+    #[test]
+    fn integrals_are_exact_for_piecewise_linear_histories() {
+        let h = TimeHistory::new(vec![0.0, 0.3, 1.0], vec![2.0, 2.0, 2.0]).unwrap();
+        let (v, u) = integral(&h, 0.7);
+        assert!((v - 1.4).abs() < 1e-15 && (u - 0.49).abs() < 1e-15, "{v} {u}");
+        // A ramp a = t: v = t²/2, u = t³/6.
+        let ramp = TimeHistory::new(vec![0.0, 0.5, 2.0], vec![0.0, 0.5, 2.0]).unwrap();
+        let (v, u) = integral(&ramp, 1.5);
+        assert!((v - 1.125).abs() < 1e-14 && (u - 0.5625).abs() < 1e-14, "{v} {u}");
+        // Past the end the velocity holds.
+        let (v, u) = integral(&ramp, 3.0);
+        assert!(
+            (v - 2.0).abs() < 1e-14 && (u - (8.0 / 6.0 + 2.0)).abs() < 1e-14,
+            "{v} {u}"
+        );
+    }
+
+    #[test]
+    fn bad_histories_are_errors() {
+        assert!(TimeHistory::new(vec![0.0], vec![1.0]).is_err());
+        assert!(TimeHistory::new(vec![0.0, 1.0], vec![1.0]).is_err());
+        assert!(TimeHistory::new(vec![0.0, 0.0], vec![1.0, 2.0]).is_err());
+        assert!(TimeHistory::new(vec![0.0, Real::NAN], vec![1.0, 2.0]).is_err());
+        assert!(TimeHistory::new(vec![0.0, 1.0], vec![1.0, Real::INFINITY]).is_err());
+        assert!(TimeHistory::sine(1.0, 0.0, 1.0, 10).is_err());
+        assert!(TimeHistory::sine(1.0, 1e9, 1.0, 10).is_err());
+        let e = TimeHistory::from_csv("t,a\n0,1\n0.1,x\n", 0, 1, 1.0).unwrap_err();
+        assert!(e.to_string().contains("line 3"), "{e}");
+        assert!(BaseMotion::new(MotionKind::Velocity, [None, None, None]).is_err());
+    }
+}

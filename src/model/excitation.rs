@@ -1,0 +1,106 @@
+//! Base excitation in the step: the blocks with a [`BaseMotion`] get, before they move, the
+//! prescribed velocity that carries them to the motion's displacement at the end of the step.
+
+use super::{Model, ModelState};
+use crate::block::{Block, Dof};
+use crate::error::{Error, Result};
+use crate::ids::BlockId;
+use crate::law::ConstitutiveLaw;
+use crate::loading::BaseMotion;
+use crate::math::Real;
+
+/// A motion applied to a block, with the model time its history starts at.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub(crate) struct AppliedMotion {
+    pub block: u32,
+    pub motion: BaseMotion,
+    /// Model time of the history's `t = 0` (s).
+    pub start: Real,
+}
+
+impl<L: ConstitutiveLaw> ModelState<L> {
+    /// Sets the prescribed velocities of the driven axes for a step of `drift` from the
+    /// current time: the mean velocity of the motion over the step, so that the block's
+    /// displacement at the end of the step is the motion's exactly.
+    pub(super) fn apply_base_motions(&mut self, drift: Real) {
+        for m in &self.motions {
+            let t = self.time - m.start;
+            let v = m.motion.mean_velocity(t, drift);
+            let block = &mut self.blocks[m.block as usize];
+            let mut fixity = *block.fixity();
+            for (axis, driven) in m.motion.driven_axes().into_iter().enumerate() {
+                if driven {
+                    fixity.translation[axis] = Dof::Velocity(v[axis]);
+                }
+            }
+            block.replace_fixity(fixity);
+        }
+    }
+}
+
+impl<L: ConstitutiveLaw> Model<L> {
+    /// Makes a block's translations follow `motion` from now on (its history's `t = 0` is the
+    /// model's current time), replacing any motion the block had; `None` removes it (the
+    /// driven axes then keep the velocity of the last step: set the fixity to stop them).
+    ///
+    /// The driven axes of the block must be fixed or prescribed
+    /// ([`Dof::Fixed`] or [`Dof::Velocity`]); every step they get the velocity that carries the
+    /// block to the motion's displacement at the end of the step
+    /// ([`BaseMotion::mean_velocity`]). Their reactions are booked as boundary work.
+    ///
+    /// # Example
+    /// ```
+    /// use voussoir::loading::{BaseMotion, MotionKind, TimeHistory};
+    /// use voussoir::prelude::*;
+    ///
+    /// let mut model: Model = Model::new(ModelParameters::default())?;
+    /// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+    /// let table = model.add_block(
+    ///     RigidBlock::cuboid("table", Vector::new(-1.0, -1.0, -0.1), Vector::new(1.0, 1.0, 0.0), 2500.0)?
+    ///         .with_fixity(Fixity::FIXED),
+    /// )?;
+    /// // 0.1 g at 2 Hz along x for a second.
+    /// let shake = TimeHistory::sine(0.1 * 9.81, 2.0, 1.0, 100)?;
+    /// model.set_base_motion(table, Some(BaseMotion::new(MotionKind::Acceleration, [Some(shake), None, None])?))?;
+    /// model.run_until_time(0.25)?;
+    /// let x = model.block(table)?.state().pose.translation.x;
+    /// let w = 2.0 * std::f64::consts::PI * 2.0;
+    /// let exact = 0.981 / (w * w) * (w * 0.25 - (w * 0.25).sin()); // a0/ω² (ωt − sin ωt)
+    /// assert!((x - exact).abs() < 1e-3 * exact, "{x} vs {exact}");
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`]; [`Error::InvalidParameter`] when a driven axis of the block
+    /// is free.
+    pub fn set_base_motion(&mut self, id: BlockId, motion: Option<BaseMotion>) -> Result<()> {
+        let fixity = *self.block(id)?.fixity();
+        self.state.motions.retain(|m| m.block != id.0);
+        let Some(motion) = motion else { return Ok(()) };
+        for (axis, driven) in motion.driven_axes().into_iter().enumerate() {
+            if driven && matches!(fixity.translation[axis], Dof::Free) {
+                return Err(Error::InvalidParameter {
+                    name: format!("base motion of block {id} along {}", ["x", "y", "z"][axis]),
+                    value: axis as Real,
+                    expected: "a fixed or prescribed translation (Dof::Fixed or Dof::Velocity) on every driven axis",
+                });
+            }
+        }
+        self.state.motions.push(AppliedMotion {
+            block: id.0,
+            motion,
+            start: self.state.time,
+        });
+        self.state.motions.sort_by_key(|m| m.block);
+        Ok(())
+    }
+
+    /// The base motions applied, with their blocks and the model time each history started at.
+    pub fn base_motions(&self) -> impl Iterator<Item = (BlockId, &BaseMotion, Real)> {
+        self.state
+            .motions
+            .iter()
+            .map(|m| (BlockId(m.block), &m.motion, m.start))
+    }
+}
