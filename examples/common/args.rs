@@ -65,17 +65,31 @@ impl Interval {
 }
 
 impl Display for Interval {
-    /// In the usual notation: `[0, 0.2]`, `(0, 90)`, `(0, ∞)`.
+    /// In the usual notation: `[0, 0.2]`, `(0, 90)`, `[1e7, 1e12]`, `(0, ∞)`.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self.lo {
-            Bound::Included(a) => write!(f, "[{a}, ")?,
-            Bound::Excluded(a) => write!(f, "({a}, ")?,
+            Bound::Included(a) => write!(f, "[{}, ", Number(a))?,
+            Bound::Excluded(a) => write!(f, "({}, ", Number(a))?,
             Bound::Unbounded => write!(f, "(−∞, ")?,
         }
         match self.hi {
-            Bound::Included(b) => write!(f, "{b}]"),
-            Bound::Excluded(b) => write!(f, "{b})"),
+            Bound::Included(b) => write!(f, "{}]", Number(b)),
+            Bound::Excluded(b) => write!(f, "{})", Number(b)),
             Bound::Unbounded => write!(f, "∞)"),
+        }
+    }
+}
+
+/// A number as a reader writes it: `0.2`, `1e12`, `1e-6`.
+struct Number(f64);
+
+impl Display for Number {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let a = self.0.abs();
+        if a >= 1e5 || (a != 0.0 && a < 1e-3) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
         }
     }
 }
