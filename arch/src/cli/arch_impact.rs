@@ -14,7 +14,9 @@
 //! (drop-height perturbations, default `-0.5,-0.25,0,0.25,0.5`), `--out DIR`, `--study`,
 //! `--compare-release`, `--no-paraview`. Writes `summary.json`, one history CSV per setup (with
 //! the energy terms), `displacement_time.svg`, `max_disp_vs_experiment.svg`, a ParaView series per
-//! setup (and `sensitivity.svg` with `--study`) under `out/arch_impact/`.
+//! setup (and `sensitivity.svg` with `--study`) under `out/arch_impact/`. The ranges of the
+//! numbers (`--help`; [`DAMPING_RANGE`], [`DURATION_RANGE`], ...) are checked when parsed, and a
+//! setup or an offset given twice is refused.
 
 use std::ops::Bound::{Excluded, Included};
 

@@ -3,6 +3,12 @@
 //! `main` and its error report, the progress bar over the parallel cases, the ParaView series,
 //! the output folder and its files.
 //!
+//! Nothing is computed before the command line is whole: every number is checked against its
+//! range when parsed (`--help` gives each range and why), an unknown argument or a value given
+//! twice where it would write the same outputs twice is refused, and the output folder is created
+//! and probed, with every planned output file checked not to be a folder ([`Outputs::prepare`]).
+//! The checks are [`args`], shared with the core crate's examples.
+//!
 //! An entry point's `main` is one line, as in `arch/examples/arch_impact.rs`:
 //!
 //! ```no_run
