@@ -1,18 +1,45 @@
 //! A block on a real inclined ramp: sticks below the friction angle, slides above it.
 //!
-//! `cargo run --release --example block_on_incline [-- <slope_deg> <friction_deg>]`
+//! `cargo run --release --example block_on_incline [-- <SLOPE_DEG> [<FRICTION_DEG>]]`
+//! (`-- --help` for the ranges)
 //!
 //! Prints the measured acceleration along the slope beside the closed form
 //! `a = g (sin ψ − tan φ cos ψ)` (zero when ψ ≤ φ).
 
+#[path = "common/args.rs"]
+mod args;
+
+use std::ops::Bound::{Excluded, Included};
 use std::time::Instant;
 
+use clap::Parser;
 use voussoir::prelude::*;
 
+/// Range of both angles (°): a ramp from flat to just short of vertical; a friction angle of
+/// 90° would be an infinite friction coefficient.
+const ANGLE: args::Interval = args::Interval {
+    lo: Included(0.0),
+    hi: Excluded(90.0),
+};
+
+/// A brick on a ramp of slope ψ with a joint of friction angle φ: it sticks for ψ ≤ φ and slides
+/// with `a = g (sin ψ − tan φ cos ψ)` above.
+#[derive(Debug, Parser)]
+#[command(name = "block_on_incline", allow_negative_numbers = true, args_override_self = true)]
+struct Options {
+    /// Slope ψ of the ramp (°), in [0, 90)
+    #[arg(value_name = "SLOPE_DEG", value_parser = ANGLE.parser(), default_value = "35")]
+    slope_deg: f64,
+    /// Friction angle φ of the joint (°), in [0, 90)
+    #[arg(value_name = "FRICTION_DEG", value_parser = ANGLE.parser(), default_value = "30")]
+    friction_deg: f64,
+}
+
 fn main() -> Result<()> {
-    let args: Vec<f64> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
-    let slope_deg = args.first().copied().unwrap_or(35.0);
-    let friction_deg = args.get(1).copied().unwrap_or(30.0);
+    let Options {
+        slope_deg,
+        friction_deg,
+    } = Options::parse();
     let (psi, phi, g) = (slope_deg.to_radians(), friction_deg.to_radians(), 9.81);
 
     let mut model: Model = Model::new(ModelParameters::default())?;

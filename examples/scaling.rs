@@ -9,13 +9,52 @@
 //! per step, sub-contact updates per second, the share of time in contact detection, peak memory
 //! per block and the number of threads, and writes `out/scaling/summary.json`. `--spacing` sets the
 //! largest sub-contact spacing (m, default 25 mm), for studies of the cost of sub-contact density.
+//! `-- --help` gives the ranges; the output folder is created and probed before the first wall is
+//! built.
 
+#[path = "common/args.rs"]
+mod args;
+
+use std::ops::Bound::{Excluded, Included};
 use std::path::PathBuf;
 use std::time::Instant;
 
+use clap::{ArgAction, Parser};
 use serde::Serialize;
 use voussoir::prelude::*;
 use voussoir::scenes::{benchmark_wall_with_spacing, BENCHMARK_SPACING};
+
+/// Range of `--spacing` (m).
+const SPACING: args::Interval = args::Interval {
+    lo: Excluded(0.0),
+    hi: Included(0.2),
+};
+
+/// Scaling of a settling running-bond wall (bricks 0.2 × 0.1 × 0.05 m) with the number of
+/// blocks: time per step, sub-contact updates per second, peak memory per block.
+#[derive(Debug, Parser)]
+#[command(name = "scaling", args_override_self = true)]
+struct Options {
+    /// Wall sizes (blocks), each at least 1
+    #[arg(
+        long = "blocks",
+        value_name = "N[,N]",
+        value_delimiter = ',',
+        action = ArgAction::Set,
+        value_parser = args::whole::<usize>(1),
+        default_value = "1000,10000"
+    )]
+    sizes: Vec<usize>,
+    /// Timed steps per size, at least 1 (after 20 untimed ones)
+    #[arg(long, value_name = "N", value_parser = args::whole::<u64>(1), default_value = "50")]
+    steps: u64,
+    /// Largest sub-contact spacing (m), in (0, 0.2]: at most the bricks' length
+    #[arg(long, value_name = "M", value_parser = SPACING.parser(), default_value_t = BENCHMARK_SPACING)]
+    spacing: f64,
+    /// Folder for summary.json
+    #[arg(long, value_name = "DIR", default_value = "out/scaling")]
+    out: PathBuf,
+}
 
 #[derive(Serialize)]
 struct Run {
@@ -65,27 +104,13 @@ fn main() {
 }
 
 fn try_main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut sizes = vec![1_000usize, 10_000];
-    let mut steps = 50u64;
-    let mut spacing = BENCHMARK_SPACING;
-    let mut out = PathBuf::from("out/scaling");
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--blocks" => {
-                sizes = args
-                    .next()
-                    .ok_or("--blocks needs a list")?
-                    .split(',')
-                    .map(|x| x.trim().parse())
-                    .collect::<Result<_, _>>()?
-            }
-            "--steps" => steps = args.next().ok_or("--steps needs a number")?.parse()?,
-            "--spacing" => spacing = args.next().ok_or("--spacing needs a length in m")?.parse()?,
-            "--out" => out = args.next().ok_or("--out needs a folder")?.into(),
-            other => return Err(format!("unknown argument {other:?}").into()),
-        }
-    }
+    let Options {
+        sizes,
+        steps,
+        spacing,
+        out,
+    } = Options::parse();
+    args::prepare_output_dir(&out, &[], &["summary.json".to_owned()])?;
     let threads = rayon::current_num_threads();
     println!(
         "running-bond wall, bricks 0.2 × 0.1 × 0.05 m, sub-contact spacing {:.1} mm, {threads} threads",

@@ -14,11 +14,14 @@
 //! Writes `summary.json`, `force_displacement.csv`, `force_displacement.svg`,
 //! `capacity_vs_friction.svg` and a ParaView series of the baseline under `out/arch_static/`.
 
+use std::ops::Bound::{Excluded, Included};
+
 use clap::{ArgAction, Args};
 use serde::Serialize;
 use voussoir::contact::DisplacementMode;
 
-use super::{finite, BoxError, Outputs, Run};
+use super::args::Interval;
+use super::{BoxError, Outputs, Run};
 use crate::plot::{Curve, LinePlot, Reference};
 use crate::scenarios::arch_static::{run, run_converged, ServoLoading, StaticCase, StaticResult};
 use voussoir::loading::Convergence;
@@ -35,23 +38,38 @@ pub struct StaticOptions {
     /// Leave out the capacity-versus-friction sweep (25° to 40° by 1°)
     #[arg(long)]
     pub no_sweep: bool,
-    /// Friction angles (°) of the study, plotted in force_displacement.svg
+    /// Friction angles (°) of the study, plotted in force_displacement.svg; each in (0, 90): a
+    /// joint without friction has no capacity, and tan φ is infinite at 90°
     #[arg(
         long,
         value_name = "DEG[,DEG]",
         value_delimiter = ',',
         action = ArgAction::Set,
-        value_parser = finite,
+        value_parser = FRICTION_RANGE.parser(),
         allow_hyphen_values = true,
         default_value = "27,30,30.5,35"
     )]
     pub friction: Vec<f64>,
     /// Servo increment (m): the plate advances this far per step from settled states only
-    /// (every case but the rate study)
-    #[arg(long, value_name = "M", value_parser = finite, default_value = "2e-5")]
+    /// (every case but the rate study). In (0, 1e-3]: the peak is read from settled states, and
+    /// a step of a millimetre or more would pass it by
+    #[arg(
+        long,
+        value_name = "M",
+        value_parser = SERVO_INCREMENT_RANGE.parser(),
+        allow_hyphen_values = true,
+        default_value = "2e-5"
+    )]
     pub servo_increment: f64,
-    /// Unbalanced-force ratio at or below which the servo advances the plate
-    #[arg(long, value_name = "RATIO", value_parser = finite, default_value = "1e-3")]
+    /// Unbalanced-force ratio at or below which the servo advances the plate. In (0, 0.1]: a
+    /// larger ratio is not a settled state, and 0 is never reached
+    #[arg(
+        long,
+        value_name = "RATIO",
+        value_parser = SERVO_RATIO_RANGE.parser(),
+        allow_hyphen_values = true,
+        default_value = "1e-3"
+    )]
     pub servo_ratio: f64,
     /// Leave out the rate study (5e-2, 1e-2 and 5e-3 m/s, the paper's study of inertia)
     #[arg(long)]
@@ -60,6 +78,22 @@ pub struct StaticOptions {
     #[arg(long)]
     pub no_convergence_check: bool,
 }
+
+/// Range of `--friction` (°).
+pub const FRICTION_RANGE: Interval = Interval {
+    lo: Excluded(0.0),
+    hi: Excluded(90.0),
+};
+/// Range of `--servo-increment` (m).
+pub const SERVO_INCREMENT_RANGE: Interval = Interval {
+    lo: Excluded(0.0),
+    hi: Included(1e-3),
+};
+/// Range of `--servo-ratio`.
+pub const SERVO_RATIO_RANGE: Interval = Interval {
+    lo: Excluded(0.0),
+    hi: Included(0.1),
+};
 
 /// The largest change of a quasi-static case's peak under refinement (relative).
 pub const CONVERGENCE_TOLERANCE: f64 = 0.03;
@@ -72,6 +106,17 @@ and the paper's parameter studies, in parallel";
 
     fn run(&self, out: &Outputs) -> Result<(), BoxError> {
         run_static(self, out)
+    }
+
+    fn outputs(&self) -> Vec<String> {
+        [
+            "summary.json",
+            "force_displacement.csv",
+            "force_displacement.svg",
+            "capacity_vs_friction.svg",
+        ]
+        .map(String::from)
+        .into()
     }
 }
 

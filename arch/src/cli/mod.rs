@@ -3,6 +3,12 @@
 //! `main` and its error report, the progress bar over the parallel cases, the ParaView series,
 //! the output folder and its files.
 //!
+//! Nothing is computed before the command line is whole: every number is checked against its
+//! range when parsed (`--help` gives each range and why), an unknown argument or a value given
+//! twice where it would write the same outputs twice is refused, and the output folder is created
+//! and probed, with every planned output file checked not to be a folder ([`Outputs::prepare`]).
+//! The checks are [`args`], shared with the core crate's examples.
+//!
 //! An entry point's `main` is one line, as in `arch/examples/arch_impact.rs`:
 //!
 //! ```no_run
@@ -11,6 +17,8 @@
 
 pub mod arch_impact;
 pub mod arch_static;
+#[path = "../../../examples/common/args.rs"]
+pub mod args;
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -39,6 +47,9 @@ pub struct CommonOptions {
 }
 
 /// A run of the command line: its options (flattened beside [`CommonOptions`]) and what it does.
+///
+/// Before [`Run::run`] computes anything, [`parse`] has checked every value's range and
+/// [`Run::check`], and `main` has prepared the output folder for [`Run::outputs`].
 pub trait Run: Args {
     /// Name of the program (the example's).
     const NAME: &'static str;
@@ -51,6 +62,18 @@ pub trait Run: Args {
     /// # Errors
     /// Whatever stops the run; `main` reports it and exits with status 1.
     fn run(&self, out: &Outputs) -> Result<(), BoxError>;
+
+    /// Checks what a value parser cannot see alone (a setup given twice, say), at parse time.
+    ///
+    /// # Errors
+    /// A message naming the option.
+    fn check(&self) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// The files the run will write, relative to the output folder (the ParaView series aside):
+    /// none may be a folder.
+    fn outputs(&self) -> Vec<String>;
 }
 
 #[derive(Debug, Parser)]
@@ -66,7 +89,11 @@ struct Cli<R: Run> {
 pub fn main<R: Run>() {
     let (common, run) = parse::<R>(std::env::args_os()).unwrap_or_else(|e| e.exit());
     let out = Outputs::new(&common);
-    if let Err(e) = run.run(&out) {
+    if let Err(e) = out
+        .prepare(&run.outputs())
+        .map_err(BoxError::from)
+        .and_then(|()| run.run(&out))
+    {
         eprintln!("{}: {e}", R::NAME);
         std::process::exit(1);
     }
@@ -84,29 +111,22 @@ pub fn command<R: Run>() -> clap::Command {
         .mut_arg("out", |a| a.required(false).default_value(R::OUT))
 }
 
-/// Parses `args` (program name first) for run `R`.
+/// Parses `args` (program name first) for run `R`: every value in its range, and
+/// [`Run::check`].
 ///
 /// # Errors
-/// clap's, for a bad or unknown option or for `--help`.
+/// clap's, for a bad, out-of-range or unknown option, for a failed [`Run::check`] or for
+/// `--help`.
 pub fn parse<R: Run>(
     args: impl IntoIterator<Item = impl Into<std::ffi::OsString> + Clone>,
 ) -> Result<(CommonOptions, R), clap::Error> {
-    let matches = command::<R>().try_get_matches_from(args)?;
+    let mut command = command::<R>();
+    let matches = command.try_get_matches_from_mut(args)?;
     let cli = Cli::<R>::from_arg_matches(&matches)?;
+    cli.run
+        .check()
+        .map_err(|e| command.error(clap::error::ErrorKind::ValueValidation, e))?;
     Ok((cli.common, cli.run))
-}
-
-/// A number that must be finite (spaces around it allowed).
-///
-/// # Errors
-/// A message for clap when it is not a number or not finite.
-pub fn finite(s: &str) -> Result<f64, String> {
-    let x: f64 = s.trim().parse().map_err(|_| format!("not a number: {s:?}"))?;
-    if x.is_finite() {
-        Ok(x)
-    } else {
-        Err(format!("not finite: {s:?}"))
-    }
 }
 
 /// Where a run writes, and since when it runs.
@@ -135,6 +155,17 @@ impl Outputs {
     /// Seconds since the run started.
     pub fn elapsed(&self) -> f64 {
         self.started.elapsed().as_secs_f64()
+    }
+
+    /// Makes the output folder ready before the run computes anything
+    /// ([`args::prepare_output_dir`]): creates it (and `paraview/` unless `--no-paraview`),
+    /// probes that it can be written, and checks that none of `files` is a folder.
+    ///
+    /// # Errors
+    /// [`voussoir::Error::Io`] naming the path at fault.
+    pub fn prepare(&self, files: &[String]) -> voussoir::Result<()> {
+        let folders: &[&str] = if self.paraview { &["paraview"] } else { &[] };
+        args::prepare_output_dir(&self.dir, folders, files)
     }
 
     /// Runs `cases` in parallel behind a progress bar labelled `message`; `f` gets each case's
@@ -194,10 +225,9 @@ impl Outputs {
     /// Writes `text` to `file` in the output folder, creating the folder.
     ///
     /// # Errors
-    /// The file system's.
-    pub fn text(&self, file: &str, text: &str) -> std::io::Result<()> {
-        std::fs::create_dir_all(&self.dir)?;
-        std::fs::write(self.dir.join(file), text)
+    /// [`voussoir::Error::Io`] naming the file.
+    pub fn text(&self, file: &str, text: &str) -> voussoir::Result<()> {
+        args::write_text(&self.dir.join(file), text)
     }
 
     /// Writes `plot` as SVG to `file` in the output folder.

@@ -1,0 +1,176 @@
+//! The command lines of the core crate's examples (`block_on_incline`, `scaling`) against hostile
+//! input (issue 18), and the argument checks they share with `voussoir-arch`
+//! (`examples/common/args.rs`). The runs of the built examples need
+//! `cargo build --release --examples`, which `cargo test --release` does.
+
+#[path = "../examples/common/args.rs"]
+mod args;
+
+use std::ops::Bound::{Excluded, Included, Unbounded};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+#[test]
+fn real_values_are_finite_and_in_range() {
+    let angle = args::real(Included(0.0), Excluded(90.0));
+    assert_eq!(angle("0"), Ok(0.0));
+    assert_eq!(angle(" 35.5 "), Ok(35.5));
+    for bad in ["90", "180", "-35", "nan", "inf", "-inf", "abc", ""] {
+        let e = angle(bad).expect_err(bad);
+        assert!(e.contains("[0, 90)"), "{bad}: {e}");
+    }
+    assert_eq!(args::positive("1e-9"), Ok(1e-9));
+    for bad in ["0", "-1", "NaN", "infinity"] {
+        assert!(args::positive(bad).is_err(), "{bad}");
+    }
+    let any = args::real(Unbounded, Unbounded);
+    assert_eq!(any("-1e300"), Ok(-1e300));
+    assert!(any("inf").is_err() && any("nan").is_err());
+    assert!(args::finite("1e400").is_err(), "overflows to inf");
+}
+
+#[test]
+fn intervals_print_as_read() {
+    let i = |lo, hi| args::Interval { lo, hi }.to_string();
+    assert_eq!(i(Included(0.0), Included(0.2)), "[0, 0.2]");
+    assert_eq!(i(Excluded(0.0), Excluded(90.0)), "(0, 90)");
+    assert_eq!(i(Included(1e7), Included(1e12)), "[1e7, 1e12]");
+    assert_eq!(i(Excluded(0.0), Included(1e-6)), "(0, 1e-6]");
+    assert_eq!(i(Excluded(0.0), Unbounded), "(0, ∞)");
+}
+
+#[test]
+fn whole_numbers_and_duplicates() {
+    let at_least_one = args::whole::<u64>(1);
+    assert_eq!(at_least_one("50"), Ok(50));
+    for bad in ["0", "-1", "1.5", "abc", ""] {
+        let e = at_least_one(bad).expect_err(bad);
+        assert!(e.contains("≥ 1"), "{bad}: {e}");
+    }
+    assert_eq!(args::unique("--setup", &["a", "b"]), Ok(()));
+    let e = args::unique("--setup", &["a", "b", "a"]).expect_err("twice");
+    assert!(
+        e.contains("--setup") && e.contains("\"a\"") && e.contains("twice"),
+        "{e}"
+    );
+}
+
+/// A fresh, empty folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("voussoir-examples-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}
+
+#[test]
+fn the_output_folder_is_probed() {
+    let dir = scratch("probe");
+    let file = dir.join("a_file");
+    std::fs::write(&file, "x").expect("write");
+    let summary = ["summary.json".to_owned()];
+    let e = args::prepare_output_dir(&file, &[], &summary).expect_err("file in the way");
+    assert!(
+        matches!(&e, voussoir::Error::Io { path, .. } if path == &file.display().to_string()),
+        "{e}"
+    );
+    let e = args::prepare_output_dir(&file.join("below"), &[], &summary).expect_err("below a file");
+    assert!(e.to_string().contains("a_file"), "{e}");
+    std::fs::create_dir_all(dir.join("out/summary.json")).expect("mkdir");
+    let e = args::prepare_output_dir(&dir.join("out"), &[], &summary).expect_err("folder in the way");
+    assert!(
+        e.to_string().contains("summary.json") && e.to_string().contains("is a folder"),
+        "{e}"
+    );
+    args::prepare_output_dir(&dir.join("new/deeper"), &["paraview"], &summary).expect("fresh");
+    assert!(dir.join("new/deeper/paraview").is_dir());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The built example `name` (beside this test's `deps/` folder).
+fn example(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable");
+    let path = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>")
+        .join("examples")
+        .join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
+    assert!(
+        path.exists(),
+        "{} is not built: run `cargo build --release --examples` (cargo test builds it)",
+        path.display()
+    );
+    path
+}
+
+/// Runs an example in `cwd`: exit code, stdout, stderr, wall time.
+fn run(name: &str, args: &[&str], cwd: &Path) -> (Option<i32>, String, String, Duration) {
+    let started = Instant::now();
+    let o = Command::new(example(name))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("runs");
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+        started.elapsed(),
+    )
+}
+
+#[test]
+fn block_on_incline_refuses_what_it_ignored() {
+    let dir = scratch("incline");
+    let (code, stdout, _, _) = run("block_on_incline", &["--help"], &dir);
+    assert_eq!(code, Some(0));
+    assert!(stdout.contains("[0, 90)") && stdout.contains("SLOPE_DEG"), "{stdout}");
+    // Each used to run (ignored, or a ramp at 180° or −35°, or an error about the ramp block).
+    for (args, expected) in [
+        (&["180"][..], "SLOPE_DEG"),
+        (&["-35"], "SLOPE_DEG"),
+        (&["nan"], "SLOPE_DEG"),
+        (&["35", "90"], "FRICTION_DEG"),
+        (&["35", "-1"], "FRICTION_DEG"),
+        (&["--slope", "35"], "--slope"),
+        (&["35", "30", "5"], "5"),
+    ] {
+        let (code, _, stderr, _) = run("block_on_incline", args, &dir);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+    let (code, stdout, stderr, _) = run("block_on_incline", &["20", "30"], &dir);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("slope 20°, friction 30°"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn scaling_checks_its_counts_and_folder_first() {
+    let dir = scratch("scaling");
+    for (args, expected) in [
+        (&["--blocks", "0"][..], "--blocks"),
+        (&["--blocks", "100,abc"], "--blocks"),
+        (&["--steps", "0"], "--steps"),
+        (&["--spacing", "0"], "--spacing"),
+        (&["--spacing", "nan"], "--spacing"),
+        (&["--frobnicate"], "--frobnicate"),
+    ] {
+        let (code, _, stderr, _) = run("scaling", args, &dir);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+    // A file in place of the output folder: refused before the first wall is built.
+    std::fs::write(dir.join("a_file"), "x").expect("write");
+    let (code, _, stderr, wall) = run("scaling", &["--out", "a_file", "--blocks", "100000"], &dir);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(stderr.contains("a_file"), "{stderr}");
+    assert!(wall < Duration::from_secs(2), "took {wall:?}");
+    // A small run writes its summary.
+    let (code, _, stderr, _) = run("scaling", &["--blocks", "20", "--steps", "1", "--out", "s"], &dir);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(dir.join("s/summary.json").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}
