@@ -53,6 +53,17 @@ pub enum Error {
         /// The computed volume.
         volume: Real,
     },
+    /// A name that cannot be used where it was given, e.g. a series name that is not a
+    /// portable file name.
+    #[error("invalid {what} {name:?}: {reason}")]
+    InvalidName {
+        /// What the name is for, e.g. `"series name"`.
+        what: &'static str,
+        /// The rejected name.
+        name: String,
+        /// Why it is rejected, e.g. `"contains the path separator '/'"`.
+        reason: String,
+    },
     /// A block id that the model does not hold.
     #[error("block {id} does not exist (the model has {count} blocks)")]
     UnknownBlock {

@@ -934,3 +934,22 @@ fn initial_overlap_beyond_the_tolerance_is_an_error() {
         }
     }
 }
+
+/// A series name that is not a portable file name (here one that would write outside the
+/// series folder) is `InvalidName`, naming the name and the separator, before anything is
+/// written (tests/vtk_output.rs checks the other characters and the folder).
+#[test]
+fn series_names_that_are_not_file_names_are_errors() {
+    let model = slab_and_cube(ModelParameters::default());
+    let dir = std::env::temp_dir().join(format!("voussoir-errors-series-{}", std::process::id()));
+    let e = voussoir::io::vtk::Series::new(&dir, "../up")
+        .write_frame(&model)
+        .unwrap_err();
+    let Error::InvalidName { what, name, reason } = &e else {
+        panic!("expected InvalidName, got {e:?}")
+    };
+    assert_eq!((*what, name.as_str()), ("series name", "../up"));
+    assert!(reason.contains("separator"), "{reason}");
+    assert_names(&e.to_string(), &["series name", "\"../up\"", "'/'"]);
+    assert!(!dir.exists(), "{} was created", dir.display());
+}
