@@ -45,13 +45,20 @@ pub enum Error {
         /// Which face or vertex violates convexity.
         reason: String,
     },
-    /// A block's volume is zero or negative (for example inward-facing faces).
-    #[error("block {block:?}: volume {volume} m^3 is not positive")]
+    /// A block's volume is zero, negative (for example inward-facing faces) or negligible: at
+    /// most `1e-12` of the volume of its axis-aligned bounding box, the scale of the round-off
+    /// in the volume. The threshold is relative, so a large block is never refused for its size.
+    #[error(
+        "block {block:?}: volume {volume} m^3 is not above 1e-12 of its bounding box's volume \
+         {bounding_box} m^3 (the round-off scale): the vertices are flat or nearly so"
+    )]
     NonPositiveVolume {
         /// Name of the block being built.
         block: String,
         /// The computed volume.
         volume: Real,
+        /// Volume of the block's axis-aligned bounding box (product of its extents, m³).
+        bounding_box: Real,
     },
     /// A name that cannot be used where it was given, e.g. a series name that is not a
     /// portable file name.

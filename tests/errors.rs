@@ -91,7 +91,7 @@ fn zero_volume_solid() {
     let pts = [Vector::ZERO, Vector::X, Vector::Y, Vector::new(0.3, 0.3, 1e-15)];
     let e = RigidBlock::from_vertices("wafer", &pts, 2000.0).unwrap_err();
     match &e {
-        Error::NonPositiveVolume { block, volume } => {
+        Error::NonPositiveVolume { block, volume, .. } => {
             assert_eq!(block, "wafer");
             assert!(*volume < 1e-12, "{volume}");
             assert_names(&e.to_string(), &["wafer", "volume"]);
@@ -99,6 +99,59 @@ fn zero_volume_solid() {
         Error::DegenerateGeometry { block, .. } => assert_eq!(block, "wafer"),
         other => panic!("unexpected {other:?}"),
     }
+}
+
+/// The volume threshold is relative to the bounding box, and its message says so: a long slender
+/// slab (600 km × 1 m × 0.23 m, 137,869.8 m³) is a block — it used to be refused with "volume
+/// 137869.8 m^3 is not positive", the threshold being 1e-12 of the diagonal cubed — while a
+/// tetrahedron 1e-13 m thick, tilted so that its bounding box is a unit cube, is refused with a
+/// message naming the bounding box's volume and the factor.
+#[test]
+fn volume_threshold_is_relative_to_the_bounding_box() {
+    let slab = RigidBlock::cuboid("slab", Vector::ZERO, Vector::new(600_000.0, 1.0, 0.229_783), 2000.0).unwrap();
+    assert!(
+        (slab.shape().volume() - 137_869.8).abs() < 1e-6,
+        "{}",
+        slab.shape().volume()
+    );
+    let corners: Vec<Vector> = (0..8)
+        .map(|i| {
+            Vector::new(
+                (i & 1) as f64 * 600_000.0,
+                (i >> 1 & 1) as f64,
+                (i >> 2) as f64 * 0.229_783,
+            )
+        })
+        .collect();
+    let hull = RigidBlock::from_vertices("slab", &corners, 2000.0).unwrap();
+    assert!((hull.shape().volume() - 137_869.8).abs() < 1e-6);
+
+    // Three unit points on the axes and an apex 1e-13 m above their plane x + y + z = 1.
+    let apex = Vector::new(0.3, 0.3, 0.4) + Vector::splat(1e-13 / 3f64.sqrt());
+    let pts = [Vector::X, Vector::Y, Vector::Z, apex];
+    let mut faces = Vec::new();
+    for (i, j, k, opposite) in [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)] {
+        let n = (pts[j] - pts[i]).cross(pts[k] - pts[i]);
+        faces.push(if n.dot(pts[opposite] - pts[i]) < 0.0 {
+            vec![i, j, k]
+        } else {
+            vec![i, k, j]
+        });
+    }
+    let e = RigidBlock::from_faces("tilted wafer", &pts, &faces, 2000.0).unwrap_err();
+    let Error::NonPositiveVolume {
+        block,
+        volume,
+        bounding_box,
+    } = &e
+    else {
+        panic!("expected NonPositiveVolume, got {e:?}")
+    };
+    assert_eq!(block, "tilted wafer");
+    assert!(*volume < 1e-12, "{volume}");
+    assert!((bounding_box - 1.0).abs() < 1e-12, "{bounding_box}");
+    assert_names(&e.to_string(), &["tilted wafer", "1e-12", "bounding box", "flat"]);
+    assert!(!e.to_string().contains("not positive"), "{e}");
 }
 
 /// Explicit faces that do not make a convex solid: a cube whose top is a pyramid pushed *into*

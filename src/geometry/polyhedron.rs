@@ -77,8 +77,8 @@ impl Polyhedron {
     ///
     /// # Errors
     /// [`Error::NonFinite`] for NaN or infinite coordinates, [`Error::DegenerateGeometry`] for fewer
-    /// than four points or a flat or collinear set, [`Error::NonPositiveVolume`] for a volume below
-    /// `1e-12` of the bounding box volume.
+    /// than four points or a flat or collinear set, [`Error::NonPositiveVolume`] for a volume not above
+    /// `1e-12` of the bounding box volume (the product of the extents).
     ///
     /// # Example
     /// ```
@@ -188,7 +188,13 @@ impl Polyhedron {
     }
 
     fn from_triangles(name: &str, verts: Vec<Vector>, tris: &[[u32; 3]]) -> Result<PlacedPolyhedron> {
-        let scale = bbox_diagonal(&verts);
+        let extent = bbox_extent(&verts);
+        if extent.min_element() <= 1e-12 * extent.max_element() {
+            return Err(Error::DegenerateGeometry {
+                block: name.to_owned(),
+                reason: "the vertices are flat (no extent in some direction)".into(),
+            });
+        }
         let world =
             ConvexPolyhedron::from_convex_mesh(verts.clone(), tris).ok_or_else(|| Error::DegenerateGeometry {
                 block: name.to_owned(),
@@ -204,10 +210,17 @@ impl Polyhedron {
             })?;
         let mp = shifted_poly.mass_properties(1.0);
         let volume = mp.mass();
-        if volume.is_nan() || volume <= 1e-12 * scale * scale * scale {
+        // Each term of the divergence sum is a triple product of one x, one y and one z
+        // coordinate relative to `reference`, so its round-off is of the order of
+        // ε·(extent.x·extent.y·extent.z) whatever the orientation: compare the volume with the
+        // bounding box's, not with the cube of the diagonal, which refused long slender blocks
+        // (a 600 km × 1 m × 0.23 m slab of 137,870 m³).
+        let bounding_box = extent.x * extent.y * extent.z;
+        if volume.is_nan() || volume <= 1e-12 * bounding_box {
             return Err(Error::NonPositiveVolume {
                 block: name.to_owned(),
                 volume,
+                bounding_box,
             });
         }
         let frame: Rotation = mp.principal_inertia_local_frame.normalize();
@@ -381,13 +394,17 @@ fn check_points(name: &str, points: &[Vector]) -> Result<()> {
     Ok(())
 }
 
-fn bbox_diagonal(points: &[Vector]) -> Real {
+fn bbox_extent(points: &[Vector]) -> Vector {
     let (mut lo, mut hi) = (Vector::splat(Real::INFINITY), Vector::splat(Real::NEG_INFINITY));
     for p in points {
         lo = lo.min(*p);
         hi = hi.max(*p);
     }
-    (hi - lo).length().max(Real::MIN_POSITIVE)
+    hi - lo
+}
+
+fn bbox_diagonal(points: &[Vector]) -> Real {
+    bbox_extent(points).length().max(Real::MIN_POSITIVE)
 }
 
 /// Newell's normal of a polygon loop: twice the vector area (not normalised).
