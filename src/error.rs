@@ -71,6 +71,21 @@ pub enum Error {
         /// Why it is rejected, e.g. `"contains the path separator '/'"`.
         reason: String,
     },
+    /// A block shape with more vertices than [`crate::geometry::MAX_HULL_VERTICES`]: contact
+    /// detection between two blocks costs about the product of their edge counts times their
+    /// vertex counts, so a step with such a block would take seconds.
+    #[error(
+        "block {block:?}: {vertices} vertices on its convex hull, more than the limit {limit}: \
+         contact detection would take seconds per step; simplify the shape"
+    )]
+    TooManyVertices {
+        /// Name of the block being built.
+        block: String,
+        /// Number of vertices of its convex hull (or of its explicit faces).
+        vertices: usize,
+        /// The limit, [`crate::geometry::MAX_HULL_VERTICES`].
+        limit: usize,
+    },
     /// A block id that the model does not hold.
     #[error("block {id} does not exist (the model has {count} blocks)")]
     UnknownBlock {
