@@ -45,13 +45,46 @@ pub enum Error {
         /// Which face or vertex violates convexity.
         reason: String,
     },
-    /// A block's volume is zero or negative (for example inward-facing faces).
-    #[error("block {block:?}: volume {volume} m^3 is not positive")]
+    /// A block's volume is zero, negative (for example inward-facing faces) or negligible: at
+    /// most `1e-12` of the volume of its axis-aligned bounding box, the scale of the round-off
+    /// in the volume. The threshold is relative, so a large block is never refused for its size.
+    #[error(
+        "block {block:?}: volume {volume} m^3 is not above 1e-12 of its bounding box's volume \
+         {bounding_box} m^3 (the round-off scale): the vertices are flat or nearly so"
+    )]
     NonPositiveVolume {
         /// Name of the block being built.
         block: String,
         /// The computed volume.
         volume: Real,
+        /// Volume of the block's axis-aligned bounding box (product of its extents, m³).
+        bounding_box: Real,
+    },
+    /// A name that cannot be used where it was given, e.g. a series name that is not a
+    /// portable file name.
+    #[error("invalid {what} {name:?}: {reason}")]
+    InvalidName {
+        /// What the name is for, e.g. `"series name"`.
+        what: &'static str,
+        /// The rejected name.
+        name: String,
+        /// Why it is rejected, e.g. `"contains the path separator '/'"`.
+        reason: String,
+    },
+    /// A block shape with more vertices than [`crate::geometry::MAX_HULL_VERTICES`]: contact
+    /// detection between two blocks costs about the product of their edge counts times their
+    /// vertex counts, so a step with such a block would take seconds.
+    #[error(
+        "block {block:?}: {vertices} vertices on its convex hull, more than the limit {limit}: \
+         contact detection would take seconds per step; simplify the shape"
+    )]
+    TooManyVertices {
+        /// Name of the block being built.
+        block: String,
+        /// Number of vertices of its convex hull (or of its explicit faces).
+        vertices: usize,
+        /// The limit, [`crate::geometry::MAX_HULL_VERTICES`].
+        limit: usize,
     },
     /// A block id that the model does not hold.
     #[error("block {id} does not exist (the model has {count} blocks)")]

@@ -91,7 +91,7 @@ fn zero_volume_solid() {
     let pts = [Vector::ZERO, Vector::X, Vector::Y, Vector::new(0.3, 0.3, 1e-15)];
     let e = RigidBlock::from_vertices("wafer", &pts, 2000.0).unwrap_err();
     match &e {
-        Error::NonPositiveVolume { block, volume } => {
+        Error::NonPositiveVolume { block, volume, .. } => {
             assert_eq!(block, "wafer");
             assert!(*volume < 1e-12, "{volume}");
             assert_names(&e.to_string(), &["wafer", "volume"]);
@@ -99,6 +99,59 @@ fn zero_volume_solid() {
         Error::DegenerateGeometry { block, .. } => assert_eq!(block, "wafer"),
         other => panic!("unexpected {other:?}"),
     }
+}
+
+/// The volume threshold is relative to the bounding box, and its message says so: a long slender
+/// slab (600 km × 1 m × 0.23 m, 137,869.8 m³) is a block — it used to be refused with "volume
+/// 137869.8 m^3 is not positive", the threshold being 1e-12 of the diagonal cubed — while a
+/// tetrahedron 1e-13 m thick, tilted so that its bounding box is a unit cube, is refused with a
+/// message naming the bounding box's volume and the factor.
+#[test]
+fn volume_threshold_is_relative_to_the_bounding_box() {
+    let slab = RigidBlock::cuboid("slab", Vector::ZERO, Vector::new(600_000.0, 1.0, 0.229_783), 2000.0).unwrap();
+    assert!(
+        (slab.shape().volume() - 137_869.8).abs() < 1e-6,
+        "{}",
+        slab.shape().volume()
+    );
+    let corners: Vec<Vector> = (0..8)
+        .map(|i| {
+            Vector::new(
+                (i & 1) as f64 * 600_000.0,
+                (i >> 1 & 1) as f64,
+                (i >> 2) as f64 * 0.229_783,
+            )
+        })
+        .collect();
+    let hull = RigidBlock::from_vertices("slab", &corners, 2000.0).unwrap();
+    assert!((hull.shape().volume() - 137_869.8).abs() < 1e-6);
+
+    // Three unit points on the axes and an apex 1e-13 m above their plane x + y + z = 1.
+    let apex = Vector::new(0.3, 0.3, 0.4) + Vector::splat(1e-13 / 3f64.sqrt());
+    let pts = [Vector::X, Vector::Y, Vector::Z, apex];
+    let mut faces = Vec::new();
+    for (i, j, k, opposite) in [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)] {
+        let n = (pts[j] - pts[i]).cross(pts[k] - pts[i]);
+        faces.push(if n.dot(pts[opposite] - pts[i]) < 0.0 {
+            vec![i, j, k]
+        } else {
+            vec![i, k, j]
+        });
+    }
+    let e = RigidBlock::from_faces("tilted wafer", &pts, &faces, 2000.0).unwrap_err();
+    let Error::NonPositiveVolume {
+        block,
+        volume,
+        bounding_box,
+    } = &e
+    else {
+        panic!("expected NonPositiveVolume, got {e:?}")
+    };
+    assert_eq!(block, "tilted wafer");
+    assert!(*volume < 1e-12, "{volume}");
+    assert!((bounding_box - 1.0).abs() < 1e-12, "{bounding_box}");
+    assert_names(&e.to_string(), &["tilted wafer", "1e-12", "bounding box", "flat"]);
+    assert!(!e.to_string().contains("not positive"), "{e}");
 }
 
 /// Explicit faces that do not make a convex solid: a cube whose top is a pyramid pushed *into*
@@ -933,4 +986,77 @@ fn initial_overlap_beyond_the_tolerance_is_an_error() {
             Err(e) => panic!("{e}"),
         }
     }
+}
+
+/// A series name that is not a portable file name (here one that would write outside the
+/// series folder) is `InvalidName`, naming the name and the separator, before anything is
+/// written (tests/vtk_output.rs checks the other characters and the folder).
+#[test]
+fn series_names_that_are_not_file_names_are_errors() {
+    let model = slab_and_cube(ModelParameters::default());
+    let dir = std::env::temp_dir().join(format!("voussoir-errors-series-{}", std::process::id()));
+    let e = voussoir::io::vtk::Series::new(&dir, "../up")
+        .write_frame(&model)
+        .unwrap_err();
+    let Error::InvalidName { what, name, reason } = &e else {
+        panic!("expected InvalidName, got {e:?}")
+    };
+    assert_eq!((*what, name.as_str()), ("series name", "../up"));
+    assert!(reason.contains("separator"), "{reason}");
+    assert_names(&e.to_string(), &["series name", "\"../up\"", "'/'"]);
+    assert!(!dir.exists(), "{} was created", dir.display());
+}
+
+/// A block whose convex hull has more than `MAX_HULL_VERTICES` vertices is refused at
+/// construction, naming the block, the count and the limit: a 20,000-point sphere used to be
+/// accepted and its first step on a slab took 10–14 s (two touching 1,000-vertex blocks: 13 s).
+/// Interior points do not count, and a shape at the limit is accepted.
+#[test]
+fn hulls_with_too_many_vertices_are_errors() {
+    use voussoir::geometry::MAX_HULL_VERTICES;
+    // Points on a sphere (Fibonacci lattice): every one is a hull vertex.
+    let sphere = |n: usize| -> Vec<Vector> {
+        let g = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        (0..n)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+                let r = (1.0 - z * z).sqrt();
+                let t = g * i as f64;
+                Vector::new(0.1 * r * t.cos(), 0.1 * r * t.sin(), 0.1 * z)
+            })
+            .collect()
+    };
+    for n in [MAX_HULL_VERTICES + 1, 20_000] {
+        let e = RigidBlock::from_vertices("boulder", &sphere(n), 2500.0).unwrap_err();
+        let Error::TooManyVertices { block, vertices, limit } = &e else {
+            panic!("expected TooManyVertices, got {e:?}")
+        };
+        assert_eq!((block.as_str(), *vertices, *limit), ("boulder", n, MAX_HULL_VERTICES));
+        assert_names(
+            &e.to_string(),
+            &["boulder", &n.to_string(), &MAX_HULL_VERTICES.to_string()],
+        );
+    }
+    let at_limit = RigidBlock::from_vertices("boulder", &sphere(MAX_HULL_VERTICES), 2500.0).unwrap();
+    assert_eq!(at_limit.shape().vertices().len(), MAX_HULL_VERTICES);
+    // A cube given with 20,000 interior points has 8 hull vertices.
+    let mut cloud = unit_cube();
+    cloud.extend(
+        (0..20_000).map(|i| Vector::new(0.5, 0.25 + (i % 100) as f64 * 0.005, 0.25 + (i / 100) as f64 * 0.0025)),
+    );
+    assert_eq!(
+        RigidBlock::from_vertices("cloud", &cloud, 2500.0)
+            .unwrap()
+            .shape()
+            .vertices()
+            .len(),
+        8
+    );
+    // Explicit faces: refused before the convexity check.
+    let many = sphere(MAX_HULL_VERTICES + 1);
+    let e = RigidBlock::from_faces("faceted", &many, &unit_cube_faces(), 2500.0).unwrap_err();
+    assert!(
+        matches!(&e, Error::TooManyVertices { block, .. } if block == "faceted"),
+        "{e:?}"
+    );
 }

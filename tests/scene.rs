@@ -107,3 +107,43 @@ fn a_byte_order_mark_is_accepted() -> Result<()> {
     assert_eq!(scene.build()?.blocks().len(), 2);
     Ok(())
 }
+
+/// A file that is not a JSON object (`[]`, `[1, 2]`, a number, a string, `null`, nothing) is
+/// refused with a message saying what a scene file is; it used to say "invalid length 2, expected
+/// struct Scene with 6 elements" (serde's message for a struct written as an array). A block
+/// written as an array gets the same hint, with its path.
+#[test]
+fn a_scene_that_is_not_a_json_object_says_what_a_scene_is() {
+    for (text, found) in [
+        ("[]", "an array"),
+        ("[1, 2]", "an array"),
+        ("\u{feff} [ ]", "an array"),
+        ("3.5", "a number"),
+        ("-1", "a number"),
+        ("\"scene\"", "a string"),
+        ("true", "a boolean"),
+        ("null", "null"),
+        ("", "empty"),
+        ("  \n", "empty"),
+    ] {
+        let e = Scene::<CoulombSlip>::from_json(text).unwrap_err();
+        assert!(matches!(e, Error::Checkpoint { .. }), "{text:?}: {e:?}");
+        let message = e.to_string();
+        for part in ["scene file must be a JSON object", "\"joints\"", "\"blocks\"", found] {
+            assert!(message.contains(part), "{text:?}: {part:?} not in {message}");
+        }
+        assert!(!message.contains("invalid length"), "{message}");
+    }
+    let e = Scene::<CoulombSlip>::from_json(r#"{"joints": [], "blocks": [[]]}"#).unwrap_err();
+    let Error::Checkpoint { path, message } = &e else {
+        panic!("expected Checkpoint, got {e:?}")
+    };
+    assert_eq!(path, "blocks[0]");
+    assert!(
+        message.contains("must be a JSON object") && message.contains("BlockSpec"),
+        "{message}"
+    );
+    // Not JSON at all: serde's syntax error, with its line and column.
+    let e = Scene::<CoulombSlip>::from_json("scene: 1").unwrap_err();
+    assert!(e.to_string().contains("line 1"), "{e}");
+}

@@ -88,6 +88,44 @@ pub struct LinePlot {
 
 const SIZE: (u32, u32) = (800, 560);
 
+/// The largest coordinate magnitude drawn: larger finite values are clamped to ±1e300 (they lie
+/// off any sensible chart anyway), so that spans and paddings cannot overflow to infinity.
+/// Non-finite points and references are skipped.
+pub const COORDINATE_LIMIT: f64 = 1e300;
+
+fn clamp(v: f64) -> f64 {
+    v.clamp(-COORDINATE_LIMIT, COORDINATE_LIMIT)
+}
+
+/// A curve's finite points, clamped to ±[`COORDINATE_LIMIT`].
+fn drawable_points(c: &Curve) -> impl Iterator<Item = (f64, f64)> + '_ {
+    c.points
+        .iter()
+        .filter(|(x, y)| x.is_finite() && y.is_finite())
+        .map(|&(x, y)| (clamp(x), clamp(y)))
+}
+
+/// A padded axis range over finite values within ±[`COORDINATE_LIMIT`] (`(0, 1)` if there are
+/// none): 5 % of the span either side, or ±half the magnitude (at least ±0.5) when the values
+/// are equal or closer than 1e-9 of their magnitude (or 1e-100), spans that plotters cannot
+/// divide into ticks.
+fn span(v: &[f64]) -> (f64, f64) {
+    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (0.0, 1.0);
+    }
+    let width = hi - lo;
+    let magnitude = lo.abs().max(hi.abs());
+    if width <= 1e-9 * magnitude || width < 1e-100 {
+        let centre = lo + 0.5 * width;
+        let pad = 0.5 * centre.abs().max(1.0);
+        return (centre - pad, centre + pad);
+    }
+    let pad = 0.05 * width;
+    (lo - pad, hi + pad)
+}
+
 fn io_error(path: &Path, e: &std::io::Error) -> Error {
     Error::Io {
         path: path.display().to_string(),
@@ -96,7 +134,9 @@ fn io_error(path: &Path, e: &std::io::Error) -> Error {
 }
 
 impl LinePlot {
-    /// Renders the plot as an SVG document.
+    /// Renders the plot as an SVG document. Total over any input: points and references with a
+    /// non-finite coordinate are skipped, finite coordinates beyond ±[`COORDINATE_LIMIT`] are
+    /// clamped to it, and an empty or single-valued axis gets a default span.
     ///
     /// # Errors
     /// [`Error::Io`] if plotters fails to draw.
@@ -124,40 +164,36 @@ impl LinePlot {
         std::fs::write(path, svg).map_err(|e| io_error(path, &e))
     }
 
+    /// The axis ranges: every finite curve point and reference, each coordinate clamped to
+    /// ±[`COORDINATE_LIMIT`], padded by 5 % of the span. Always finite with `lo < hi` and a
+    /// span that is neither zero nor below plotters' resolution at that magnitude (a single
+    /// value, or values closer than 1e-9 of their magnitude, get a span of about their
+    /// magnitude), so plotters' key-point search terminates.
     fn ranges(&self) -> ((f64, f64), (f64, f64)) {
         let mut xs: Vec<f64> = Vec::new();
         let mut ys: Vec<f64> = Vec::new();
-        for c in &self.curves {
-            for &(x, y) in &c.points {
-                if x.is_finite() && y.is_finite() {
-                    xs.push(x);
-                    ys.push(y);
-                }
-            }
+        for (x, y) in self.curves.iter().flat_map(drawable_points) {
+            xs.push(x);
+            ys.push(y);
         }
-        for r in &self.references {
+        for r in self.drawable_references() {
             match *r {
-                Reference::Horizontal { y, .. } => ys.push(y),
+                Reference::Horizontal { y, .. } => ys.push(clamp(y)),
                 Reference::Point { x, y, .. } => {
-                    xs.push(x);
-                    ys.push(y);
+                    xs.push(clamp(x));
+                    ys.push(clamp(y));
                 }
             }
         }
-        let span = |v: &[f64]| {
-            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            if !lo.is_finite() {
-                return (0.0, 1.0);
-            }
-            let pad = if hi > lo {
-                0.05 * (hi - lo)
-            } else {
-                0.5 * lo.abs().max(1.0)
-            };
-            (lo - pad, hi + pad)
-        };
         (span(&xs), span(&ys))
+    }
+
+    /// The references whose coordinates are all finite (the others are skipped).
+    fn drawable_references(&self) -> impl Iterator<Item = &Reference> {
+        self.references.iter().filter(|r| match **r {
+            Reference::Horizontal { y, .. } => y.is_finite(),
+            Reference::Point { x, y, .. } => x.is_finite() && y.is_finite(),
+        })
     }
 
     /// The legend corner: the given one, or for [`LegendPosition::Auto`] the corner whose
@@ -172,7 +208,7 @@ impl LinePlot {
             .curves
             .iter()
             .map(|c| c.label.as_str())
-            .chain(self.references.iter().map(|r| match r {
+            .chain(self.drawable_references().map(|r| match r {
                 Reference::Horizontal { label, .. } | Reference::Point { label, .. } => label.as_str(),
             }));
         let (count, longest) = labels.fold((0usize, 0usize), |(n, w), l| (n + 1, w.max(l.chars().count())));
@@ -194,7 +230,8 @@ impl LinePlot {
         for (corner, bx, by) in corners {
             let mut score = 0.0;
             for c in &self.curves {
-                for pair in c.points.windows(2) {
+                let points: Vec<(f64, f64)> = drawable_points(c).collect();
+                for pair in points.windows(2) {
                     let ((xa, ya), (xb, yb)) = (pair[0], pair[1]);
                     for k in 0..16 {
                         let t = k as f64 / 16.0;
@@ -203,22 +240,22 @@ impl LinePlot {
                         }
                     }
                 }
-                if let Some(&(x, y)) = c.points.last() {
+                if let Some(&(x, y)) = points.last() {
                     if inside(to_frac(x, y), bx, by) {
                         score += 1.0;
                     }
                 }
             }
-            for r in &self.references {
+            for r in self.drawable_references() {
                 let hit = match *r {
                     Reference::Point { x, y, .. } => {
                         // The marker's half-size, about 10 px.
-                        let (fx, fy) = to_frac(x, y);
+                        let (fx, fy) = to_frac(clamp(x), clamp(y));
                         let (mx, my) = (10.0 / 700.0, 10.0 / 430.0);
                         fx + mx >= bx.0 && fx - mx <= bx.1 && fy + my >= by.0 && fy - my <= by.1
                     }
                     Reference::Horizontal { y, .. } => {
-                        let fy = to_frac(x0, y).1;
+                        let fy = to_frac(x0, clamp(y)).1;
                         fy >= by.0 && fy <= by.1
                     }
                 };
@@ -257,24 +294,29 @@ impl LinePlot {
         for (k, c) in self.curves.iter().enumerate() {
             let color = Palette99::pick(k).to_rgba();
             chart
-                .draw_series(LineSeries::new(c.points.iter().copied(), color.stroke_width(2)))
+                .draw_series(LineSeries::new(drawable_points(c), color.stroke_width(2)))
                 .map_err(err)?
                 .label(c.label.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
         }
-        for r in &self.references {
+        for r in self.drawable_references() {
             match r {
                 Reference::Horizontal { label, y } => {
+                    let y = clamp(*y);
                     let style = BLACK.stroke_width(1);
                     chart
-                        .draw_series(DashedLineSeries::new(vec![(x0, *y), (x1, *y)], 8, 5, style))
+                        .draw_series(DashedLineSeries::new(vec![(x0, y), (x1, y)], 8, 5, style))
                         .map_err(err)?
                         .label(label.as_str())
                         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
                 }
                 Reference::Point { label, x, y } => {
                     chart
-                        .draw_series(std::iter::once(Cross::new((*x, *y), 7, BLACK.stroke_width(2))))
+                        .draw_series(std::iter::once(Cross::new(
+                            (clamp(*x), clamp(*y)),
+                            7,
+                            BLACK.stroke_width(2),
+                        )))
                         .map_err(err)?
                         .label(label.as_str())
                         .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
@@ -329,5 +371,89 @@ mod tests {
             ..plot
         };
         assert_eq!(fixed.legend_corner((x0, x1), (y0, y1)), LegendPosition::LowerRight);
+    }
+
+    /// Renders `plot` on another thread and fails if it does not return within 10 s (on the
+    /// code before issue 18 an infinite reference or a ±1e308 point looped forever in plotters'
+    /// key-point computation).
+    fn renders_quickly(plot: LinePlot) -> String {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let title = plot.title.clone();
+        std::thread::spawn(move || {
+            let _ = tx.send(plot.to_svg_string());
+        });
+        match rx.recv_timeout(std::time::Duration::from_secs(10)) {
+            Ok(Ok(svg)) => svg,
+            Ok(Err(e)) => panic!("plot {title:?} failed: {e}"),
+            Err(_) => panic!("plot {title:?} did not finish within 10 s"),
+        }
+    }
+
+    fn curve(points: Vec<(f64, f64)>) -> Curve {
+        Curve {
+            label: "model".into(),
+            points,
+        }
+    }
+
+    #[test]
+    fn infinite_reference_does_not_hang() {
+        for y in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+            let plot = LinePlot {
+                title: format!("reference at {y}"),
+                curves: vec![curve(vec![(0.0, 0.0), (1.0, 2.0)])],
+                references: vec![
+                    Reference::Horizontal {
+                        label: "experiment".into(),
+                        y,
+                    },
+                    Reference::Point {
+                        label: "test".into(),
+                        x: y,
+                        y: 1.0,
+                    },
+                ],
+                ..Default::default()
+            };
+            let svg = renders_quickly(plot);
+            assert!(svg.contains("<svg"));
+        }
+    }
+
+    #[test]
+    fn extreme_points_do_not_hang() {
+        let cases: Vec<Vec<(f64, f64)>> = vec![
+            vec![(0.0, -1e308), (1.0, 1e308)],
+            vec![(-1e308, 0.0), (1e308, 1.0)],
+            vec![(-f64::MAX, -f64::MAX), (f64::MAX, f64::MAX)],
+            vec![(0.0, f64::MAX), (1.0, f64::MAX)],
+            vec![(0.0, 1.7e308), (1.0, 1.79e308)],
+            vec![(0.0, 0.0), (1.0, 1e-310)],
+            vec![(0.0, 1e15), (1.0, 1e15 + 0.125)],
+            vec![(1e20, 0.0), (1e20 + 16384.0, 1.0)],
+            vec![(0.0, 5e-324), (5e-324, 0.0)],
+            vec![(f64::NAN, 1.0), (f64::INFINITY, f64::NEG_INFINITY)],
+            vec![],
+        ];
+        for points in cases {
+            let plot = LinePlot {
+                title: format!("{points:?}"),
+                curves: vec![curve(points)],
+                references: vec![Reference::Horizontal {
+                    label: "experiment".into(),
+                    y: 1e308,
+                }],
+                ..Default::default()
+            };
+            let ((x0, x1), (y0, y1)) = plot.ranges();
+            for (lo, hi) in [(x0, x1), (y0, y1)] {
+                assert!(
+                    lo.is_finite() && hi.is_finite() && (hi - lo).is_finite() && hi > lo,
+                    "{lo}..{hi}"
+                );
+            }
+            let svg = renders_quickly(plot);
+            assert!(svg.contains("<svg"));
+        }
     }
 }

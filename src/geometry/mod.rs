@@ -11,4 +11,4 @@ pub use narrow_phase::{
     detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, SubKey,
     SubcontactDensity, SubcontactSeed, MAX_SUBCONTACTS_PER_EDGE,
 };
-pub use polyhedron::{Face, MassProperties, PlacedPolyhedron, Polyhedron};
+pub use polyhedron::{Face, MassProperties, PlacedPolyhedron, Polyhedron, MAX_HULL_VERTICES};

@@ -1,14 +1,16 @@
-//! CSV histories: `time [s],step,<monitor> [unit],...`, one row per sample.
+//! CSV histories: `time [s],step,<monitor> [unit],...`, one row per sample (RFC 4180: a header
+//! field holding a comma, a double quote or a line break is quoted, its quotes doubled).
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::Result;
-use crate::io::io_error;
 use crate::monitor::History;
 
 /// Renders a history as CSV text: a header `time [s],step,name [unit],...` then one row per
-/// sample, numbers in shortest round-trip form.
+/// sample, numbers in shortest round-trip form. Monitor names are written as given; a header
+/// field that holds a comma, a double quote or a line break is quoted as RFC 4180 says
+/// (`"a ""b"", c [J]"`), so every record has one field per column whatever the names.
 ///
 /// ```
 /// use voussoir::prelude::*;
@@ -26,7 +28,8 @@ use crate::monitor::History;
 pub fn history_to_csv(history: &History) -> String {
     let mut out = String::from("time [s],step");
     for (name, unit) in history.names().iter().zip(history.units()) {
-        let _ = write!(out, ",{} [{}]", name.replace(',', ";"), unit);
+        out.push(',');
+        push_field(&mut out, &format!("{name} [{unit}]"));
     }
     out.push('\n');
     for row in 0..history.len() {
@@ -39,13 +42,23 @@ pub fn history_to_csv(history: &History) -> String {
     out
 }
 
-/// Writes [`history_to_csv`] to a file, creating its folder.
+/// Appends one CSV field: as is, or between double quotes with its quotes doubled when it holds
+/// a comma, a double quote, a carriage return or a line feed (RFC 4180, section 2).
+fn push_field(out: &mut String, field: &str) {
+    if field.contains([',', '"', '\n', '\r']) {
+        out.push('"');
+        out.push_str(&field.replace('"', "\"\""));
+        out.push('"');
+    } else {
+        out.push_str(field);
+    }
+}
+
+/// Writes [`history_to_csv`] to a file, creating its folder. The file is replaced atomically
+/// (written beside it, then renamed): an interrupted write leaves the previous file whole.
 ///
 /// # Errors
 /// [`crate::Error::Io`] naming the file.
 pub fn write_history(path: &Path, history: &History) -> Result<()> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
-    }
-    std::fs::write(path, history_to_csv(history)).map_err(|e| io_error(path, &e))
+    crate::file::write_atomically(path, history_to_csv(history).as_bytes())
 }

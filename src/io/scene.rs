@@ -94,18 +94,56 @@ fn one() -> u64 {
     1
 }
 
+/// The fields of a scene file, for messages.
+const SCENE_FIELDS: &str = "with the fields \"joints\" and \"blocks\" (required) and \"parameters\", \
+                            \"damping\", \"monitors\", \"monitor_interval\" (optional)";
+
+/// serde's message for a struct given as an array (`invalid length 2, expected struct
+/// BlockSpec with 5 elements`) rephrased: the value must be a JSON object with named fields.
+fn struct_as_array_message(message: &str) -> String {
+    match message.split_once("expected struct ") {
+        Some((head, tail)) if head.starts_with("invalid length") && tail.contains(" elements") => {
+            let name = tail.split_whitespace().next().unwrap_or("value");
+            format!("must be a JSON object {{ ... }} with named fields ({name}), not an array ({message})")
+        }
+        _ => message.to_owned(),
+    }
+}
+
 impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
-    /// Parses a scene from JSON text. Syntax and type errors name the path of the field.
+    /// Parses a scene from JSON text: a JSON object with the fields `joints` and `blocks`
+    /// (required) and `parameters`, `damping`, `monitors`, `monitor_interval` (optional), see
+    /// `docs/scene-format.md`. Syntax and type errors name the path of the field; a file that is
+    /// not a JSON object (`[]`, a number, nothing) says so.
     ///
     /// # Errors
     /// [`Error::Checkpoint`] with the path (for example `blocks[2].density`).
     pub fn from_json(text: &str) -> Result<Self> {
         // A byte-order mark, as some editors write, is not part of the JSON.
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        // serde accepts a struct written as an array of its fields in order, so `[]` or
+        // `[1, 2]` got "invalid length 2, expected struct Scene with 6 elements": say what a scene
+        // file is instead.
+        let found = match text.trim_start().chars().next() {
+            None => Some("nothing (the file is empty)"),
+            Some('{') => None,
+            Some('[') => Some("an array"),
+            Some('"') => Some("a string"),
+            Some('t' | 'f') => Some("a boolean"),
+            Some('n') => Some("null"),
+            Some(c) if c == '-' || c.is_ascii_digit() => Some("a number"),
+            Some(_) => None, // not JSON: serde's syntax error says where
+        };
+        if let Some(found) = found {
+            return Err(Error::Checkpoint {
+                path: "(the whole file)".into(),
+                message: format!("a scene file must be a JSON object {{ ... }} {SCENE_FIELDS}; found {found}"),
+            });
+        }
         let de = &mut serde_json::Deserializer::from_str(text);
         serde_path_to_error::deserialize(de).map_err(|e| Error::Checkpoint {
             path: e.path().to_string(),
-            message: e.inner().to_string(),
+            message: struct_as_array_message(&e.inner().to_string()),
         })
     }
 

@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::block::Block;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::law::{ConstitutiveLaw, JointStatus};
 use crate::math::Real;
 use crate::model::Model;
@@ -233,6 +233,10 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
 /// `<name>_contacts_<k>.vtu` into the folder and rewrites `<name>_blocks.pvd` and
 /// `<name>_contacts.pvd`.
 ///
+/// The name must make portable file names inside the folder (see [`check_series_name`]):
+/// [`Series::try_new`] checks it at once, [`Series::write_frame`] before writing anything. In
+/// the `.pvd` collections the file names are XML-escaped (`&` is written `&amp;`).
+///
 /// ```no_run
 /// # use voussoir::prelude::*;
 /// # fn run(model: &mut Model) -> voussoir::Result<()> {
@@ -250,8 +254,79 @@ pub struct Series {
     frames: Vec<(Real, String, String)>,
 }
 
+/// Longest series name accepted, in bytes: with `_contacts_00000.vtu` and the temporary file's
+/// affixes the file names stay within the 255 bytes most file systems allow.
+pub const MAX_SERIES_NAME_BYTES: usize = 200;
+
+/// Checks that `name` can prefix the file names of a [`Series`] on any common file system,
+/// inside the series folder: not empty, not `.` or `..`, at most [`MAX_SERIES_NAME_BYTES`]
+/// bytes, and none of the path separators `/` and `\`, control characters (NUL, line breaks,
+/// tabs, ...) or the characters `< > : " | ? *` that Windows refuses.
+///
+/// ```
+/// use voussoir::io::vtk::check_series_name;
+/// assert!(check_series_name("wall & arch").is_ok());
+/// assert!(check_series_name("../outside").is_err());
+/// ```
+///
+/// # Errors
+/// [`Error::InvalidName`] naming the name and the offending character.
+pub fn check_series_name(name: &str) -> Result<()> {
+    let reject = |reason: String| {
+        Err(Error::InvalidName {
+            what: "series name",
+            name: name.to_owned(),
+            reason,
+        })
+    };
+    if name.is_empty() {
+        return reject("is empty".into());
+    }
+    if name == "." || name == ".." {
+        return reject("is a relative folder name, not a file name".into());
+    }
+    if name.len() > MAX_SERIES_NAME_BYTES {
+        return reject(format!(
+            "is {} bytes long, more than the {MAX_SERIES_NAME_BYTES} bytes a file name leaves for it",
+            name.len()
+        ));
+    }
+    if let Some(c) = name.chars().find(|c| matches!(c, '/' | '\\')) {
+        return reject(format!(
+            "contains the path separator {c:?}: files would be written outside the folder"
+        ));
+    }
+    if let Some(c) = name.chars().find(|c| c.is_control()) {
+        return reject(format!("contains the control character U+{:04X}", u32::from(c)));
+    }
+    if let Some(c) = name
+        .chars()
+        .find(|c| matches!(c, '<' | '>' | ':' | '"' | '|' | '?' | '*'))
+    {
+        return reject(format!("contains {c:?}, which Windows does not allow in file names"));
+    }
+    Ok(())
+}
+
+/// Escapes text for an XML attribute value or element content.
+fn xml_escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\'' => out.push_str("&apos;"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
 impl Series {
-    /// A new, empty series written into `dir`.
+    /// A new, empty series written into `dir`. The name is checked by the first
+    /// [`Series::write_frame`]; [`Series::try_new`] checks it at once.
     pub fn new(dir: impl Into<PathBuf>, name: &str) -> Self {
         Self {
             dir: dir.into(),
@@ -260,11 +335,22 @@ impl Series {
         }
     }
 
+    /// A new, empty series written into `dir`, its name checked by [`check_series_name`].
+    ///
+    /// # Errors
+    /// [`Error::InvalidName`] naming the name and what is wrong with it.
+    pub fn try_new(dir: impl Into<PathBuf>, name: &str) -> Result<Self> {
+        check_series_name(name)?;
+        Ok(Self::new(dir, name))
+    }
+
     /// Writes the model's blocks and sub-contacts as the next frame, at the model's time.
     ///
     /// # Errors
-    /// [`crate::Error::Io`] naming the file.
+    /// [`Error::InvalidName`] (nothing written) if the series name is not a portable file name
+    /// (see [`check_series_name`]); [`crate::Error::Io`] naming the file.
     pub fn write_frame<L: ConstitutiveLaw>(&mut self, model: &Model<L>) -> Result<()> {
+        check_series_name(&self.name)?;
         let k = self.frames.len();
         let blocks = format!("{}_blocks_{k:05}.vtu", self.name);
         let contacts = format!("{}_contacts_{k:05}.vtu", self.name);
@@ -296,7 +382,7 @@ impl Series {
                 "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n",
             );
             for (t, b, c) in &self.frames {
-                let file = if pick == 0 { b } else { c };
+                let file = xml_escape(if pick == 0 { b } else { c });
                 let _ = writeln!(
                     out,
                     "<DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{file}\"/>"
