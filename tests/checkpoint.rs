@@ -8,6 +8,13 @@ use voussoir::monitor::Recorder;
 use voussoir::prelude::*;
 
 use common::fingerprint;
+use voussoir::model::reseal_checkpoint;
+
+/// An edited checkpoint document as text, its checksum recomputed: what an edit on purpose
+/// looks like, so that the checks behind the checksum are reached.
+fn sealed(json: &serde_json::Value) -> Result<String> {
+    reseal_checkpoint(&json.to_string())
+}
 
 /// A small wall under a lateral load, so that blocks slide, rock and get re-detected.
 fn moving_wall() -> Result<Model> {
@@ -97,13 +104,13 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     for (field, value) in [("blocks", serde_json::json!([0, 7777])), ("law", serde_json::json!(7))] {
         let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
         json["contacts"][0][field] = value;
-        let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err(field);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err(field);
         assert!(err.to_string().contains("contacts[0]"), "{err}");
     }
     // A bad law parameter is caught by the law's own validation, with its path.
     let bad_law = text.replacen("\"friction_deg\":25.0", "\"friction_deg\":95.0", 1);
     assert_ne!(bad_law, text);
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_law).expect_err("bad friction");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&reseal_checkpoint(&bad_law)?).expect_err("bad friction");
     assert!(
         err.to_string().contains("joints.laws[0]") && err.to_string().contains("friction"),
         "{err}"
@@ -114,7 +121,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     let fz = force.as_f64().expect("a number");
     assert!(fz.abs() > 1.0, "the first contact is loaded: {fz}");
     *force = serde_json::json!(fz * 1.5);
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("bad springs");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("bad springs");
     assert!(err.to_string().contains("contacts[0].springs"), "{err}");
     // Joint axes or anchor plane axes that are not orthonormal.
     for (field, path) in [("tangent", "contacts[0].tangent"), ("anchors", "contacts[0].anchors")] {
@@ -131,7 +138,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
             .map(|c| 1.01 * c.as_f64().expect("a number"))
             .collect();
         *axis = serde_json::json!(scaled);
-        let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err(field);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err(field);
         assert!(err.to_string().contains(path), "{err}");
     }
     // Another version is named as such, whatever else changed between the versions.
@@ -140,13 +147,13 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 9"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 10"),
         "{err}"
     );
     // Every contact has its wrench.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
     json["contacts"][0].as_object_mut().expect("a contact").remove("wrench");
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("wrench");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("wrench");
     assert!(
         err.to_string().contains("contacts[0]") && err.to_string().contains("wrench"),
         "{err}"
@@ -195,11 +202,14 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 9);
+    assert_eq!(json["version"], 10);
+    assert_eq!(json["law_type"], "CoulombSlip");
+    assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
         keys(&json),
         [
             "blocks",
+            "checksum",
             "contacts",
             "critical",
             "damping",
@@ -210,6 +220,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
             "format",
             "joints",
             "last_forces",
+            "law_type",
             "params",
             "pending_detection",
             "ref_poses",
