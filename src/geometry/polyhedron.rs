@@ -316,7 +316,10 @@ impl Polyhedron {
     #[cfg(feature = "serde")]
     pub(crate) fn check_derived(&self) -> std::result::Result<(), (String, String)> {
         let differs = |field: String, stored: &dyn std::fmt::Debug, computed: &dyn std::fmt::Debug| {
-            Err((field, format!("is {stored:?} in the file, its vertices give {computed:?}")))
+            Err((
+                field,
+                format!("is {stored:?} in the file, its vertices give {computed:?}"),
+            ))
         };
         let mut edges: Vec<[u32; 2]> = Vec::new();
         for (i, f) in self.faces.iter().enumerate() {

@@ -402,7 +402,10 @@ where
         if header.version != VERSION {
             return Err(corrupt(
                 "version",
-                &format!("{FORMAT} version {}; this build reads version {VERSION}", header.version),
+                &format!(
+                    "{FORMAT} version {}; this build reads version {VERSION}",
+                    header.version
+                ),
             ));
         }
         // The checksum over the rest: any value changed since the save is refused here.
@@ -442,7 +445,10 @@ where
             return Err(corrupt("ref_poses", "one pose per block expected"));
         }
         if let Some(i) = snap.ref_poses.iter().position(|p| !pose_ok(p)) {
-            return Err(corrupt(&format!("ref_poses[{i}]"), "not a finite pose with a unit rotation"));
+            return Err(corrupt(
+                &format!("ref_poses[{i}]"),
+                "not a finite pose with a unit rotation",
+            ));
         }
         if snap.last_forces.len() != n {
             return Err(corrupt("last_forces", "one pair of wrenches per block expected"));
@@ -492,7 +498,10 @@ where
                 ));
             }
             // The law is the one the blocks' materials map to (a contact is never given another).
-            let (material_a, material_b) = (snap.blocks[p.a as usize].material(), snap.blocks[p.b as usize].material());
+            let (material_a, material_b) = (
+                snap.blocks[p.a as usize].material(),
+                snap.blocks[p.b as usize].material(),
+            );
             let expected = snap.joints.index_of(material_a, material_b);
             if expected != Some(p.law) {
                 return Err(Error::CheckpointContactLaw {
@@ -530,7 +539,8 @@ where
                 field,
                 message,
             };
-            b.check_derived().map_err(|(field, message)| block_error(field, message))?;
+            b.check_derived()
+                .map_err(|(field, message)| block_error(field, message))?;
             if !pose_ok(b.initial_pose()) {
                 return Err(block_error(
                     "initial_pose".into(),
@@ -733,12 +743,7 @@ fn check_time_step(
             TimeStep::Fixed(fixed) => fixed,
         },
         (Some(_), None) => return bad("critical", "in the file, but nothing in the model is stiff".into()),
-        (None, Some(f)) => {
-            return bad(
-                "critical",
-                format!("missing, the blocks and contacts give {} s", f.dt),
-            )
-        }
+        (None, Some(f)) => return bad("critical", format!("missing, the blocks and contacts give {} s", f.dt)),
     };
     if dt.to_bits() != expected.to_bits() {
         return bad(
