@@ -25,7 +25,8 @@ use crate::monitor::History;
 /// ```
 pub fn history_to_csv(history: &History) -> String {
     let mut out = String::from("time [s],step");
-    for (name, unit) in history.names().iter().zip(history.units()) {
+    for (c, name) in history.names().iter().enumerate() {
+        let unit = history.units().get(c).map_or("", String::as_str);
         let _ = write!(out, ",{} [{}]", name.replace(',', ";"), unit);
     }
     out.push('\n');

@@ -342,7 +342,7 @@ where
     ///   compact JSON of the document without that field, keys sorted). Any change to a value,
     ///   by corruption or by hand, gives [`Error::CheckpointChecksum`]; formatting (spaces, key
     ///   order) does not count. Edit a checkpoint on purpose, then
-    ///   [`reseal_checkpoint`](crate::model::reseal_checkpoint) it.
+    ///   [`reseal_checkpoint`] it.
     /// - **Version and law type**: another format version is refused naming both versions (files
     ///   of version 9, which have no checksum, included); a file written by a model of another
     ///   law type gives [`Error::CheckpointLawType`] naming both (a law type is named by its
@@ -551,7 +551,9 @@ where
             let from_w = b.world_inertia_times(s.angular_velocity);
             let tolerance =
                 (1e-9 + 2.0 * s.angular_velocity.length() * step) * s.angular_momentum.length().max(from_w.length());
-            if !((from_w - s.angular_momentum).length() <= tolerance) {
+            // (Written so that a NaN is refused too.)
+            let consistent = (from_w - s.angular_momentum).length() <= tolerance;
+            if !consistent {
                 return Err(block_error(
                     "state.angular_velocity".into(),
                     format!(
@@ -727,7 +729,8 @@ fn check_time_step(
     };
     let expected = match (critical, fresh) {
         (Some(c), Some(f)) => {
-            if !((c.dt - f.dt).abs() <= 0.1 * f.dt) {
+            let close = (c.dt - f.dt).abs() <= 0.1 * f.dt;
+            if !close {
                 return bad(
                     "critical.dt",
                     format!("{} s in the file, the blocks and contacts give {} s", c.dt, f.dt),
