@@ -513,8 +513,8 @@ mod tests {
     use super::History;
 
     /// `history_to_csv` never indexes out of range, even for a history whose columns do not fit
-    /// together (deserialisation refuses those; this one is built by hand): missing values are
-    /// written as NaN.
+    /// together (deserialisation refuses those; this one is built by hand): every row has a value
+    /// per monitor name, missing values written as NaN.
     #[test]
     fn csv_of_an_inconsistent_history_does_not_panic() {
         let history = History {
@@ -527,7 +527,7 @@ mod tests {
         let csv = crate::io::csv::history_to_csv(&history);
         assert_eq!(
             csv,
-            "time [s],step,a [m],b [],c []\n1e-1,10,1e0,NaN,NaN\nNaN,20,2e0,NaN,NaN\nNaN,30,NaN,NaN,NaN\n"
+            "time [s],step,a [m]\n1e-1,10,1e0,NaN,NaN\nNaN,20,2e0,NaN,NaN\nNaN,30,NaN,NaN,NaN\n"
         );
     }
 }

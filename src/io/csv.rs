@@ -25,8 +25,7 @@ use crate::monitor::History;
 /// ```
 pub fn history_to_csv(history: &History) -> String {
     let mut out = String::from("time [s],step");
-    for (c, name) in history.names().iter().enumerate() {
-        let unit = history.units().get(c).map_or("", String::as_str);
+    for (name, unit) in history.names().iter().zip(history.units()) {
         let _ = write!(out, ",{} [{}]", name.replace(',', ";"), unit);
     }
     out.push('\n');
