@@ -144,6 +144,69 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A checkpoint's checksum does not match its content: the file was corrupted (a disk or
+    /// transfer error) or edited by hand. A checkpoint edited on purpose can be resealed with
+    /// [`crate::model::reseal_checkpoint`].
+    #[error(
+        "checkpoint corrupted or edited: its checksum is {stored} but its content gives {computed} \
+         (reseal a checkpoint edited on purpose with voussoir::model::reseal_checkpoint)"
+    )]
+    CheckpointChecksum {
+        /// The checksum stored in the file.
+        stored: String,
+        /// The checksum of the content as read.
+        computed: String,
+    },
+    /// A checkpoint written by a model of one joint law type, loaded as a model of another.
+    #[error("checkpoint written for law type {written}, loading it as law type {loading}")]
+    CheckpointLawType {
+        /// The law type the file was written for (its serde name, e.g. `CoulombSlip`).
+        written: String,
+        /// The law type it is being loaded as.
+        loading: String,
+    },
+    /// A checkpointed contact whose law index is not the one the law table gives its blocks'
+    /// pair of materials.
+    #[error(
+        "checkpoint contact {contact} between blocks {a} and {b} uses law {law}, but their materials \
+         ({material_a}, {material_b}) map to {expected}"
+    )]
+    CheckpointContactLaw {
+        /// Index of the contact in the file (`contacts[contact]`).
+        contact: usize,
+        /// First block of the contact.
+        a: BlockId,
+        /// Second block of the contact.
+        b: BlockId,
+        /// Material of block `a`.
+        material_a: MaterialId,
+        /// Material of block `b`.
+        material_b: MaterialId,
+        /// The law index stored in the file.
+        law: u32,
+        /// The law index the law table gives (`"no law"` when it has none for the pair).
+        expected: String,
+    },
+    /// A checkpointed block whose stored derived data (mass properties, face planes, angular
+    /// momentum) disagrees with what its geometry, density and velocities give.
+    #[error("checkpoint block {block} ({name:?}): {field} {message}")]
+    CheckpointBlock {
+        /// The block.
+        block: BlockId,
+        /// Its name.
+        name: String,
+        /// The field concerned, e.g. `"mass"` or `"shape.faces[2].normal"`.
+        field: String,
+        /// What is wrong, with the stored and the expected value.
+        message: String,
+    },
+    /// A monitor history whose columns do not fit together (read from a file, e.g. with a
+    /// checkpoint).
+    #[error("inconsistent history: {what}")]
+    InconsistentHistory {
+        /// What does not fit, e.g. `"column 1 (\"top x\") has 29 samples, steps has 30"`.
+        what: String,
+    },
     /// Two blocks overlap at the start of a run by more than the contact tolerance.
     #[error(
         "blocks {a} and {b} overlap by {depth:.3e} m at the start, more than the contact tolerance {tolerance} m: \

@@ -359,8 +359,13 @@ impl<L: ConstitutiveLaw> Observer<L> for Recorder<L> {
 }
 
 /// Sampled histories: one row per sample, one column per monitor.
+///
+/// Read back (with serde) only if it is consistent: as many names, units and columns, and as
+/// many steps, times and samples in every column; otherwise deserialisation fails with the
+/// message of [`crate::Error::InconsistentHistory`], naming the column.
 #[derive(Debug, Clone, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "HistoryData"))]
 pub struct History {
     names: Vec<String>,
     units: Vec<String>,
@@ -368,6 +373,58 @@ pub struct History {
     times: Vec<Real>,
     #[cfg_attr(feature = "serde", serde(with = "nullable_columns"))]
     columns: Vec<Vec<Real>>,
+}
+
+/// A [`History`] as read, before its consistency is checked.
+#[cfg(feature = "serde")]
+#[derive(Deserialize)]
+struct HistoryData {
+    names: Vec<String>,
+    units: Vec<String>,
+    steps: Vec<u64>,
+    times: Vec<Real>,
+    #[serde(with = "nullable_columns")]
+    columns: Vec<Vec<Real>>,
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<HistoryData> for History {
+    type Error = crate::Error;
+
+    fn try_from(h: HistoryData) -> Result<Self> {
+        let bad = |what: String| Err(crate::Error::InconsistentHistory { what });
+        if h.units.len() != h.names.len() || h.columns.len() != h.names.len() {
+            return bad(format!(
+                "{} names, {} units and {} columns (one of each per monitor expected)",
+                h.names.len(),
+                h.units.len(),
+                h.columns.len()
+            ));
+        }
+        if h.times.len() != h.steps.len() {
+            return bad(format!(
+                "{} times for {} steps (one per sample expected)",
+                h.times.len(),
+                h.steps.len()
+            ));
+        }
+        for (c, (column, name)) in h.columns.iter().zip(&h.names).enumerate() {
+            if column.len() != h.steps.len() {
+                return bad(format!(
+                    "column {c} ({name:?}) has {} samples, steps has {}",
+                    column.len(),
+                    h.steps.len()
+                ));
+            }
+        }
+        Ok(History {
+            names: h.names,
+            units: h.units,
+            steps: h.steps,
+            times: h.times,
+            columns: h.columns,
+        })
+    }
 }
 
 /// JSON has no NaN: missing samples (NaN) are written as `null` and read back as NaN.
@@ -428,8 +485,16 @@ impl History {
     }
 
     /// Samples of one monitor.
+    ///
+    /// # Panics
+    /// For an id that is not one of this history's monitors ([`History::try_column`] does not).
     pub fn column(&self, id: MonitorId) -> &[Real] {
         &self.columns[id.0 as usize]
+    }
+
+    /// Samples of one monitor, `None` for an id that is not one of this history's monitors.
+    pub fn try_column(&self, id: MonitorId) -> Option<&[Real]> {
+        self.columns.get(id.0 as usize).map(Vec::as_slice)
     }
 
     /// Number of samples.
@@ -440,5 +505,29 @@ impl History {
     /// `true` when nothing has been sampled.
     pub fn is_empty(&self) -> bool {
         self.steps.is_empty()
+    }
+}
+
+#[cfg(all(test, feature = "io"))]
+mod tests {
+    use super::History;
+
+    /// `history_to_csv` never indexes out of range, even for a history whose columns do not fit
+    /// together (deserialisation refuses those; this one is built by hand): every row has a value
+    /// per monitor name, missing values written as NaN.
+    #[test]
+    fn csv_of_an_inconsistent_history_does_not_panic() {
+        let history = History {
+            names: vec!["a".into(), "b".into(), "c".into()],
+            units: vec!["m".into()],
+            steps: vec![10, 20, 30],
+            times: vec![0.1],
+            columns: vec![vec![1.0, 2.0], vec![]],
+        };
+        let csv = crate::io::csv::history_to_csv(&history);
+        assert_eq!(
+            csv,
+            "time [s],step,a [m]\n1e-1,10,1e0,NaN,NaN\nNaN,20,2e0,NaN,NaN\nNaN,30,NaN,NaN,NaN\n"
+        );
     }
 }

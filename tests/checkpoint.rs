@@ -8,6 +8,13 @@ use voussoir::monitor::Recorder;
 use voussoir::prelude::*;
 
 use common::fingerprint;
+use voussoir::model::reseal_checkpoint;
+
+/// An edited checkpoint document as text, its checksum recomputed: what an edit on purpose
+/// looks like, so that the checks behind the checksum are reached.
+fn sealed(json: &serde_json::Value) -> Result<String> {
+    reseal_checkpoint(&json.to_string())
+}
 
 /// A small wall under a lateral load, so that blocks slide, rock and get re-detected.
 fn moving_wall() -> Result<Model> {
@@ -97,13 +104,13 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     for (field, value) in [("blocks", serde_json::json!([0, 7777])), ("law", serde_json::json!(7))] {
         let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
         json["contacts"][0][field] = value;
-        let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err(field);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err(field);
         assert!(err.to_string().contains("contacts[0]"), "{err}");
     }
     // A bad law parameter is caught by the law's own validation, with its path.
     let bad_law = text.replacen("\"friction_deg\":25.0", "\"friction_deg\":95.0", 1);
     assert_ne!(bad_law, text);
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&bad_law).expect_err("bad friction");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&reseal_checkpoint(&bad_law)?).expect_err("bad friction");
     assert!(
         err.to_string().contains("joints.laws[0]") && err.to_string().contains("friction"),
         "{err}"
@@ -114,7 +121,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     let fz = force.as_f64().expect("a number");
     assert!(fz.abs() > 1.0, "the first contact is loaded: {fz}");
     *force = serde_json::json!(fz * 1.5);
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("bad springs");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("bad springs");
     assert!(err.to_string().contains("contacts[0].springs"), "{err}");
     // Joint axes or anchor plane axes that are not orthonormal.
     for (field, path) in [("tangent", "contacts[0].tangent"), ("anchors", "contacts[0].anchors")] {
@@ -131,7 +138,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
             .map(|c| 1.01 * c.as_f64().expect("a number"))
             .collect();
         *axis = serde_json::json!(scaled);
-        let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err(field);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err(field);
         assert!(err.to_string().contains(path), "{err}");
     }
     // Another version is named as such, whatever else changed between the versions.
@@ -140,13 +147,13 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 9"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 10"),
         "{err}"
     );
     // Every contact has its wrench.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
     json["contacts"][0].as_object_mut().expect("a contact").remove("wrench");
-    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("wrench");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("wrench");
     assert!(
         err.to_string().contains("contacts[0]") && err.to_string().contains("wrench"),
         "{err}"
@@ -195,11 +202,14 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 9);
+    assert_eq!(json["version"], 10);
+    assert_eq!(json["law_type"], "CoulombSlip");
+    assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
         keys(&json),
         [
             "blocks",
+            "checksum",
             "contacts",
             "critical",
             "damping",
@@ -210,6 +220,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
             "format",
             "joints",
             "last_forces",
+            "law_type",
             "params",
             "pending_detection",
             "ref_poses",
@@ -277,5 +288,420 @@ fn checkpoints_are_written_beside_and_renamed_over_the_target() -> Result<()> {
         .collect();
     assert_eq!(names, ["state.json"]);
     std::fs::remove_dir_all(&dir).ok();
+    Ok(())
+}
+
+/// Edits of a checkpoint's derived data, resealed (so that the checksum passes, as after an edit
+/// on purpose), are refused with a typed error naming the block and the field: the stored value
+/// is compared with what the geometry, the density and the velocities give. Before format 10
+/// every one of them loaded and ran (an outside probe's list).
+#[test]
+fn edited_derived_data_is_refused() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(300)?;
+    let text = model.to_checkpoint_string()?;
+    let original: serde_json::Value = serde_json::from_str(&text).expect("json");
+    // A free block that moves and turns: its angular velocity and momentum are not zero.
+    let i = (0..model.blocks().len())
+        .find(|&i| model.blocks()[i].is_free() && model.blocks()[i].state().angular_velocity.length() > 1e-6)
+        .expect("a turning block");
+    let scale = |v: &serde_json::Value, f: f64| -> serde_json::Value {
+        match v {
+            serde_json::Value::Array(items) => items
+                .iter()
+                .map(|x| serde_json::json!(x.as_f64().expect("n") * f))
+                .collect(),
+            x => serde_json::json!(x.as_f64().expect("a number") * f),
+        }
+    };
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let b = format!("blocks[{i}]");
+    let cases: Vec<(&str, Edit, &str)> = vec![
+        (
+            "mass ×1000",
+            Box::new(move |j| j["blocks"][i]["mass"]["mass"] = scale(&j["blocks"][i]["mass"]["mass"], 1000.0)),
+            "mass.mass",
+        ),
+        (
+            "negative mass",
+            Box::new(move |j| j["blocks"][i]["mass"]["mass"] = scale(&j["blocks"][i]["mass"]["mass"], -1.0)),
+            "mass.mass",
+        ),
+        (
+            "negative inertia",
+            Box::new(move |j| {
+                j["blocks"][i]["mass"]["principal_inertia"][1] =
+                    scale(&j["blocks"][i]["mass"]["principal_inertia"][1], -1.0)
+            }),
+            "mass.principal_inertia",
+        ),
+        (
+            "negative unit inertia of the shape",
+            Box::new(move |j| {
+                j["blocks"][i]["shape"]["unit_inertia"] = scale(&j["blocks"][i]["shape"]["unit_inertia"], -1.0)
+            }),
+            "shape.unit_inertia",
+        ),
+        (
+            "negative volume",
+            Box::new(move |j| j["blocks"][i]["mass"]["volume"] = scale(&j["blocks"][i]["mass"]["volume"], -1.0)),
+            "mass.volume",
+        ),
+        (
+            "negative shape volume",
+            Box::new(move |j| j["blocks"][i]["shape"]["volume"] = scale(&j["blocks"][i]["shape"]["volume"], -1.0)),
+            "shape.volume",
+        ),
+        (
+            "negative density",
+            Box::new(move |j| j["blocks"][i]["density"] = scale(&j["blocks"][i]["density"], -1.0)),
+            "density",
+        ),
+        (
+            "density ×1000 (mass no longer that of the density)",
+            Box::new(move |j| j["blocks"][i]["density"] = scale(&j["blocks"][i]["density"], 1000.0)),
+            "mass.mass",
+        ),
+        (
+            "angular momentum inconsistent with ω",
+            Box::new(move |j| {
+                j["blocks"][i]["state"]["angular_momentum"] = scale(&j["blocks"][i]["state"]["angular_momentum"], 3.0)
+            }),
+            "state.angular_velocity",
+        ),
+        (
+            "ω inconsistent with the angular momentum",
+            Box::new(move |j| {
+                j["blocks"][i]["state"]["angular_velocity"] = scale(&j["blocks"][i]["state"]["angular_velocity"], -1.0)
+            }),
+            "state.angular_velocity",
+        ),
+        (
+            "face normal zeroed",
+            Box::new(move |j| j["blocks"][i]["shape"]["faces"][2]["normal"] = serde_json::json!([0.0, 0.0, 0.0])),
+            "shape.faces[2].normal",
+        ),
+        (
+            "face normal flipped",
+            Box::new(move |j| {
+                j["blocks"][i]["shape"]["faces"][0]["normal"] =
+                    scale(&j["blocks"][i]["shape"]["faces"][0]["normal"], -1.0)
+            }),
+            "shape.faces[0].normal",
+        ),
+        (
+            "face offset moved",
+            Box::new(move |j| {
+                j["blocks"][i]["shape"]["faces"][1]["offset"] =
+                    scale(&j["blocks"][i]["shape"]["faces"][1]["offset"], 1.01)
+            }),
+            "shape.faces[1].offset",
+        ),
+        (
+            "moved vertex",
+            Box::new(move |j| {
+                j["blocks"][i]["shape"]["vertices"][3] = scale(&j["blocks"][i]["shape"]["vertices"][3], 1.05)
+            }),
+            "shape.faces[",
+        ),
+        (
+            "shape radius",
+            Box::new(move |j| j["blocks"][i]["shape"]["radius"] = scale(&j["blocks"][i]["shape"]["radius"], 0.5)),
+            "shape.radius",
+        ),
+    ];
+    for (what, edit, field) in &cases {
+        let mut json = original.clone();
+        edit(&mut json);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err(what);
+        let Error::CheckpointBlock { block, field: f, .. } = &err else {
+            panic!("{what}: expected CheckpointBlock, got {err:?}")
+        };
+        assert_eq!(block.index(), i, "{what}: {err}");
+        assert!(f.starts_with(field), "{what}: {err}");
+        assert!(
+            err.to_string().contains(&b[7..b.len() - 1]),
+            "{what} names the block: {err}"
+        );
+    }
+    // The original, resealed, still loads: the checks hold for what a run writes.
+    Model::<CoulombSlip>::from_checkpoint_str(&sealed(&original)?)?;
+    Ok(())
+}
+
+/// A negative, zero or doubled time step, a critical step that is not that of the blocks and
+/// contacts, and counters near overflow are refused (a negative `dt` used to run backwards,
+/// `step: u64::MAX` to wrap at the next step).
+#[test]
+fn edited_time_step_and_counters_are_refused() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(300)?;
+    let original: serde_json::Value = serde_json::from_str(&model.to_checkpoint_string()?).expect("json");
+    let dt = original["dt"].as_f64().expect("dt");
+    let critical = original["critical"]["dt"].as_f64().expect("critical dt");
+    let cases: Vec<(&str, &str, serde_json::Value)> = vec![
+        ("dt", "dt", serde_json::json!(-1e-4)),
+        ("dt", "dt", serde_json::json!(0.0)),
+        ("dt", "dt", serde_json::json!(2.0 * dt)),
+        ("step", "step", serde_json::json!(u64::MAX)),
+        ("detections", "detections", serde_json::json!(u64::MAX)),
+        ("time", "time", serde_json::json!(-1.0)),
+        ("drift", "drift", serde_json::json!(-1e-4)),
+    ];
+    for (field, path, value) in cases {
+        let mut json = original.clone();
+        json[field] = value.clone();
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err(field);
+        let Error::Checkpoint { path: p, .. } = &err else {
+            panic!("{field} = {value}: expected Checkpoint, got {err:?}")
+        };
+        assert_eq!(p, path, "{field} = {value}: {err}");
+    }
+    // dt and the critical step edited together (dt still safety × critical): the critical step
+    // re-evaluated from the blocks and contacts gives it away.
+    let mut json = original.clone();
+    json["critical"]["dt"] = serde_json::json!(10.0 * critical);
+    json["dt"] = serde_json::json!(10.0 * dt);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("critical");
+    assert!(
+        matches!(&err, Error::Checkpoint { path, .. } if path == "critical.dt"),
+        "{err}"
+    );
+    // A step count far beyond any run but short of 2^53 loads and steps.
+    let mut json = original.clone();
+    json["step"] = serde_json::json!(1u64 << 52);
+    let mut restored: Model = Model::from_checkpoint_str(&sealed(&json)?)?;
+    restored.run_steps(3)?;
+    assert_eq!(restored.step_count(), (1u64 << 52) + 3);
+    Ok(())
+}
+
+/// Two materials with two laws: a contact whose law index is the other pair's law is refused,
+/// naming the contact and its blocks.
+#[test]
+fn contact_law_index_must_be_its_materials_law() -> Result<()> {
+    let mut model: Model = Model::new(ModelParameters::default())?;
+    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+    model.set_joint_law(MaterialId(0), MaterialId(1), CoulombSlip::dry(2e9, 8e8, 35.0)?)?;
+    model.add_block(common::fixed_slab("base").with_material(MaterialId(1)))?;
+    model.add_block(common::cube("low", Vector::ZERO))?;
+    model.add_block(common::cube("high", Vector::new(0.0, 0.0, common::CUBE_EDGE)))?;
+    model.run_steps(50)?;
+    let text = model.to_checkpoint_string()?;
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let contacts = json["contacts"].as_array().expect("contacts");
+    assert_eq!(contacts.len(), 2);
+    for (k, contact) in contacts.iter().enumerate() {
+        let law = contact["law"].as_u64().expect("a law index");
+        let mut edited = json.clone();
+        edited["contacts"][k]["law"] = serde_json::json!(1 - law);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("another law");
+        let Error::CheckpointContactLaw {
+            contact: c,
+            a,
+            b,
+            law: l,
+            ..
+        } = &err
+        else {
+            panic!("expected CheckpointContactLaw, got {err:?}")
+        };
+        assert_eq!((*c, *l), (k, 1 - law as u32), "{err}");
+        let blocks = contact["blocks"].as_array().expect("blocks");
+        assert_eq!(
+            (a.0 as u64, b.0 as u64),
+            (blocks[0].as_u64().expect("a"), blocks[1].as_u64().expect("b"))
+        );
+        assert!(err.to_string().contains(&format!("contact {k}")), "{err}");
+    }
+    Model::<CoulombSlip>::from_checkpoint_str(&text)?;
+    Ok(())
+}
+
+/// Any change to a checkpoint's content, corruption or edit, is refused as such unless the
+/// checksum is recomputed; formatting is not content. Random single-byte mutations are either
+/// refused (never a panic) or load the very model that was saved.
+#[test]
+fn corrupted_checkpoints_are_refused() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(200)?;
+    let text = model.to_checkpoint_string()?;
+    // An edit of one value, not resealed.
+    let edited = text.replacen("\"step\":200", "\"step\":201", 1);
+    assert_ne!(edited, text);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&edited).expect_err("edited");
+    assert!(matches!(err, Error::CheckpointChecksum { .. }), "{err}");
+    assert!(err.to_string().contains("corrupted or edited"), "{err}");
+    // No checksum, or a mangled one.
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    json.as_object_mut().expect("an object").remove("checksum");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("no checksum");
+    assert!(
+        matches!(&err, Error::Checkpoint { path, .. } if path == "checksum"),
+        "{err}"
+    );
+    // Re-indented with its keys in another order: the same content, the same model.
+    let pretty = serde_json::to_string_pretty(&json).expect("json");
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let checksum = json
+        .as_object_mut()
+        .expect("an object")
+        .remove("checksum")
+        .expect("checksum");
+    let pretty = format!("{{\"checksum\": {checksum},\n{}", &pretty[1..]);
+    let restored: Model = Model::from_checkpoint_str(&pretty)?;
+    assert_eq!(restored.to_checkpoint_string()?, text);
+    // Random single-byte mutations (a fixed pseudo-random sequence, printable bytes only so that
+    // the text stays UTF-8): every one refused or harmless.
+    let bytes = text.as_bytes();
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let (mut refused, mut same) = (0, 0);
+    for _ in 0..3000 {
+        let at = (next() % bytes.len() as u64) as usize;
+        let byte = b' ' + (next() % 95) as u8;
+        if bytes[at] == byte {
+            continue;
+        }
+        let mut mutated = bytes.to_vec();
+        mutated[at] = byte;
+        let mutated = String::from_utf8(mutated).expect("ascii");
+        match Model::<CoulombSlip>::from_checkpoint_str(&mutated) {
+            Err(_) => refused += 1,
+            Ok(m) => {
+                assert_eq!(
+                    m.to_checkpoint_string()?,
+                    text,
+                    "byte {at} set to {:?} loaded another model",
+                    byte as char
+                );
+                same += 1;
+            }
+        }
+    }
+    assert!(refused > 2900, "{refused} refused, {same} harmless");
+    Ok(())
+}
+
+/// A checkpoint written by a model of one law type names both law types when loaded as another
+/// (it used to fail on the first field the laws do not share: "missing field `friction_deg`").
+#[test]
+fn checkpoint_of_another_law_type_is_named() -> Result<()> {
+    let elastic = LinearElastic {
+        normal_stiffness: 1e9,
+        shear_stiffness: 4e8,
+    };
+    let mut model = common::model(elastic);
+    model.add_block(common::fixed_slab("base"))?;
+    model.add_block(common::cube("cube", Vector::ZERO))?;
+    model.run_steps(20)?;
+    let text = model.to_checkpoint_string()?;
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&text).expect_err("another law type");
+    assert_eq!(
+        err,
+        Error::CheckpointLawType {
+            written: "LinearElastic".into(),
+            loading: "CoulombSlip".into()
+        }
+    );
+    assert!(
+        err.to_string().contains("LinearElastic") && err.to_string().contains("CoulombSlip"),
+        "{err}"
+    );
+    let err = Model::<AnyLaw>::from_checkpoint_str(&text).expect_err("AnyLaw");
+    assert!(
+        matches!(&err, Error::CheckpointLawType { loading, .. } if loading == "AnyLaw"),
+        "{err}"
+    );
+    // The same law type loads.
+    Model::<LinearElastic>::from_checkpoint_str(&text)?;
+    // And a Coulomb checkpoint as linear elastic.
+    let mut wall = moving_wall()?;
+    wall.run_steps(5)?;
+    let err = Model::<LinearElastic>::from_checkpoint_str(&wall.to_checkpoint_string()?).expect_err("elastic");
+    assert!(
+        matches!(&err, Error::CheckpointLawType { written, .. } if written == "CoulombSlip"),
+        "{err}"
+    );
+    Ok(())
+}
+
+/// A recorded history whose columns do not fit together (a monitor removed, a column
+/// shortened, a byte of `steps` mutated) is refused as it is read, naming what does not fit;
+/// it used to load and make `history_to_csv` panic.
+#[test]
+fn inconsistent_histories_are_refused() -> Result<()> {
+    let mut model = moving_wall()?;
+    let mut recorder = wall_recorder(&model)?;
+    model.run_steps_observed(100, &mut recorder)?;
+    let text = serde_json::to_string(recorder.history()).expect("json");
+    let back: voussoir::monitor::History = serde_json::from_str(&text).expect("a consistent history");
+    assert_eq!(&back, recorder.history());
+    let original: serde_json::Value = serde_json::from_str(&text).expect("json");
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    let cases: Vec<(&str, Edit)> = vec![
+        (
+            "a monitor's name removed",
+            Box::new(|j| {
+                j["names"].as_array_mut().expect("names").pop();
+            }),
+        ),
+        (
+            "a monitor's column removed",
+            Box::new(|j| {
+                j["columns"].as_array_mut().expect("columns").remove(0);
+            }),
+        ),
+        (
+            "a unit removed",
+            Box::new(|j| {
+                j["units"].as_array_mut().expect("units").pop();
+            }),
+        ),
+        (
+            "a column shortened",
+            Box::new(|j| {
+                j["columns"][1].as_array_mut().expect("column").pop();
+            }),
+        ),
+        (
+            "a sample added to a column",
+            Box::new(|j| {
+                j["columns"][0]
+                    .as_array_mut()
+                    .expect("column")
+                    .push(serde_json::json!(1.0));
+            }),
+        ),
+        (
+            "a step removed",
+            Box::new(|j| {
+                j["steps"].as_array_mut().expect("steps").pop();
+            }),
+        ),
+        (
+            "a time removed",
+            Box::new(|j| {
+                j["times"].as_array_mut().expect("times").pop();
+            }),
+        ),
+    ];
+    for (what, edit) in &cases {
+        let mut json = original.clone();
+        edit(&mut json);
+        let err = serde_json::from_str::<voussoir::monitor::History>(&json.to_string()).expect_err(what);
+        assert!(err.to_string().contains("inconsistent history"), "{what}: {err}");
+    }
+    // A byte of `steps` mutated: the separator in "20,30" made a digit, "20530".
+    let steps_at = text.find("\"steps\":[").expect("steps");
+    let comma = steps_at + text[steps_at..].find("20,30").expect("steps 20 and 30") + 2;
+    let mutated = format!("{}5{}", &text[..comma], &text[comma + 1..]);
+    let err = serde_json::from_str::<voussoir::monitor::History>(&mutated).expect_err("mutated steps");
+    assert!(err.to_string().contains("10 times for 9 steps"), "{err}");
     Ok(())
 }

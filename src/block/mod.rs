@@ -387,6 +387,39 @@ impl RigidBlock {
         self.free = self.fixity.is_free();
         self.validate()
     }
+
+    /// Checks the stored derived data (after [`RigidBlock::restore`]): the shape's against its
+    /// vertices ([`Polyhedron::check_derived`]) and the mass properties, which must be those
+    /// construction computes from the shape and the density (bit for bit). `Err((field,
+    /// message))`.
+    pub(crate) fn check_derived(&self) -> std::result::Result<(), (String, String)> {
+        if !(self.density.is_finite() && self.density > 0.0) {
+            return Err(("density".into(), format!("{} is not positive and finite", self.density)));
+        }
+        self.shape.check_derived()?;
+        let expected = self.shape.mass_properties(self.density);
+        let same = |a: Real, b: Real| a.to_bits() == b.to_bits();
+        let stored = self.mass;
+        for (field, ok) in [
+            ("mass.mass", same(stored.mass, expected.mass)),
+            ("mass.volume", same(stored.volume, expected.volume)),
+            (
+                "mass.principal_inertia",
+                (0..3).all(|i| same(stored.principal_inertia[i], expected.principal_inertia[i])),
+            ),
+        ] {
+            if !ok {
+                return Err((
+                    field.into(),
+                    format!(
+                        "disagrees with the shape and the density {} kg/m³: {:?} in the file, {:?} expected",
+                        self.density, stored, expected
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Block for RigidBlock {

@@ -344,6 +344,95 @@ impl Polyhedron {
         Ok(())
     }
 
+    /// Checks the stored derived data against the vertices and face loops (after
+    /// [`Polyhedron::restore`]): each face's plane and area, the edges and the radius as
+    /// construction computes them from the vertices (the same code, so bit for bit); every
+    /// vertex on or inside every face plane (convexity); and the volume, centroid (the origin)
+    /// and inertia per unit density (diagonal, along the body axes) as the geometry gives them,
+    /// to round-off (construction computes them in world coordinates, before the move to the
+    /// principal frame). The error names the field and gives both values.
+    #[cfg(feature = "serde")]
+    pub(crate) fn check_derived(&self) -> std::result::Result<(), (String, String)> {
+        let differs = |field: String, stored: &dyn std::fmt::Debug, computed: &dyn std::fmt::Debug| {
+            Err((
+                field,
+                format!("is {stored:?} in the file, its vertices give {computed:?}"),
+            ))
+        };
+        let mut edges: Vec<[u32; 2]> = Vec::new();
+        for (i, f) in self.faces.iter().enumerate() {
+            let ids = self.face_loop(i);
+            let loop_pts: Vec<Vector> = ids.iter().map(|&v| self.vertices[v as usize]).collect();
+            let nw = newell_normal(&loop_pts);
+            let (area, normal) = (0.5 * nw.length(), nw.normalize());
+            let offset = loop_pts.iter().map(|p| normal.dot(*p)).sum::<Real>() / loop_pts.len() as Real;
+            if normal.to_array().map(Real::to_bits) != f.normal.to_array().map(Real::to_bits) {
+                return differs(format!("shape.faces[{i}].normal"), &f.normal, &normal);
+            }
+            if offset.to_bits() != f.offset.to_bits() {
+                return differs(format!("shape.faces[{i}].offset"), &f.offset, &offset);
+            }
+            if area.to_bits() != f.area.to_bits() {
+                return differs(format!("shape.faces[{i}].area"), &f.area, &area);
+            }
+            for k in 0..ids.len() {
+                let (a, b) = (ids[k], ids[(k + 1) % ids.len()]);
+                edges.push([a.min(b), a.max(b)]);
+            }
+        }
+        edges.sort_unstable();
+        edges.dedup();
+        if edges != self.edges {
+            return Err(("shape.edges".into(), "are not those of the face loops".into()));
+        }
+        let radius = self.vertices.iter().map(|v| v.length()).fold(0.0, Real::max);
+        if radius.to_bits() != self.radius.to_bits() {
+            return differs("shape.radius".into(), &self.radius, &radius);
+        }
+        let tol = 1e-9 * bbox_diagonal(&self.vertices);
+        for (i, f) in self.faces.iter().enumerate() {
+            if let Some(v) = self.vertices.iter().position(|p| f.normal.dot(*p) - f.offset > tol) {
+                return Err((
+                    format!("shape.vertices[{v}]"),
+                    format!("lies outside face {i}: the shape is not convex"),
+                ));
+            }
+        }
+        let mp = self.parry().mass_properties(1.0);
+        let volume = mp.mass();
+        if !(volume > 0.0 && (volume - self.volume).abs() <= 1e-9 * volume) {
+            return differs("shape.volume".into(), &self.volume, &volume);
+        }
+        if mp.local_com.length() > 1e-9 * radius {
+            return Err((
+                "shape.vertices".into(),
+                format!(
+                    "have their centroid at {:?}, not at the origin of the body frame",
+                    mp.local_com
+                ),
+            ));
+        }
+        let inertia = mp.reconstruct_inertia_matrix();
+        let scale = self.unit_inertia.abs().max_element();
+        for i in 0..3 {
+            for j in 0..3 {
+                let stored = if i == j { self.unit_inertia[i] } else { 0.0 };
+                let computed = inertia.col(j)[i];
+                if !((computed - stored).abs() <= 1e-6 * scale && scale > 0.0) {
+                    return Err((
+                        "shape.unit_inertia".into(),
+                        format!(
+                            "is {:?} in the file (body axes principal), its vertices give the tensor {:?}",
+                            self.unit_inertia,
+                            inertia.to_cols_array_2d()
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Vertices in the body frame (m).
     pub fn vertices(&self) -> &[Vector] {
         &self.vertices

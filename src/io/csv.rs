@@ -32,10 +32,16 @@ pub fn history_to_csv(history: &History) -> String {
         push_field(&mut out, &format!("{name} [{unit}]"));
     }
     out.push('\n');
-    for row in 0..history.len() {
-        let _ = write!(out, "{:e},{}", history.times()[row], history.steps()[row]);
-        for c in 0..history.names().len() {
-            let _ = write!(out, ",{:e}", history.column(crate::monitor::MonitorId(c as u32))[row]);
+    // A history is consistent (every column as long as `steps`; deserialisation checks it), but
+    // this never indexes out of range: a missing value is written as NaN.
+    let value = |v: Option<&f64>| v.copied().unwrap_or(f64::NAN);
+    let columns: Vec<&[f64]> = (0..history.names().len())
+        .map(|c| history.try_column(crate::monitor::MonitorId(c as u32)).unwrap_or(&[]))
+        .collect();
+    for (row, step) in history.steps().iter().enumerate() {
+        let _ = write!(out, "{:e},{}", value(history.times().get(row)), step);
+        for column in &columns {
+            let _ = write!(out, ",{:e}", value(column.get(row)));
         }
         out.push('\n');
     }

@@ -36,7 +36,8 @@ pub struct CoulombSlip {
 /// The serialised form of [`CoulombSlip`]: angles in degrees, validated on load.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+// Named as the law it reads: checkpoints store the law type by its serde name.
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields, rename = "CoulombSlip"))]
 struct CoulombSpec {
     /// Pa/m.
     normal_stiffness: Real,

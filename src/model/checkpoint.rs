@@ -1,7 +1,12 @@
 //! Checkpoint and restart: the full state of a model (blocks, contacts, sub-contact history, law
 //! state, energies) as JSON, restored so that the run continues bit-identically. Recorders are
-//! the caller's: their [`crate::monitor::History`] serialises on its own.
+//! the caller's: their [`crate::monitor::History`] serialises on its own (and is checked for
+//! consistency as it is read).
 //! Compiled with the `serde` feature.
+//!
+//! A checkpoint carries a checksum of its content and the name of its law type; loading one
+//! checks everything it can against everything else (see [`Model::from_checkpoint_str`]), so
+//! that a corrupted or edited file is refused with a typed error rather than run.
 
 use std::path::Path;
 
@@ -15,7 +20,8 @@ use crate::contact::{
 };
 use crate::error::{io_error, Error, Result};
 use crate::geometry::{ContactKind, SubKey};
-use crate::integrate::{CentralDifference, CriticalStep, Damping};
+use crate::ids::BlockId;
+use crate::integrate::{CentralDifference, CriticalStep, Damping, TimeStep};
 use crate::law::{ConstitutiveLaw, LawTable};
 use crate::law::{JointForce, JointStatus};
 use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
@@ -23,14 +29,23 @@ use crate::model::Energies;
 
 const FORMAT: &str = "voussoir-checkpoint";
 /// Version 9 stores joints through [`ContactEntry`], apart from the step's storage layout, so
-/// that a layout change no longer changes the format.
-const VERSION: u32 = 9;
+/// that a layout change no longer changes the format. Version 10 adds the checksum and the law
+/// type; version 9 files (which have neither, so that corruption could not be told) are refused.
+const VERSION: u32 = 10;
+/// The checksum's field: `"crc32:"` and eight hexadecimal digits.
+const CHECKSUM: &str = "checksum";
+/// The largest step count (or detection count) a checkpoint may hold: 2⁵³, where `f64` stops
+/// counting exactly; far beyond any run (years at a microsecond a step), far below where the
+/// counter would overflow.
+const MAX_COUNT: u64 = 1 << 53;
 
 /// The fields every version has, read before the rest (other fields are skipped).
 #[derive(Deserialize)]
 struct Header {
     format: String,
     version: u32,
+    #[serde(default)]
+    law_type: Option<String>,
 }
 
 #[derive(Serialize, Deserialize)]
@@ -41,6 +56,8 @@ struct Header {
 struct Snapshot<L: ConstitutiveLaw> {
     format: String,
     version: u32,
+    /// The law type's serde name ([`law_type_name`]), `None` when it has none.
+    law_type: Option<String>,
     params: ModelParameters,
     damping: Damping,
     blocks: Vec<RigidBlock>,
@@ -257,6 +274,7 @@ where
         let snap = Snapshot::<L> {
             format: FORMAT.into(),
             version: VERSION,
+            law_type: law_type_name::<L>().map(str::to_owned),
             params: self.state.params,
             damping,
             blocks: self.state.blocks.clone(),
@@ -282,10 +300,16 @@ where
             refining: self.state.refining.clone(),
             pending_detection: self.state.changes.need_full_detection(),
         };
-        serde_json::to_string(&snap).map_err(|e| Error::Io {
+        let io = |e: serde_json::Error| Error::Io {
             path: "(checkpoint)".into(),
             message: e.to_string(),
-        })
+        };
+        let mut value = serde_json::to_value(&snap).map_err(io)?;
+        let checksum = checksum_of(&value);
+        if let serde_json::Value::Object(map) = &mut value {
+            map.insert(CHECKSUM.into(), checksum.into());
+        }
+        serde_json::to_string(&value).map_err(io)
     }
 
     /// Restores a model from [`Model::to_checkpoint_string`] text.
@@ -303,40 +327,107 @@ where
     /// restarted.run_steps(50)?;
     /// assert_eq!(model.block(b)?.state(), restarted.block(b)?.state()); // bit-identical
     /// assert!(Model::<CoulombSlip>::from_checkpoint_str("{\"format\": 3").is_err());
+    /// // A checkpoint of one law type does not load as another.
+    /// let err = Model::<LinearElastic>::from_checkpoint_str(&model.to_checkpoint_string()?).unwrap_err();
+    /// assert!(matches!(err, Error::CheckpointLawType { .. }));
     /// # Ok::<(), voussoir::Error>(())
     /// ```
     ///
+    /// # What is checked
+    ///
+    /// A checkpoint is trusted only as far as it can be checked; what can be recomputed is
+    /// compared with what construction computes:
+    ///
+    /// - **Checksum**: the file stores the CRC-32 of its content (`"checksum": "crc32:…"`; the
+    ///   compact JSON of the document without that field, keys sorted). Any change to a value,
+    ///   by corruption or by hand, gives [`Error::CheckpointChecksum`]; formatting (spaces, key
+    ///   order) does not count. Edit a checkpoint on purpose, then
+    ///   [`reseal_checkpoint`] it.
+    /// - **Version and law type**: another format version is refused naming both versions (files
+    ///   of version 9, which have no checksum, included); a file written by a model of another
+    ///   law type gives [`Error::CheckpointLawType`] naming both (a law type is named by its
+    ///   serde name: `CoulombSlip`, `LinearElastic`, `AnyLaw`, or a custom law's struct or enum
+    ///   name; a law whose `Deserialize` gives no name is not checked).
+    /// - **Blocks** ([`Error::CheckpointBlock`]): each face's normal, offset and area, the edges
+    ///   and the radius are recomputed from the vertices and face loops as construction does and
+    ///   must match bit for bit; every vertex lies inside every face (convexity); the volume, the
+    ///   centroid (the body frame's origin) and the principal inertia per unit density must be
+    ///   those of the vertices (to round-off, 10⁻⁹ of the volume, 10⁻⁶ of the inertia); the
+    ///   mass, volume and principal inertia must be those of the shape and the (positive)
+    ///   density, bit for bit. The angular momentum `L` is the state the integrator advances;
+    ///   the angular velocity must be `I⁻¹L` in the world frame to within the rotation of one
+    ///   step (relative `10⁻⁹ + 2|ω|Δt`).
+    /// - **Time step and counters** ([`Error::Checkpoint`] at `dt`, `critical`, `step`, …): `dt`
+    ///   must be positive and what the parameters make of the stored critical step (`safety ×
+    ///   critical`, or the fixed step); the critical step is re-evaluated from the blocks and
+    ///   contacts and must agree with the stored one within 10 %; the step and detection counts
+    ///   must not exceed 2⁵³ (so they never overflow); time and the impact refinement's state
+    ///   must be finite and not negative.
+    /// - **Contacts**: block, face, law and sub-contact indices in range and sorted; each
+    ///   contact's law must be the one the law table gives its blocks' materials
+    ///   ([`Error::CheckpointContactLaw`]); axes orthonormal; spring moments those of the
+    ///   sub-contact forces; areas not negative.
+    /// - **Laws and parameters**: validated as [`Model::set_joint_law`] and [`Model::new`] do.
+    ///
+    /// Everything else (positions, velocities, forces, law states, energies) is state, restored
+    /// as stored, so that a valid checkpoint continues bit for bit.
+    ///
     /// # Errors
-    /// [`Error::Checkpoint`] for truncated, corrupt or inconsistent text, naming where.
+    /// [`Error::Checkpoint`] for truncated, corrupt or inconsistent text, naming where;
+    /// [`Error::CheckpointChecksum`], [`Error::CheckpointLawType`],
+    /// [`Error::CheckpointContactLaw`] and [`Error::CheckpointBlock`] as above; never a panic.
     pub fn from_checkpoint_str(text: &str) -> Result<Self> {
-        // The format and version first, so that a file of another version is named as such
-        // rather than failing on the first field that changed.
-        if let Ok(header) = serde_json::from_str::<Header>(text) {
-            if header.format != FORMAT {
-                return Err(Error::Checkpoint {
-                    path: "format".into(),
-                    message: format!("\"{}\" is not a {FORMAT}", header.format),
-                });
-            }
-            if header.version != VERSION {
-                return Err(Error::Checkpoint {
-                    path: "version".into(),
-                    message: format!(
-                        "{FORMAT} version {}; this build reads version {VERSION}",
-                        header.version
-                    ),
-                });
-            }
-        }
-        let de = &mut serde_json::Deserializer::from_str(text);
-        let snap: Snapshot<L> = serde_path_to_error::deserialize(de).map_err(|e| Error::Checkpoint {
-            path: e.path().to_string(),
-            message: e.inner().to_string(),
-        })?;
         let corrupt = |path: &str, message: &str| Error::Checkpoint {
             path: path.into(),
             message: message.into(),
         };
+        let typed_error = |e: serde_path_to_error::Error<serde_json::Error>| Error::Checkpoint {
+            path: e.path().to_string(),
+            message: e.inner().to_string(),
+        };
+        let mut value: serde_json::Value = serde_json::from_str(text)
+            .map_err(|e| corrupt("(document)", &format!("not a complete JSON document: {e}")))?;
+        // The format and version first, so that a file of another version is named as such
+        // rather than failing on the first field that changed.
+        let Ok(header) = Header::deserialize(&value) else {
+            // Let the typed reading say which field is wrong.
+            return Err(match serde_path_to_error::deserialize::<_, Snapshot<L>>(value) {
+                Err(e) => typed_error(e),
+                Ok(_) => corrupt("format", &format!("not a {FORMAT}")),
+            });
+        };
+        if header.format != FORMAT {
+            return Err(corrupt("format", &format!("\"{}\" is not a {FORMAT}", header.format)));
+        }
+        if header.version != VERSION {
+            return Err(corrupt(
+                "version",
+                &format!(
+                    "{FORMAT} version {}; this build reads version {VERSION}",
+                    header.version
+                ),
+            ));
+        }
+        // The checksum over the rest: any value changed since the save is refused here.
+        let stored = match value.as_object_mut().and_then(|m| m.remove(CHECKSUM)) {
+            Some(serde_json::Value::String(s)) => s,
+            Some(_) => return Err(corrupt(CHECKSUM, "not a string")),
+            None => return Err(corrupt(CHECKSUM, "missing: the file is truncated or was edited")),
+        };
+        let computed = checksum_of(&value);
+        if stored != computed {
+            return Err(Error::CheckpointChecksum { stored, computed });
+        }
+        // The law type before the laws, which would fail on the first field that differs.
+        if let (Some(written), Some(loading)) = (header.law_type.as_deref(), law_type_name::<L>()) {
+            if written != loading {
+                return Err(Error::CheckpointLawType {
+                    written: written.into(),
+                    loading: loading.into(),
+                });
+            }
+        }
+        let snap: Snapshot<L> = serde_path_to_error::deserialize(value).map_err(typed_error)?;
         if snap.format != FORMAT || snap.version != VERSION {
             return Err(corrupt("format", &format!("not a {FORMAT} version {VERSION}")));
         }
@@ -353,6 +444,16 @@ where
         if snap.ref_poses.len() != n {
             return Err(corrupt("ref_poses", "one pose per block expected"));
         }
+        if let Some(i) = snap.ref_poses.iter().position(|p| !pose_ok(p)) {
+            return Err(corrupt(
+                &format!("ref_poses[{i}]"),
+                "not a finite pose with a unit rotation",
+            ));
+        }
+        if snap.last_forces.len() != n {
+            return Err(corrupt("last_forces", "one pair of wrenches per block expected"));
+        }
+        check_run_state(&snap)?;
         let (pairs, references, wrenches, subs, sub_records) = into_storage(snap.contacts);
         if let Some(k) = wrenches
             .iter()
@@ -396,7 +497,27 @@ where
                     "inconsistent block, law or sub-contact indices",
                 ));
             }
+            // The law is the one the blocks' materials map to (a contact is never given another).
+            let (material_a, material_b) = (
+                snap.blocks[p.a as usize].material(),
+                snap.blocks[p.b as usize].material(),
+            );
+            let expected = snap.joints.index_of(material_a, material_b);
+            if expected != Some(p.law) {
+                return Err(Error::CheckpointContactLaw {
+                    contact: k,
+                    a: BlockId(p.a),
+                    b: BlockId(p.b),
+                    material_a,
+                    material_b,
+                    law: p.law,
+                    expected: expected.map_or_else(|| "no law".into(), |e| format!("law {e}")),
+                });
+            }
             next = end;
+        }
+        if next != subs.len() {
+            return Err(corrupt("contacts", "sub-contacts outside every contact"));
         }
         if let Some(i) = subs.iter().position(|s| s.area < 0.0) {
             let k = pairs.partition_point(|p| p.first as usize + p.count as usize <= i);
@@ -406,10 +527,41 @@ where
                 "negative area",
             ));
         }
+        // The step that relates each block's angular velocity to its angular momentum.
+        let step = snap.dt.max(snap.drift);
         let mut model = Model::new(snap.params)?;
         for (i, mut b) in snap.blocks.into_iter().enumerate() {
             b.restore()
                 .map_err(|e| corrupt(&format!("blocks[{i}]"), &e.to_string()))?;
+            let block_error = |field: String, message: String| Error::CheckpointBlock {
+                block: BlockId(i as u32),
+                name: b.name().to_owned(),
+                field,
+                message,
+            };
+            b.check_derived()
+                .map_err(|(field, message)| block_error(field, message))?;
+            if !pose_ok(b.initial_pose()) {
+                return Err(block_error(
+                    "initial_pose".into(),
+                    "is not a finite pose with a unit rotation".into(),
+                ));
+            }
+            let s = *b.state();
+            let from_w = b.world_inertia_times(s.angular_velocity);
+            let tolerance =
+                (1e-9 + 2.0 * s.angular_velocity.length() * step) * s.angular_momentum.length().max(from_w.length());
+            // (Written so that a NaN is refused too.)
+            let consistent = (from_w - s.angular_momentum).length() <= tolerance;
+            if !consistent {
+                return Err(block_error(
+                    "state.angular_velocity".into(),
+                    format!(
+                        "{:?} disagrees with the angular momentum {:?} (the inertia gives {:?} for it)",
+                        s.angular_velocity, s.angular_momentum, from_w
+                    ),
+                ));
+            }
             model.add_block(b)?;
         }
         model.state.laws = snap.joints;
@@ -438,7 +590,6 @@ where
             }
         }
         model.state.ref_poses = snap.ref_poses;
-        model.state.dt = snap.dt;
         model.state.drift = if snap.drift > 0.0 && snap.started {
             snap.drift
         } else {
@@ -449,7 +600,6 @@ where
         model.state.refining = snap.refining;
         model.state.refining.sort_unstable();
         model.state.refining.dedup();
-        model.state.critical = snap.critical;
         model.state.step = snap.step;
         model.state.time = snap.time;
         model.state.energy = snap.energy;
@@ -461,10 +611,27 @@ where
             r.damping = damping;
         }
         model.state.changes.clear();
-        if !model.state.started || snap.pending_detection {
+        let redetect = !model.state.started || snap.pending_detection;
+        if redetect {
             model.state.changes.insert(super::changes::Changes::DETECTION);
         }
         model.state.rebuild_block_index(&mut model.pipeline);
+        // The time step: re-evaluated from the blocks and contacts as detection does, and
+        // compared with the stored one, which is kept (re-evaluated poses differ from those at
+        // the last detection in the last digits). A step due for re-evaluation is re-evaluated
+        // by the next step anyway.
+        if !redetect {
+            let bound_areas: Vec<Real> = model.state.references.iter().map(|r| r.bound_area).collect();
+            // An error here is a fixed step above the re-evaluated limit: compared below.
+            let _ = model.state.refresh_time_step(&mut model.pipeline);
+            let fresh = model.state.critical;
+            for (r, area) in model.state.references.iter_mut().zip(bound_areas) {
+                r.bound_area = area;
+            }
+            check_time_step(&snap.params, snap.dt, snap.critical, fresh)?;
+        }
+        model.state.dt = snap.dt;
+        model.state.critical = snap.critical;
         Ok(model)
     }
 
@@ -493,4 +660,261 @@ fn orthonormal(a: Vector, b: Vector) -> bool {
     (a.length_squared() - 1.0).abs() <= tolerance
         && (b.length_squared() - 1.0).abs() <= tolerance
         && a.dot(b).abs() <= tolerance
+}
+
+/// Whether a pose is finite with a unit rotation (to 1e-9, as blocks are checked).
+fn pose_ok(p: &Pose) -> bool {
+    is_finite_vector(p.translation) && p.rotation.is_finite() && (p.rotation.length() - 1.0).abs() <= 1e-9
+}
+
+/// The run's counters, clock and step: finite, not negative, and counters far from overflow.
+fn check_run_state<L: ConstitutiveLaw>(snap: &Snapshot<L>) -> Result<()> {
+    let bad = |path: &str, message: String| {
+        Err(Error::Checkpoint {
+            path: path.into(),
+            message,
+        })
+    };
+    for (path, count) in [("step", snap.step), ("detections", snap.detections)] {
+        if count > MAX_COUNT {
+            return bad(path, format!("{count} is beyond any run (at most 2^53 = {MAX_COUNT})"));
+        }
+    }
+    let positive_dt = snap.dt.is_finite() && (snap.dt > 0.0 || (!snap.started && snap.dt == 0.0));
+    if !positive_dt {
+        return bad("dt", format!("{} s is not a positive, finite time step", snap.dt));
+    }
+    for (path, v) in [
+        ("time", snap.time),
+        ("drift", snap.drift),
+        ("refine_until", snap.refine_until),
+        ("refine_omega2", snap.refine_omega2),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return bad(path, format!("{v} is not finite and not negative"));
+        }
+    }
+    if let Some(c) = snap.critical {
+        if !(c.dt.is_finite() && c.dt > 0.0 && c.omega_max.is_finite() && c.omega_max >= 0.0) {
+            return bad("critical", format!("{c:?} is not a positive, finite step"));
+        }
+        if c.block.index() >= snap.blocks.len() {
+            return bad("critical.block", format!("{} does not exist", c.block));
+        }
+    }
+    if let Some(&(a, b)) = snap
+        .refining
+        .iter()
+        .find(|&&(a, b)| a >= b || b as usize >= snap.blocks.len())
+    {
+        return bad("refining", format!("({a}, {b}) is not a pair of blocks"));
+    }
+    Ok(())
+}
+
+/// The stored step against the parameters and the critical step re-evaluated on load (`fresh`):
+/// the stored critical step within 10 % of it (the poses moved a little since the last
+/// detection), the step what the parameters make of the stored critical step, bit for bit.
+fn check_time_step(
+    params: &ModelParameters,
+    dt: Real,
+    critical: Option<CriticalStep>,
+    fresh: Option<CriticalStep>,
+) -> Result<()> {
+    let bad = |path: &str, message: String| {
+        Err(Error::Checkpoint {
+            path: path.into(),
+            message,
+        })
+    };
+    let expected = match (critical, fresh) {
+        (Some(c), Some(f)) => {
+            let close = (c.dt - f.dt).abs() <= 0.1 * f.dt;
+            if !close {
+                return bad(
+                    "critical.dt",
+                    format!("{} s in the file, the blocks and contacts give {} s", c.dt, f.dt),
+                );
+            }
+            match params.time_step {
+                TimeStep::Auto { safety } => safety * c.dt,
+                TimeStep::Fixed(fixed) => fixed,
+            }
+        }
+        (None, None) => match params.time_step {
+            TimeStep::Auto { .. } => dt,
+            TimeStep::Fixed(fixed) => fixed,
+        },
+        (Some(_), None) => return bad("critical", "in the file, but nothing in the model is stiff".into()),
+        (None, Some(f)) => return bad("critical", format!("missing, the blocks and contacts give {} s", f.dt)),
+    };
+    if dt.to_bits() != expected.to_bits() {
+        return bad(
+            "dt",
+            format!("{dt} s in the file, the parameters and the critical step give {expected} s"),
+        );
+    }
+    Ok(())
+}
+
+/// The checksum of a checkpoint document (without its checksum field): CRC-32 (IEEE) of its
+/// compact JSON with every object's keys sorted, as `crc32:` and eight hexadecimal digits.
+fn checksum_of(value: &serde_json::Value) -> String {
+    let mut text = String::new();
+    canonical(value, &mut text);
+    format!("crc32:{:08x}", crc32fast::hash(text.as_bytes()))
+}
+
+/// Compact JSON with sorted keys, whatever order the map keeps them in.
+fn canonical(value: &serde_json::Value, out: &mut String) {
+    use serde_json::Value;
+    match value {
+        Value::Object(map) => {
+            let mut keys: Vec<&String> = map.keys().collect();
+            keys.sort_unstable();
+            out.push('{');
+            for (i, k) in keys.into_iter().enumerate() {
+                if i > 0 {
+                    out.push(',');
+                }
+                out.push_str(&Value::String(k.clone()).to_string());
+                out.push(':');
+                canonical(&map[k], out);
+            }
+            out.push('}');
+        }
+        Value::Array(items) => {
+            out.push('[');
+            for (i, v) in items.iter().enumerate() {
+                if i > 0 {
+                    out.push(',');
+                }
+                canonical(v, out);
+            }
+            out.push(']');
+        }
+        scalar => out.push_str(&scalar.to_string()),
+    }
+}
+
+/// Recomputes the checksum of a checkpoint edited on purpose, so that it loads again (its content
+/// is then checked as any checkpoint's is).
+///
+/// ```
+/// use voussoir::prelude::*;
+/// let mut model: Model = Model::new(ModelParameters::default())?;
+/// model.add_block(RigidBlock::cuboid("b", Vector::ZERO, Vector::splat(0.1), 2000.0)?)?;
+/// let text = model.to_checkpoint_string()?;
+/// let edited = text.replace("\"name\":\"b\"", "\"name\":\"stone\"");
+/// assert!(matches!(Model::<CoulombSlip>::from_checkpoint_str(&edited), Err(Error::CheckpointChecksum { .. })));
+/// let resealed = voussoir::model::reseal_checkpoint(&edited)?;
+/// assert_eq!(Model::<CoulombSlip>::from_checkpoint_str(&resealed)?.blocks()[0].name(), "stone");
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+///
+/// # Errors
+/// [`Error::Checkpoint`] for text that is not a JSON object.
+pub fn reseal_checkpoint(text: &str) -> Result<String> {
+    let corrupt = |message: String| Error::Checkpoint {
+        path: "(document)".into(),
+        message,
+    };
+    let mut value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| corrupt(format!("not a complete JSON document: {e}")))?;
+    let Some(map) = value.as_object_mut() else {
+        return Err(corrupt("not a JSON object".into()));
+    };
+    map.remove(CHECKSUM);
+    let checksum = checksum_of(&value);
+    if let serde_json::Value::Object(map) = &mut value {
+        map.insert(CHECKSUM.into(), checksum.into());
+    }
+    serde_json::to_string(&value).map_err(|e| corrupt(e.to_string()))
+}
+
+/// The law type's name as its serde derive gives it (the struct or enum name, or its
+/// `#[serde(rename)]`): stable across builds, unlike `std::any::type_name`. `None` for a
+/// `Deserialize` that does not name its type.
+fn law_type_name<L: DeserializeOwned>() -> Option<&'static str> {
+    match L::deserialize(NameOnly) {
+        Err(NameFound(name)) => name,
+        Ok(_) => None,
+    }
+}
+
+/// A deserializer with no data, which stops at the first type name serde hands it.
+struct NameOnly;
+
+/// The name [`NameOnly`] found (the "error" that stops the deserialisation).
+#[derive(Debug)]
+struct NameFound(Option<&'static str>);
+
+impl std::fmt::Display for NameFound {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "type name {:?}", self.0)
+    }
+}
+
+impl std::error::Error for NameFound {}
+
+impl serde::de::Error for NameFound {
+    fn custom<T: std::fmt::Display>(_: T) -> Self {
+        NameFound(None)
+    }
+}
+
+impl<'de> serde::Deserializer<'de> for NameOnly {
+    type Error = NameFound;
+
+    fn deserialize_any<V: serde::de::Visitor<'de>>(self, _: V) -> std::result::Result<V::Value, NameFound> {
+        Err(NameFound(None))
+    }
+
+    fn deserialize_struct<V: serde::de::Visitor<'de>>(
+        self,
+        name: &'static str,
+        _: &'static [&'static str],
+        _: V,
+    ) -> std::result::Result<V::Value, NameFound> {
+        Err(NameFound(Some(name)))
+    }
+
+    fn deserialize_enum<V: serde::de::Visitor<'de>>(
+        self,
+        name: &'static str,
+        _: &'static [&'static str],
+        _: V,
+    ) -> std::result::Result<V::Value, NameFound> {
+        Err(NameFound(Some(name)))
+    }
+
+    fn deserialize_newtype_struct<V: serde::de::Visitor<'de>>(
+        self,
+        name: &'static str,
+        _: V,
+    ) -> std::result::Result<V::Value, NameFound> {
+        Err(NameFound(Some(name)))
+    }
+
+    fn deserialize_unit_struct<V: serde::de::Visitor<'de>>(
+        self,
+        name: &'static str,
+        _: V,
+    ) -> std::result::Result<V::Value, NameFound> {
+        Err(NameFound(Some(name)))
+    }
+
+    fn deserialize_tuple_struct<V: serde::de::Visitor<'de>>(
+        self,
+        name: &'static str,
+        _: usize,
+        _: V,
+    ) -> std::result::Result<V::Value, NameFound> {
+        Err(NameFound(Some(name)))
+    }
+
+    serde::forward_to_deserialize_any! {
+        bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf option
+        unit seq tuple map identifier ignored_any
+    }
 }

@@ -17,6 +17,8 @@ use rayon::prelude::*;
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
+#[cfg(feature = "serde")]
+pub use checkpoint::reseal_checkpoint;
 pub use energy::Energies;
 pub use observe::Observer;
 
