@@ -177,3 +177,37 @@ fn a_free_axis_cannot_be_driven() {
         .expect_err("free axis");
     assert!(e.to_string().contains("along y"), "{e}");
 }
+
+/// A shaking run saved half-way resumes bit for bit: the checkpoint carries the base motion and
+/// when its history started (a resumed shaking table that stood still would be a silent wrong
+/// answer).
+#[test]
+fn a_checkpoint_resumes_the_shaking() {
+    let mut model = common::model(CoulombSlip::dry(1e10, 4e9, PHI_DEG).expect("law"));
+    model.set_damping(Damping::None).expect("damping");
+    let base = model.add_block(common::fixed_slab("shaking table")).expect("slab");
+    model.add_block(common::cube("block", Vector::ZERO)).expect("cube");
+    model.run_until_time(0.05).expect("settle");
+    let shake = TimeHistory::sine(0.8 * G, FREQUENCY, DURATION, 400).expect("history");
+    model
+        .set_base_motion(
+            base,
+            Some(BaseMotion::new(MotionKind::Acceleration, [Some(shake), None, None]).expect("motion")),
+        )
+        .expect("base motion");
+    model.run_until_time(0.2).expect("run");
+    let saved = model.to_checkpoint_string().expect("save");
+    model.run_until_time(0.4).expect("run");
+    let mut resumed = Model::<CoulombSlip>::from_checkpoint_str(&saved).expect("load");
+    assert_eq!(resumed.base_motions().count(), 1);
+    assert_eq!(
+        resumed.base_motions().next().map(|m| m.2),
+        Some(model.base_motions().next().expect("motion").2)
+    );
+    resumed.run_until_time(0.4).expect("run");
+    assert_eq!(common::fingerprint(&model), common::fingerprint(&resumed));
+    assert!(
+        model.block(base).expect("base").state().pose.translation.x > 1e-3,
+        "the table moved"
+    );
+}

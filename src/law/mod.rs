@@ -263,10 +263,14 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     }
 
     /// Elastic energy stored in the joint springs (J), never negative. The default assumes linear
-    /// springs with the stiffness of [`ConstitutiveLaw::stiffness`].
+    /// springs with the stiffness of [`ConstitutiveLaw::stiffness`]; a sub-contact without
+    /// area (or a law without stiffness) has no springs and stores nothing.
     fn elastic_energy(&self, area: Real, force: &JointForce, _state: &Self::State) -> Real {
         let k = self.stiffness();
         let mut e = 0.0;
+        if !(area > 0.0) {
+            return 0.0;
+        }
         if k.normal > 0.0 {
             e += 0.5 * force.normal * force.normal / (k.normal * area);
         }

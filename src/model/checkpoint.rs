@@ -91,6 +91,9 @@ struct Snapshot<L: ConstitutiveLaw> {
     /// The contacts under impact refinement (sorted block pairs).
     #[serde(default)]
     refining: Vec<(u32, u32)>,
+    /// Base motions ([`Model::set_base_motion`]), with the model time each started at.
+    #[serde(default)]
+    motions: Vec<super::excitation::AppliedMotion>,
 }
 
 /// A joint as checkpoints store it: its geometry, law, the step's running sums and its
@@ -298,6 +301,7 @@ where
             refine_until: self.state.refine_until,
             refine_omega2: self.state.refine_omega2,
             refining: self.state.refining.clone(),
+            motions: self.state.motions.clone(),
             pending_detection: self.state.changes.need_full_detection(),
         };
         let io = |e: serde_json::Error| Error::Io {
@@ -598,6 +602,22 @@ where
         model.state.refine_until = snap.refine_until;
         model.state.refine_omega2 = snap.refine_omega2;
         model.state.refining = snap.refining;
+        for (k, m) in snap.motions.into_iter().enumerate() {
+            let block = BlockId(m.block);
+            if !(m.start.is_finite() && m.start <= snap.time) {
+                return Err(corrupt(
+                    &format!("motions[{k}].start"),
+                    "not a finite time before the checkpoint's",
+                ));
+            }
+            let start = m.start;
+            model
+                .set_base_motion(block, Some(m.motion))
+                .map_err(|e| corrupt(&format!("motions[{k}]"), &e.to_string()))?;
+            if let Some(last) = model.state.motions.iter_mut().find(|a| a.block == block.0) {
+                last.start = start;
+            }
+        }
         model.state.refining.sort_unstable();
         model.state.refining.dedup();
         model.state.step = snap.step;
