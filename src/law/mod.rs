@@ -268,7 +268,7 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
     fn elastic_energy(&self, area: Real, force: &JointForce, _state: &Self::State) -> Real {
         let k = self.stiffness();
         let mut e = 0.0;
-        if !(area > 0.0) {
+        if area.is_nan() || area <= 0.0 {
             return 0.0;
         }
         if k.normal > 0.0 {

@@ -8,7 +8,7 @@
 //!
 //! [`Servo`] removes the rate from the answer: the plate advances by a fixed increment per
 //! step ([`Servo::increment`]) only while the model is close to equilibrium — the
-//! unbalanced-force ratio ([`Model::unbalanced_force_ratio`]) at or below
+//! unbalanced-force ratio ([`crate::Model::unbalanced_force_ratio`]) at or below
 //! [`Servo::max_unbalanced_ratio`] — and stands still otherwise, until the structure has
 //! settled under the load it carries. The plate's path is thus followed through a sequence of
 //! equilibria; there is no loading speed at all, and the answer is read at the settled states
