@@ -10,6 +10,7 @@
 //! ```
 
 pub mod arch_impact;
+pub mod arch_limit;
 pub mod arch_static;
 
 use std::path::{Path, PathBuf};
@@ -130,6 +131,11 @@ impl Outputs {
     /// The output folder.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// Whether ParaView series are written (not `--no-paraview`).
+    pub fn paraview(&self) -> bool {
+        self.paraview
     }
 
     /// Seconds since the run started.
