@@ -68,12 +68,17 @@ load on voussoir 5: collapse load and mechanism";
             s.plate_weight
         );
         println!(
-            "mechanism: {} (i/e = intrados/extrados); solved in {} iterations, {:.1} ms",
+            "mechanism: {} (i/e = intrados/extrados); {} contacts, {} corners; solved in {} iterations, {:.1} ms",
             s.mechanism.describe(),
+            r.result.contacts.len(),
+            r.result.contacts.iter().map(|c| c.vertices.len()).sum::<usize>(),
             r.result.iterations,
             s.wall_s * 1e3
         );
-        println!("\n{:>5} {:>14} {:>14} {:>12}  state", "joint", "opening i", "opening e", "sliding");
+        println!(
+            "\n{:>5} {:>14} {:>14} {:>12}  state",
+            "joint", "opening i", "opening e", "sliding"
+        );
         for j in &s.joints {
             let state = match (j.hinge, j.is_sliding) {
                 (Some(side), sliding) => format!("hinge ({side:?}){}", if sliding { ", sliding" } else { "" }),

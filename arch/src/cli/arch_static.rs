@@ -312,7 +312,7 @@ fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
 
     println!();
     println!(
-        "{:<22} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7}  {:<44} {:>5} {:>8} {:>6}  {}",
+        "{:<22} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7}  {:<44} {:>5} {:>8} {:>6}  limit mechanism",
         "case",
         "peak kN",
         "raw kN",
@@ -324,7 +324,6 @@ fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
         "exp.",
         "limit kN",
         "DEM/LA",
-        "limit mechanism"
     );
     for (r, c) in &runs {
         let exp = if r.case.label == "baseline" {
