@@ -54,7 +54,7 @@
 //! | [`build`] | generators (walls, arches, vaults): they return blocks |
 //! | [`scenes`] | ready-made models (the benchmarks' wall) |
 //! | [`io`] | ParaView series, CSV histories, scenes (feature `io`) |
-//! | [`analysis`] | joint states and collapse mechanisms |
+//! | [`analysis`] | joint states and collapse mechanisms; limit analysis (feature `limit`) |
 //!
 //! The reproduction of the reference arch's tests (Pulatsu, Gonen & Lourenço 2021), with its
 //! command line, plots and progress bars, is the repository's unpublished `voussoir-arch` crate
@@ -62,13 +62,14 @@
 //!
 //! ## Features
 //!
-//! Both are on by default; `default-features = false` builds the solver alone (parry, glam,
+//! All three are on by default; `default-features = false` builds the solver alone (parry, glam,
 //! rayon, thiserror, approx).
 //!
 //! | feature | gives | brings in |
 //! |---|---|---|
 //! | `serde` | `Serialize`/`Deserialize` on the public types (parameters, laws and their states, blocks, monitors, histories, joint states); checkpoints: [`Model::to_checkpoint_string`], [`Model::from_checkpoint_str`], [`Model::save_checkpoint`], [`Model::load_checkpoint`] | serde, serde_json, serde_path_to_error, glam's and parry's serde support |
 //! | `io` | the `io` module: ParaView series, CSV histories, scene files, `write_json` | `serde` |
+//! | `limit` | [`analysis::limit`]: limit analysis of the blocks as they stand (collapse load multiplier, contact forces, mechanism) | clarabel (pure-Rust conic interior point) |
 #![cfg_attr(docsrs, feature(doc_cfg))]
 #![warn(missing_docs)]
 

@@ -123,6 +123,11 @@ impl<'a, S> ContactView<'a, S> {
     pub fn kind(&self) -> ContactKind {
         self.pair.kind
     }
+    /// Whether the sub-contacts are anchored to block `a` (else `b`).
+    #[cfg(feature = "limit")]
+    pub(crate) fn host_is_a(&self) -> bool {
+        self.pair.host_is_a
+    }
     /// Unit normal a → b (world).
     pub fn normal(&self) -> Vector {
         self.pair.normal

@@ -7,6 +7,8 @@ mod narrow_phase;
 mod polyhedron;
 
 pub use broad_phase::BroadPhase;
+#[cfg(feature = "limit")]
+pub(crate) use narrow_phase::contact_polygon;
 pub use narrow_phase::{
     detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, SubKey,
     SubcontactDensity, SubcontactSeed, MAX_SUBCONTACTS_PER_EDGE,

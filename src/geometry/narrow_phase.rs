@@ -611,6 +611,60 @@ fn face_face_hosted(
     })
 }
 
+/// The corners of a contact's polygon (world, counter-clockwise seen from outside the host):
+/// for a face-face contact the other face projected on the host face's plane and clipped by the
+/// host face — the polygon whose grid cells carry the sub-contacts (`face_face_hosted`); for a
+/// point contact, or a face-face polygon that came out degenerate, the 2-D hull of `points`
+/// (the sub-contacts) in the plane normal to `normal`: a polygon, a segment or a point.
+/// Corners closer than 1e-9 of the polygon's extent are merged, collinear ones dropped.
+#[cfg(feature = "limit")]
+pub(crate) fn contact_polygon(
+    a: BlockGeometry<'_>,
+    b: BlockGeometry<'_>,
+    kind: ContactKind,
+    host_is_a: bool,
+    normal: Vector,
+    points: &[Vector],
+) -> Vec<Vector> {
+    if let ContactKind::FaceFace { face_a, face_b } = kind {
+        let (fa, fb) = (face_a as usize, face_b as usize);
+        let (host, fh, other, fo) = if host_is_a { (a, fa, b, fb) } else { (b, fb, a, fa) };
+        if fh < host.shape.faces().len() && fo < other.shape.faces().len() {
+            let (origin, u, v) = face_frame(host.shape, fh);
+            let to2d = |p: Vector| DVec2::new(u.dot(p - origin), v.dot(p - origin));
+            let host_loop: Vec<DVec2> = host
+                .shape
+                .face_loop(fh)
+                .iter()
+                .map(|&i| to2d(host.shape.vertices()[i as usize]))
+                .collect();
+            let rel = host.pose.inv_mul(other.pose);
+            let mut overlap: Vec<DVec2> = other
+                .shape
+                .face_loop(fo)
+                .iter()
+                .rev()
+                .map(|&i| to2d(rel.transform_point(other.shape.vertices()[i as usize])))
+                .collect();
+            let mut tmp = Vec::new();
+            clip_convex(&mut overlap, &host_loop, &mut tmp);
+            let corners = hull2d(&overlap);
+            if corners.len() >= 3 {
+                return corners
+                    .into_iter()
+                    .map(|q| host.pose.transform_point(origin + u * q.x + v * q.y))
+                    .collect();
+            }
+        }
+    }
+    let Some(&o) = points.first() else {
+        return Vec::new();
+    };
+    let (u, v) = plane_basis(normal);
+    let flat: Vec<DVec2> = points.iter().map(|&p| DVec2::new(u.dot(p - o), v.dot(p - o))).collect();
+    hull2d(&flat).into_iter().map(|q| o + u * q.x + v * q.y).collect()
+}
+
 /// A material frame on face `f`: origin at its first vertex, `u` along its longest edge.
 pub(crate) fn face_frame(shape: &Polyhedron, f: usize) -> (Vector, Vector, Vector) {
     let ids = shape.face_loop(f);

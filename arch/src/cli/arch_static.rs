@@ -11,6 +11,9 @@
 //! change of the peak is `rate_convergence` in `summary.json`, and the run fails, naming the
 //! cases, if a quasi-static case moves by more than 3 %.
 //!
+//! Every case also gets the limit analysis of its settled arch (`limit_load_kn` and the limit
+//! mechanism in `summary.json` and the table, the second curve of `capacity_vs_friction.svg`).
+//!
 //! Writes `summary.json`, `force_displacement.csv`, `force_displacement.svg`,
 //! `capacity_vs_friction.svg` and a ParaView series of the baseline under `out/arch_static/`.
 
@@ -208,6 +211,16 @@ struct CaseSummary {
     end_load_kn: f64,
     settle_unbalanced_ratio: f64,
     mechanism: MechanismSummary,
+    /// The limit analysis of the settled arch (rigid blocks, associative Coulomb joints of the
+    /// case's friction, no tension): the plate's load on voussoir 5 at collapse.
+    limit_load_kn: f64,
+    limit_load_kn_per_m: f64,
+    /// DEM peak / limit load − 1 (%): by Radenković's theorem not above 0 but for the DEM's own
+    /// errors (`docs/benchmarks/arch-static.md`, "Limit analysis").
+    peak_over_limit_percent: f64,
+    limit_mechanism: voussoir::analysis::Mechanism,
+    /// Per joint of the ring: its opening and sliding rates in the limit mechanism.
+    limit_joints: Vec<voussoir::analysis::limit::JointMotion>,
     /// Per joint at the peak and at the end: open fraction, compression position, slip, hinge.
     joints_at_peak: Vec<voussoir::analysis::JointState>,
     joints_at_end: Vec<voussoir::analysis::JointState>,
@@ -282,6 +295,11 @@ fn summarise(r: &StaticResult, convergence: Option<&Convergence>) -> CaseSummary
             at_peak: r.mechanism_at_peak.clone(),
             at_end: r.mechanism_at_end.clone(),
         },
+        limit_load_kn: r.limit.load / 1e3,
+        limit_load_kn_per_m: r.limit.load / 1e3 / c.width,
+        peak_over_limit_percent: 100.0 * (r.peak_load / r.limit.load - 1.0),
+        limit_mechanism: r.limit.mechanism.clone(),
+        limit_joints: r.limit.joints.clone(),
         joints_at_peak: r.joints_at_peak.clone(),
         joints_at_end: r.joints_at_end.clone(),
         steps: r.steps,
@@ -339,7 +357,7 @@ fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
 
     println!();
     println!(
-        "{:<22} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7}  {:<44} {:>5}",
+        "{:<22} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7}  {:<44} {:>5} {:>8} {:>6}  limit mechanism",
         "case",
         "peak kN",
         "raw kN",
@@ -348,7 +366,9 @@ fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
         "refine %",
         "wall s",
         "mechanism at peak (i/e = intrados/extrados)",
-        "exp."
+        "exp.",
+        "limit kN",
+        "DEM/LA",
     );
     for (r, c) in &runs {
         let exp = if r.case.label == "baseline" {
@@ -357,7 +377,7 @@ fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
             String::new()
         };
         println!(
-            "{:<22} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8} {:>7.1}  {:<44} {:>5}",
+            "{:<22} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8} {:>7.1}  {:<44} {:>5} {:>8.3} {:>6.3}  {}",
             r.case.label,
             r.peak_load / 1e3,
             r.raw_peak_load / 1e3,
@@ -366,12 +386,16 @@ fn run_static(o: &StaticOptions, out: &Outputs) -> Result<(), BoxError> {
             c.map_or("-".into(), |c| format!("{:.2}", 100.0 * c.relative_change())),
             r.wall_s,
             r.mechanism_at_peak.describe(),
-            exp
+            exp,
+            r.limit.load / 1e3,
+            r.peak_load / r.limit.load,
+            r.limit.mechanism.describe()
         );
     }
     println!(
         "(peak: of the settled states under servo loading; in the rate study, of the load averaged over 1 mm of travel, \
-raw: with the mechanism's inertial oscillation; refine %: change of the peak when refined)"
+raw: with the mechanism's inertial oscillation; refine %: change of the peak when refined; \
+limit: rigid-block limit analysis of the settled arch, associative Coulomb joints, docs/theory.md §9)"
     );
     let b = &results[0];
     println!(
@@ -451,20 +475,26 @@ raw: with the mechanism's inertial oscillation; refine %: change of the peak whe
         ..Default::default()
     };
     out.svg("force_displacement.svg", &force_displacement)?;
-    let mut sweep: Vec<(f64, f64)> = results
+    let mut sweep: Vec<(f64, f64, f64)> = results
         .iter()
         .filter(|r| r.case.label == "baseline" || r.case.label.starts_with("friction"))
-        .map(|r| (r.case.friction_deg, r.peak_load / 1e3))
+        .map(|r| (r.case.friction_deg, r.peak_load / 1e3, r.limit.load / 1e3))
         .collect();
     sweep.sort_by(|a, b| a.0.total_cmp(&b.0));
     let capacity = LinePlot {
         title: "Capacity versus joint friction angle".into(),
         x_label: "friction angle [°]".into(),
         y_label: "peak load [kN]".into(),
-        curves: vec![Curve {
-            label: "model".into(),
-            points: sweep,
-        }],
+        curves: vec![
+            Curve {
+                label: "model (DEM, quasi-static peak)".into(),
+                points: sweep.iter().map(|p| (p.0, p.1)).collect(),
+            },
+            Curve {
+                label: "limit analysis (rigid blocks, associative)".into(),
+                points: sweep.iter().map(|p| (p.0, p.2)).collect(),
+            },
+        ],
         references: vec![Reference::Point {
             label: "experiment (φ = 30.5°)".into(),
             x: 30.5,

@@ -16,6 +16,7 @@
 //! ```
 
 pub mod arch_impact;
+pub mod arch_limit;
 pub mod arch_static;
 #[path = "../../../examples/common/args.rs"]
 pub mod args;
@@ -150,6 +151,11 @@ impl Outputs {
     /// The output folder.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// Whether ParaView series are written (not `--no-paraview`).
+    pub fn paraview(&self) -> bool {
+        self.paraview
     }
 
     /// Seconds since the run started.

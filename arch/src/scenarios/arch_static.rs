@@ -11,12 +11,15 @@
 //! inertia effects ([`StaticCase::rate_study`]), with local damping on, until the plate has
 //! travelled `max_displacement` or the load has fallen below `stop_fraction` of its peak.
 //! [`run_converged`] also runs the case refined and reports how much its peak moves.
+//! [`limit_analysis`] gives the rigid-block collapse load of the settled arch beside the DEM's
+//! peak (`docs/benchmarks/arch-static.md`, "Limit analysis").
 
 use std::ops::ControlFlow;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use voussoir::analysis::limit::{JointMotion, LimitOptions, LimitProblem, LimitResult, LiveLoad};
 use voussoir::analysis::{classify_joints, JointRef, JointState, Mechanism, MechanismCriteria};
 use voussoir::block::{Block, BlockId, Dof, Fixity, RigidBlock};
 use voussoir::build::arch::Arch;
@@ -221,6 +224,69 @@ pub struct StaticResult {
     pub subcontacts: usize,
     /// Wall-clock time (s).
     pub wall_s: Real,
+    /// The limit analysis of the settled arch under the plate's load ([`limit_analysis`]).
+    pub limit: LimitSummary,
+}
+
+/// The limit analysis of a case (`voussoir::analysis::limit`): the collapse load of the settled
+/// arch, with rigid blocks, no-tension Coulomb joints of the case's friction (associative) and
+/// the plate's load, beside the DEM's peak.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LimitSummary {
+    /// Vertical force of the plate on voussoir 5 at collapse (N): the live load's multiplier
+    /// plus the plate's weight, the quantity the DEM's load is (the plate–voussoir resultant).
+    pub load: Real,
+    /// The multiplier of the unit downward force on the plate (N).
+    pub multiplier: Real,
+    /// The plate's weight (N).
+    pub plate_weight: Real,
+    /// Hinges and sliding joints of the collapse mechanism.
+    pub mechanism: Mechanism,
+    /// How each joint of the ring moves in the mechanism.
+    pub joints: Vec<JointMotion>,
+    /// Wall-clock time of the analysis (s).
+    pub wall_s: Real,
+}
+
+/// Relative velocity (of the largest at any contact corner) above which a joint of the limit
+/// mechanism counts as hinging or sliding ([`LimitResult::classify`]).
+pub const LIMIT_MECHANISM_TOLERANCE: Real = 1e-3;
+
+/// The limit analysis of the arch as it stands in `model` (settled, before loading): the plate,
+/// driven vertically in the DEM, is loaded instead by a downward force at its centroid and is
+/// free vertically (it still slides and turns in the plane, as in the DEM); the joints' strength
+/// is the case's Coulomb law (friction, no cohesion, no tension).
+///
+/// # Errors
+/// The limit analysis's (`voussoir::Error::LimitInfeasible`, `LimitUnbounded`, `LimitSolver`).
+pub fn limit_analysis(model: &Model, plate: BlockId, joints: &[JointRef]) -> Result<(LimitSummary, LimitResult)> {
+    let started = Instant::now();
+    let mut problem = LimitProblem::from_model(model)?;
+    problem.set_fixity(
+        plate,
+        Fixity {
+            translation: [Dof::Free, Dof::Free, Dof::Fixed],
+            rotation: [Dof::Fixed, Dof::Fixed, Dof::Free],
+        },
+    )?;
+    let block = &model.blocks()[plate.index()];
+    let live = LiveLoad {
+        block: plate,
+        point: block.state().pose.translation,
+        force: -Vector::Y,
+    };
+    let result = problem.solve(&[live], &LimitOptions::default())?;
+    let plate_weight = block.mass_properties().mass * model.parameters().gravity.length();
+    let (motions, mechanism) = result.classify(model, joints, LIMIT_MECHANISM_TOLERANCE);
+    let summary = LimitSummary {
+        load: result.multiplier + plate_weight,
+        multiplier: result.multiplier,
+        plate_weight,
+        mechanism,
+        joints: motions,
+        wall_s: started.elapsed().as_secs_f64(),
+    };
+    Ok((summary, result))
 }
 
 /// The model of a case, with the ids of what it monitors.
@@ -408,6 +474,8 @@ pub fn run(
     } = build(case)?;
     let settle_steps = model.run_to_equilibrium(case.settle_ratio, 200_000)?;
     let settle_ratio = model.unbalanced_force_ratio();
+    // The limit analysis of the settled arch, once, before loading.
+    let (limit, _) = limit_analysis(&model, plate, &joints)?;
     if case.servo.is_none() {
         model.set_fixity(plate, plate_fixity(-case.rate))?;
     }
@@ -479,6 +547,7 @@ pub fn run(
         dt: model.dt(),
         subcontacts: model.subcontact_count(),
         wall_s: started.elapsed().as_secs_f64(),
+        limit,
     })
 }
 

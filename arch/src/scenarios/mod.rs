@@ -1,8 +1,9 @@
 //! Ready-made reproductions of published tests, shared by the examples and the integration
 //! tests: the quasi-static load test and the drop-weight impact tests of the reference arch
-//! (Pulatsu, Gonen & Lourenço 2021).
+//! (Pulatsu, Gonen & Lourenço 2021), and the limit analysis of its static test.
 
 pub mod arch_impact;
+pub mod arch_limit;
 pub mod arch_static;
 
 use voussoir::build::arch::{Arch, ArchSpec};

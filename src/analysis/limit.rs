@@ -1,0 +1,1029 @@
+//! Limit analysis of rigid-block assemblies: the largest multiplier `λ` of a live load that the
+//! blocks can carry in equilibrium with no-tension, Coulomb-frictional joints, and the collapse
+//! mechanism at it — the answer of RING or LiABlock beside the DEM's (`docs/theory.md` §9).
+//!
+//! The formulation (Livesley 1978; Gilbert, Casapulla & Ahmed 2006; Portioli et al. 2014): the
+//! blocks and face-face contacts of a [`Model`] as it stands (its current poses and contacts);
+//! at every corner of every contact polygon a normal force `n ≥ 0` and a shear force `t` with
+//! `‖t‖ ≤ μ n + c A/m` (the Coulomb cone, exact, as a second-order cone; `m` corners share the
+//! cohesion `c A`); six equilibrium equations per free block (force and moment about its
+//! centroid) under the dead loads (gravity × mass at the centroid, and the blocks' constant
+//! loads) and `λ` times the live loads; maximise `λ`. The programme is solved by
+//! [Clarabel](https://docs.rs/clarabel)'s interior-point method. The duals of the equilibrium
+//! equations are the blocks' virtual velocities in the collapse mechanism, which
+//! [`LimitResult::classify`] reads as hinges and sliding joints in the terms of
+//! [`classify_joints`](super::classify_joints).
+//!
+//! The flow rule of this (associative) formulation is dilatant: a sliding corner opens at
+//! `μ` times its slip rate. The DEM's Coulomb joints slide without dilatancy; by Radenković's
+//! theorem the associative limit load bounds the non-associative one from above.
+//!
+//! ```
+//! use voussoir::analysis::limit::{LimitOptions, LimitProblem, LiveLoad};
+//! use voussoir::prelude::*;
+//!
+//! // A 0.2 m × 0.2 m × 0.4 m pier on a fixed base, pushed sideways at the top.
+//! let mut model: Model = Model::new(ModelParameters::default())?;
+//! model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 40.0)?)?;
+//! model.add_block(
+//!     RigidBlock::cuboid("base", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), 2500.0)?
+//!         .with_fixity(Fixity::FIXED),
+//! )?;
+//! let pier = model.add_block(RigidBlock::cuboid("pier", Vector::ZERO, Vector::new(0.2, 0.2, 0.4), 2500.0)?)?;
+//! model.step()?; // detects the contact
+//! let problem = LimitProblem::from_model(&model)?;
+//! let push = LiveLoad { block: pier, point: Vector::new(0.0, 0.1, 0.4), force: Vector::X };
+//! let result = problem.solve(&[push], &LimitOptions::default())?;
+//! // Overturning about the toe: λ h = W b/2.
+//! let weight = 2500.0 * 0.016 * 9.81;
+//! assert!((result.multiplier - weight * 0.1 / 0.4).abs() < 1e-4 * weight);
+//! // The mechanism: the pier turns about the toe at x = 0.2 (clockwise seen from +y).
+//! let (v, w) = result.block_velocity(pier).expect("a block of the model");
+//! assert!(v.x > 0.0 && w.y > 0.0);
+//! # Ok::<(), voussoir::Error>(())
+//! ```
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+#[cfg(feature = "serde")]
+use serde::{Deserialize, Serialize};
+
+use super::mechanism::{Hinge, HingeSide, JointRef, Mechanism};
+use crate::block::{Block, BlockId, Dof, Fixity};
+use crate::error::{non_negative, Error, Result};
+use crate::geometry::{contact_polygon, BlockGeometry};
+use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, LinearElastic};
+use crate::math::{Pose, Real, Rotation, Vector};
+use crate::model::Model;
+
+/// The strength of a joint in limit analysis: the Coulomb cone `‖t‖ ≤ μ n + c A` over its area
+/// `A`, with no tension.
+///
+/// ```
+/// use voussoir::analysis::limit::JointStrength;
+/// let s = JointStrength::from_degrees(30.5, 0.0)?;
+/// assert!((s.friction - 30.5f64.to_radians().tan()).abs() < 1e-15);
+/// assert!(JointStrength::new(-0.1, 0.0).is_err());
+/// # Ok::<(), voussoir::Error>(())
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct JointStrength {
+    /// Friction coefficient `μ = tan φ`.
+    pub friction: Real,
+    /// Cohesion `c` (Pa), shared equally by the polygon's corners.
+    pub cohesion: Real,
+}
+
+impl JointStrength {
+    /// A joint with friction coefficient `μ` and cohesion `c` (Pa).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a negative or non-finite value.
+    pub fn new(friction: Real, cohesion: Real) -> Result<Self> {
+        Ok(Self {
+            friction: non_negative("limit analysis friction coefficient", friction)?,
+            cohesion: non_negative("limit analysis cohesion", cohesion)?,
+        })
+    }
+
+    /// A joint with friction angle `φ` (degrees, in `[0°, 90°)`) and cohesion `c` (Pa).
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for an angle outside `[0°, 90°)` or a bad cohesion.
+    pub fn from_degrees(friction_deg: Real, cohesion: Real) -> Result<Self> {
+        crate::error::in_range(
+            "limit analysis friction angle (degrees)",
+            friction_deg,
+            0.0,
+            90.0,
+            "must lie in [0°, 90°)",
+        )?;
+        Self::new(friction_deg.to_radians().tan(), cohesion)
+    }
+}
+
+/// Joint laws that know their strength for limit analysis.
+///
+/// [`CoulombSlip`] gives its (initial) friction angle and cohesion — the intact joint's; its
+/// tensile strength is left out (no tension). A law with no strength limit
+/// ([`LinearElastic`]) gives `None`, and [`LimitProblem::from_model`] refuses its contacts; give
+/// their strength with [`LimitProblem::from_model_with`].
+pub trait LimitStrength {
+    /// The joint's strength, or `None` when the law has no strength limit.
+    fn limit_strength(&self) -> Option<JointStrength>;
+}
+
+impl LimitStrength for CoulombSlip {
+    fn limit_strength(&self) -> Option<JointStrength> {
+        Some(JointStrength {
+            friction: self.friction_angle().tan(),
+            cohesion: self.cohesion(),
+        })
+    }
+}
+
+impl LimitStrength for LinearElastic {
+    fn limit_strength(&self) -> Option<JointStrength> {
+        None
+    }
+}
+
+impl LimitStrength for AnyLaw {
+    fn limit_strength(&self) -> Option<JointStrength> {
+        match self {
+            AnyLaw::Coulomb(law) => law.limit_strength(),
+            AnyLaw::Elastic(law) => law.limit_strength(),
+        }
+    }
+}
+
+/// How the Coulomb cone is imposed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub enum FrictionModel {
+    /// The exact cone `‖t‖ ≤ μ n + c A/m`, a second-order cone (the default).
+    #[default]
+    Cone,
+    /// A pyramid of `facets` planes (at least 3) inscribed in the cone, the first facing the
+    /// joint's first tangent: `t·d_k ≤ cos(π/facets) (μ n + c A/m)`. A linear programme whose
+    /// answer is a lower bound of the cone's, by at most `1 − cos(π/facets)` (1.9 % at 16
+    /// facets) when the joint slides.
+    Pyramid {
+        /// Number of planes.
+        facets: usize,
+    },
+}
+
+/// Settings of a limit analysis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct LimitOptions {
+    /// Cone or pyramid. Default: the cone.
+    pub friction: FrictionModel,
+    /// Also check that the dead loads alone are carried (`λ = 0` admissible), a second solve
+    /// of the same size. Default `true`. Without it a structure that stands only when pushed by
+    /// the live load gets its largest multiplier without complaint.
+    pub check_dead_load: bool,
+    /// Interior-point iteration limit. Default 200 (Clarabel's).
+    pub max_iterations: u32,
+}
+
+impl Default for LimitOptions {
+    fn default() -> Self {
+        Self {
+            friction: FrictionModel::Cone,
+            check_dead_load: true,
+            max_iterations: 200,
+        }
+    }
+}
+
+/// A live load: the force `λ · force` on `block` at `point`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct LiveLoad {
+    /// The loaded block.
+    pub block: BlockId,
+    /// Where the force acts (m, world).
+    pub point: Vector,
+    /// The force per unit multiplier (N): with a unit vector, `λ` is in newtons.
+    pub force: Vector,
+}
+
+/// One corner of a contact polygon with its forces and the mechanism's relative motion there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct LimitVertex {
+    /// The corner (m, world).
+    pub point: Vector,
+    /// Normal force (N, compression positive).
+    pub normal_force: Real,
+    /// Shear force on block `b` (N, world, in the joint plane).
+    pub shear_force: Vector,
+    /// Opening rate `n·(v_b − v_a)` in the mechanism (m/s on the mechanism's scale, ≥ 0 up to
+    /// the solver's tolerance).
+    pub opening: Real,
+    /// Sliding rate `|(v_b − v_a)_t|` in the mechanism.
+    pub sliding: Real,
+}
+
+/// A contact at collapse: its blocks, normal and polygon corners.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct LimitContact {
+    /// The two blocks, `a < b`.
+    pub blocks: (BlockId, BlockId),
+    /// Unit normal from `a` to `b`.
+    pub normal: Vector,
+    /// The polygon's corners.
+    pub vertices: Vec<LimitVertex>,
+}
+
+impl LimitContact {
+    /// Sum of the corners' forces on block `b` (N).
+    pub fn resultant(&self) -> Vector {
+        self.vertices
+            .iter()
+            .map(|v| self.normal * v.normal_force + v.shear_force)
+            .sum()
+    }
+}
+
+/// A block's rigid motion in the collapse mechanism: velocity of its centroid and angular
+/// velocity (zero for supports and constrained degrees of freedom).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct BlockMotion {
+    /// Centroid (m, world).
+    pub centroid: Vector,
+    /// Velocity of the centroid.
+    pub velocity: Vector,
+    /// Angular velocity (rad per unit of the mechanism's time).
+    pub angular_velocity: Vector,
+}
+
+/// How a joint moves in the mechanism, at its two edge points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct JointMotion {
+    /// Joint label.
+    pub joint: usize,
+    /// Opening rate at the intrados point (relative normal velocity, positive = opening).
+    pub opening_intrados: Real,
+    /// Opening rate at the extrados point.
+    pub opening_extrados: Real,
+    /// Sliding rate at the edge that opens less (where a hinge turns).
+    pub sliding: Real,
+    /// Hinge, if any.
+    pub hinge: Option<HingeSide>,
+    /// Whether the joint slides.
+    pub is_sliding: bool,
+}
+
+/// The answer of [`LimitProblem::solve`].
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct LimitResult {
+    /// The collapse multiplier `λ`: the live loads at collapse are `λ` times theirs.
+    pub multiplier: Real,
+    /// The contacts with their corner forces at collapse (a statically admissible set; it is
+    /// not unique where the structure is hyperstatic at collapse).
+    pub contacts: Vec<LimitContact>,
+    /// Per block of the model, in order: its motion in the mechanism, scaled so that the live
+    /// loads' power is `Σ |force|` (one live load of unit direction: its point moves at unit
+    /// speed along it).
+    pub blocks: Vec<BlockMotion>,
+    /// Clarabel's status (`Solved` or `AlmostSolved`).
+    pub status: String,
+    /// Interior-point iterations.
+    pub iterations: u32,
+}
+
+impl LimitResult {
+    /// Velocity and angular velocity of `block` in the mechanism, `None` for an unknown id.
+    pub fn block_velocity(&self, block: BlockId) -> Option<(Vector, Vector)> {
+        self.blocks.get(block.index()).map(|m| (m.velocity, m.angular_velocity))
+    }
+
+    /// Velocity of the material point of `block` at `point` (world) in the mechanism.
+    pub fn point_velocity(&self, block: BlockId, point: Vector) -> Option<Vector> {
+        self.blocks
+            .get(block.index())
+            .map(|m| m.velocity + m.angular_velocity.cross(point - m.centroid))
+    }
+
+    /// The rigid motion of `block` after advancing the mechanism by `t`: a turn by `ω t` about
+    /// its centroid and a translation by `v t`, to put on top of the block's pose (a frame of
+    /// the mechanism for ParaView). The identity for an unknown id.
+    pub fn displacement(&self, block: BlockId, t: Real) -> Pose {
+        let Some(m) = self.blocks.get(block.index()) else {
+            return Pose::IDENTITY;
+        };
+        let rotation = Rotation::from_scaled_axis(m.angular_velocity * t);
+        // x ↦ c + v t + R (x − c)
+        Pose::from_parts(m.centroid + m.velocity * t - rotation * m.centroid, rotation)
+    }
+
+    /// The contact between `a` and `b` (either order).
+    pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<&LimitContact> {
+        let key = (a.min(b), a.max(b));
+        self.contacts.iter().find(|c| c.blocks == key)
+    }
+
+    /// Names the mechanism's hinges and sliding joints at `joints`, as
+    /// [`classify_joints`](super::classify_joints) does for the DEM's states, from the relative
+    /// velocity `v_rel = v_b − v_a` of the joint's blocks at its intrados and extrados points
+    /// (mapped from the blocks' initial poses to where they were analysed, like
+    /// `classify_joints`):
+    ///
+    /// * a joint moves when `|v_rel|` at either point exceeds `tolerance` times the largest
+    ///   relative speed at any contact corner;
+    /// * it is a **hinge** when the opening rates at its two points differ by more than that
+    ///   (a relative rotation about an axis in the joint), about the edge that opens less;
+    /// * it **slides** when the tangential relative speed at the edge that opens less exceeds
+    ///   it (about a hinge edge the relative velocity vanishes). Sliding is dilatant
+    ///   (associative flow): the joint opens at `μ` times the slip rate as well.
+    ///
+    /// `tolerance` 1e-3 suits a converged interior-point answer (duals to ~1e-8); where the
+    /// mechanism is not unique the duals are a blend of the admissible ones.
+    pub fn classify<L: ConstitutiveLaw>(
+        &self,
+        model: &Model<L>,
+        joints: &[JointRef],
+        tolerance: Real,
+    ) -> (Vec<JointMotion>, Mechanism) {
+        let scale = self
+            .contacts
+            .iter()
+            .flat_map(|c| c.vertices.iter().map(|v| v.opening.hypot(v.sliding)))
+            .fold(0.0, Real::max);
+        let tol = tolerance * scale;
+        let mut motions = Vec::with_capacity(joints.len());
+        let mut mechanism = Mechanism::default();
+        for j in joints {
+            let (a, b) = j.blocks;
+            let normal = match self.contact_between(a, b) {
+                Some(c) if c.blocks.0 == a => c.normal,
+                Some(c) => -c.normal,
+                None => {
+                    motions.push(JointMotion {
+                        joint: j.index,
+                        opening_intrados: 0.0,
+                        opening_extrados: 0.0,
+                        sliding: 0.0,
+                        hinge: None,
+                        is_sliding: false,
+                    });
+                    continue;
+                }
+            };
+            // Edge points move with the first block, as in `classify_joints`.
+            let here = |p: Vector| match model.blocks().get(a.index()) {
+                Some(block) => block.world_point(block.initial_pose().inverse_transform_point(p)),
+                None => p,
+            };
+            let rel = |p: Vector| {
+                let vb = self.point_velocity(b, p).unwrap_or(Vector::ZERO);
+                let va = self.point_velocity(a, p).unwrap_or(Vector::ZERO);
+                vb - va
+            };
+            let (pi, pe) = (here(j.intrados), here(j.extrados));
+            let (ri, re) = (rel(pi), rel(pe));
+            let (oi, oe) = (normal.dot(ri), normal.dot(re));
+            let tangential = |r: Vector, o: Real| (r - normal * o).length();
+            let (si, se) = (tangential(ri, oi), tangential(re, oe));
+            let moving = ri.length().max(re.length()) > tol;
+            let hinge = (moving && (oe - oi).abs() > tol).then_some(if oi < oe {
+                HingeSide::Intrados
+            } else {
+                HingeSide::Extrados
+            });
+            let sliding = if oi <= oe { si } else { se };
+            let is_sliding = moving && sliding > tol;
+            if let Some(side) = hinge {
+                mechanism.hinges.push(Hinge { joint: j.index, side });
+            }
+            if is_sliding {
+                mechanism.sliding_joints.push(j.index);
+            }
+            motions.push(JointMotion {
+                joint: j.index,
+                opening_intrados: oi,
+                opening_extrados: oe,
+                sliding,
+                hinge,
+                is_sliding,
+            });
+        }
+        (motions, mechanism)
+    }
+}
+
+/// What the programme needs of one block.
+#[derive(Debug, Clone)]
+struct BlockData {
+    name: String,
+    centroid: Vector,
+    /// Free degrees of freedom: translations x, y, z, rotations x, y, z.
+    free: [bool; 6],
+    /// Dead load: gravity and the block's constant load (force; moment about the centroid).
+    dead_force: Vector,
+    dead_moment: Vector,
+    radius: Real,
+    weight: Real,
+}
+
+/// What the programme needs of one contact.
+#[derive(Debug, Clone)]
+struct ContactData {
+    a: usize,
+    b: usize,
+    normal: Vector,
+    t1: Vector,
+    t2: Vector,
+    vertices: Vec<Vector>,
+    /// Cohesive force per corner (N): `c A / m`.
+    cohesion_share: Real,
+    friction: Real,
+}
+
+/// The limit-analysis programme of a model's blocks and contacts as they stand.
+///
+/// Build it from a model whose contacts have been detected (after at least one step, e.g. once
+/// it has settled under gravity), then [`solve`](LimitProblem::solve) it for a live load. The
+/// contact polygons are the contacts' own: for a face-face contact the overlap of the two faces
+/// (`docs/theory.md` §2.2), for a point contact the hull of its sub-contacts (a segment or a
+/// point). Contacts whose blocks are both supports are left out.
+#[derive(Debug, Clone)]
+pub struct LimitProblem {
+    blocks: Vec<BlockData>,
+    contacts: Vec<ContactData>,
+}
+
+impl LimitProblem {
+    /// The programme of `model` with each contact's strength from its joint law
+    /// ([`LimitStrength`]).
+    ///
+    /// # Errors
+    /// As [`LimitProblem::from_model_with`].
+    pub fn from_model<L: ConstitutiveLaw + LimitStrength>(model: &Model<L>) -> Result<Self> {
+        Self::from_model_with(model, |law: &L| law.limit_strength())
+    }
+
+    /// The programme of `model` with each contact's strength given by `strength` from its
+    /// joint law (e.g. a table of your own per pair of materials, or a law of your own).
+    ///
+    /// # Errors
+    /// [`Error::Unsupported`] naming the contact whose law `strength` gives no strength for;
+    /// [`Error::InvalidParameter`] for a negative or non-finite strength.
+    pub fn from_model_with<L: ConstitutiveLaw>(
+        model: &Model<L>,
+        strength: impl Fn(&L) -> Option<JointStrength>,
+    ) -> Result<Self> {
+        let gravity = model.parameters().gravity;
+        let blocks: Vec<BlockData> = model
+            .blocks()
+            .iter()
+            .map(|b| {
+                let mass = b.mass_properties().mass;
+                let load = b.load();
+                BlockData {
+                    name: b.name().to_owned(),
+                    centroid: b.state().pose.translation,
+                    free: free_dofs(b.fixity()),
+                    dead_force: gravity * mass + load.force,
+                    dead_moment: load.moment,
+                    radius: b.shape().radius(),
+                    weight: (gravity * mass).length(),
+                }
+            })
+            .collect();
+        let mut contacts = Vec::new();
+        for view in model.contacts() {
+            let (a, b) = view.blocks();
+            let (ia, ib) = (a.index(), b.index());
+            if !blocks[ia].free.iter().chain(&blocks[ib].free).any(|&f| f) {
+                continue;
+            }
+            let law = &model.law_table().laws()[view.law_index()];
+            let s = strength(law).ok_or_else(|| Error::Unsupported {
+                what: format!(
+                    "limit analysis of the contact between blocks {a} ({:?}) and {b} ({:?}): its joint law has no \
+                     strength limit; give one with LimitProblem::from_model_with",
+                    blocks[ia].name, blocks[ib].name
+                ),
+            })?;
+            let s = JointStrength::new(s.friction, s.cohesion)?;
+            let (ba, bb) = (&model.blocks()[ia], &model.blocks()[ib]);
+            let points: Vec<Vector> = view.points().collect();
+            let vertices = contact_polygon(
+                BlockGeometry {
+                    shape: ba.shape(),
+                    pose: &ba.state().pose,
+                },
+                BlockGeometry {
+                    shape: bb.shape(),
+                    pose: &bb.state().pose,
+                },
+                view.kind(),
+                view.host_is_a(),
+                view.normal(),
+                &points,
+            );
+            if vertices.is_empty() {
+                continue;
+            }
+            let area: Real = view.subcontacts().map(|s| s.area()).sum();
+            let axes = view.axes();
+            contacts.push(ContactData {
+                a: ia,
+                b: ib,
+                normal: axes.normal,
+                t1: axes.tangent,
+                t2: axes.tangent_2(),
+                cohesion_share: s.cohesion * area / vertices.len() as Real,
+                friction: s.friction,
+                vertices,
+            });
+        }
+        Ok(Self { blocks, contacts })
+    }
+
+    /// Replaces the fixity of `block` for the analysis: e.g. a loading plate driven in the DEM
+    /// (its vertical velocity prescribed) that the limit analysis loads by force instead.
+    /// Equilibrium is written for the free degrees of freedom only; a constrained one is a
+    /// support that takes any reaction.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn set_fixity(&mut self, block: BlockId, fixity: Fixity) -> Result<()> {
+        let count = self.blocks.len();
+        let data = self
+            .blocks
+            .get_mut(block.index())
+            .ok_or(Error::UnknownBlock { id: block, count })?;
+        data.free = free_dofs(&fixity);
+        Ok(())
+    }
+
+    /// Number of contacts in the programme.
+    pub fn contact_count(&self) -> usize {
+        self.contacts.len()
+    }
+
+    /// The contacts' blocks and polygon corners (m, world).
+    pub fn polygons(&self) -> impl Iterator<Item = ((BlockId, BlockId), &[Vector])> + '_ {
+        self.contacts
+            .iter()
+            .map(|c| ((BlockId(c.a as u32), BlockId(c.b as u32)), c.vertices.as_slice()))
+    }
+
+    /// The largest multiplier `λ` of `live` that the blocks carry, with the forces at collapse
+    /// and the mechanism.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`] or [`Error::NonFinite`] for a bad live load,
+    /// [`Error::InvalidParameter`] for a zero live load or a pyramid of fewer than 3 facets;
+    /// [`Error::LimitInfeasible`] when the dead loads are not carried (no admissible `λ`, or
+    /// only negative ones, or — with [`LimitOptions::check_dead_load`] — only positive ones);
+    /// [`Error::LimitUnbounded`] when `λ` has no bound; [`Error::LimitSolver`] when Clarabel
+    /// stops without an answer.
+    pub fn solve(&self, live: &[LiveLoad], options: &LimitOptions) -> Result<LimitResult> {
+        self.check_live(live)?;
+        let scales = self.scales(live);
+        let programme = self.assemble(Some(live), options.friction, &scales)?;
+        let (solution, status, iterations) = programme.run(options.max_iterations)?;
+        match status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {}
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                return Err(Error::LimitInfeasible {
+                    reason: "no contact forces within the joints' strength carry the dead loads, whatever the live \
+                             load"
+                        .into(),
+                })
+            }
+            SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => {
+                return Err(Error::LimitUnbounded {
+                    reason: format!(
+                        "the live load ({}) is carried whatever its size: it acts on constrained degrees of freedom, \
+                         goes straight into the supports, or wedges blocks that friction locks",
+                        describe_live(live, &self.blocks)
+                    ),
+                })
+            }
+            other => {
+                return Err(Error::LimitSolver {
+                    status: format!("{other:?}"),
+                    iterations,
+                })
+            }
+        }
+        let multiplier = solution.x[0] * scales.multiplier;
+        if solution.x[0] < -FEASIBILITY_TOLERANCE {
+            return Err(Error::LimitInfeasible {
+                reason: format!(
+                    "the largest admissible multiplier of the live load is {multiplier:.6e} < 0: the dead loads are \
+                     carried only with a live load against its direction"
+                ),
+            });
+        }
+        if options.check_dead_load && !self.carries_dead_load(options)? {
+            return Err(Error::LimitInfeasible {
+                reason: format!(
+                    "the dead loads alone are not carried; the structure stands only with part of the live load \
+                     (largest multiplier {multiplier:.6e})"
+                ),
+            });
+        }
+        Ok(self.result(&programme, &solution, &scales, multiplier, status, iterations))
+    }
+
+    /// Whether the dead loads alone are carried: whether contact forces within the joints'
+    /// strength equilibrate every free block under gravity and the blocks' constant loads.
+    /// (The structure "can carry its own weight".)
+    ///
+    /// # Errors
+    /// [`Error::InvalidParameter`] for a pyramid of fewer than 3 facets; [`Error::LimitSolver`]
+    /// when Clarabel stops without an answer or a certificate.
+    pub fn carries_dead_load(&self, options: &LimitOptions) -> Result<bool> {
+        let scales = self.scales(&[]);
+        let programme = self.assemble(None, options.friction, &scales)?;
+        let (_, status, iterations) = programme.run(options.max_iterations)?;
+        match status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(true),
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Ok(false),
+            other => Err(Error::LimitSolver {
+                status: format!("{other:?}"),
+                iterations,
+            }),
+        }
+    }
+
+    fn check_live(&self, live: &[LiveLoad]) -> Result<()> {
+        if live.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "live loads (count)".into(),
+                value: 0.0,
+                expected: "at least one live load",
+            });
+        }
+        for (k, l) in live.iter().enumerate() {
+            if l.block.index() >= self.blocks.len() {
+                return Err(Error::UnknownBlock {
+                    id: l.block,
+                    count: self.blocks.len(),
+                });
+            }
+            if !(l.point.is_finite() && l.force.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: format!("live load {k} (on block {})", l.block),
+                });
+            }
+        }
+        let total: Real = live.iter().map(|l| l.force.length()).sum();
+        if total <= 0.0 {
+            return Err(Error::InvalidParameter {
+                name: "live load force".into(),
+                value: total,
+                expected: "must not be zero",
+            });
+        }
+        Ok(())
+    }
+
+    /// Reference force, length and multiplier scale of the programme.
+    fn scales(&self, live: &[LiveLoad]) -> Scales {
+        let free: Vec<&BlockData> = self.blocks.iter().filter(|b| b.free.iter().any(|&f| f)).collect();
+        let weight: Real = free.iter().map(|b| b.weight.max(b.dead_force.length())).sum();
+        let force = if weight > 0.0 { weight } else { 1.0 };
+        let length = if free.is_empty() {
+            1.0
+        } else {
+            free.iter().map(|b| b.radius).sum::<Real>() / free.len() as Real
+        };
+        let live_total: Real = live.iter().map(|l| l.force.length()).sum();
+        Scales {
+            force,
+            length,
+            live: if live_total > 0.0 { live_total } else { 1.0 },
+            multiplier: force / if live_total > 0.0 { live_total } else { 1.0 },
+        }
+    }
+
+    /// The conic programme in Clarabel's form: minimise `qᵀx` subject to `A x + s = b`,
+    /// `s ∈ K`; variables `[λ̂?, per corner: n̂, t̂₁, t̂₂]` in units of the reference force.
+    fn assemble(&self, live: Option<&[LiveLoad]>, friction: FrictionModel, sc: &Scales) -> Result<Programme> {
+        if let FrictionModel::Pyramid { facets } = friction {
+            if facets < 3 {
+                return Err(Error::InvalidParameter {
+                    name: "limit analysis pyramid facets".into(),
+                    value: facets as Real,
+                    expected: "at least 3",
+                });
+            }
+        }
+        // Equilibrium rows: the free degrees of freedom.
+        let mut row_of = vec![None; 6 * self.blocks.len()];
+        let mut rows = 0;
+        for (k, b) in self.blocks.iter().enumerate() {
+            for d in 0..6 {
+                if b.free[d] {
+                    row_of[6 * k + d] = Some(rows);
+                    rows += 1;
+                }
+            }
+        }
+        let equilibrium_rows = rows;
+        let mut eq = Triplets::default();
+        let mut b_eq = vec![0.0; equilibrium_rows];
+        for (k, b) in self.blocks.iter().enumerate() {
+            for d in 0..3 {
+                if let Some(r) = row_of[6 * k + d] {
+                    b_eq[r] = -b.dead_force[d] / sc.force;
+                }
+                if let Some(r) = row_of[6 * k + 3 + d] {
+                    b_eq[r] = -b.dead_moment[d] / (sc.force * sc.length);
+                }
+            }
+        }
+        // A force `dir` (per unit of the variable) at `p` on block `k`.
+        let add_force = |eq: &mut Triplets, k: usize, p: Vector, dir: Vector, col: usize| {
+            let m = (p - self.blocks[k].centroid).cross(dir) / sc.length;
+            for d in 0..3 {
+                if let Some(r) = row_of[6 * k + d] {
+                    eq.push(r, col, dir[d]);
+                }
+                if let Some(r) = row_of[6 * k + 3 + d] {
+                    eq.push(r, col, m[d]);
+                }
+            }
+        };
+        let mut columns = 0;
+        let has_live = live.is_some();
+        if let Some(live) = live {
+            for l in live {
+                add_force(&mut eq, l.block.index(), l.point, l.force / sc.live, 0);
+            }
+            columns = 1;
+        }
+        // Corner variables.
+        let mut corners = Vec::new();
+        for (c, contact) in self.contacts.iter().enumerate() {
+            let shear = contact.friction > 0.0 || contact.cohesion_share > 0.0;
+            for &p in &contact.vertices {
+                let n = columns;
+                columns += 1;
+                let t = shear.then(|| {
+                    columns += 2;
+                    (n + 1, n + 2)
+                });
+                for (dir, col) in std::iter::once((contact.normal, n))
+                    .chain(t.into_iter().flat_map(|(t1, t2)| [(contact.t1, t1), (contact.t2, t2)]))
+                {
+                    add_force(&mut eq, contact.b, p, dir, col);
+                    add_force(&mut eq, contact.a, p, -dir, col);
+                }
+                corners.push(Corner {
+                    contact: c,
+                    point: p,
+                    n,
+                    t,
+                });
+            }
+        }
+        // Cones: no tension, then friction.
+        let mut a = eq;
+        let mut b = b_eq;
+        let mut cones = vec![SupportedConeT::ZeroConeT(equilibrium_rows)];
+        let equations = equilibrium_rows;
+        let mut row = equilibrium_rows;
+        let mut nonneg = 0;
+        for corner in &corners {
+            a.push(row, corner.n, -1.0);
+            b.push(0.0);
+            row += 1;
+            nonneg += 1;
+        }
+        let mut socs = 0;
+        match friction {
+            FrictionModel::Pyramid { facets } => {
+                let inscribed = (std::f64::consts::PI / facets as Real).cos();
+                for corner in &corners {
+                    let Some((t1, t2)) = corner.t else { continue };
+                    let contact = &self.contacts[corner.contact];
+                    for k in 0..facets {
+                        let angle = 2.0 * std::f64::consts::PI * k as Real / facets as Real;
+                        a.push(row, corner.n, -inscribed * contact.friction);
+                        a.push(row, t1, angle.cos());
+                        a.push(row, t2, angle.sin());
+                        b.push(inscribed * contact.cohesion_share / sc.force);
+                        row += 1;
+                        nonneg += 1;
+                    }
+                }
+                cones.push(SupportedConeT::NonnegativeConeT(nonneg));
+            }
+            FrictionModel::Cone => {
+                cones.push(SupportedConeT::NonnegativeConeT(nonneg));
+                for corner in &corners {
+                    let Some((t1, t2)) = corner.t else { continue };
+                    let contact = &self.contacts[corner.contact];
+                    a.push(row, corner.n, -contact.friction);
+                    b.push(contact.cohesion_share / sc.force);
+                    a.push(row + 1, t1, -1.0);
+                    b.push(0.0);
+                    a.push(row + 2, t2, -1.0);
+                    b.push(0.0);
+                    row += 3;
+                    socs += 1;
+                }
+                cones.extend(std::iter::repeat_n(SupportedConeT::SecondOrderConeT(3), socs));
+            }
+        }
+        let mut q = vec![0.0; columns];
+        if has_live {
+            q[0] = -1.0;
+        }
+        cones.retain(|c| !matches!(c, SupportedConeT::ZeroConeT(0) | SupportedConeT::NonnegativeConeT(0)));
+        Ok(Programme {
+            equations,
+            a: a.into_csc(row, columns),
+            b,
+            q,
+            cones,
+            row_of,
+            corners,
+        })
+    }
+
+    fn result(
+        &self,
+        programme: &Programme,
+        solution: &Solution,
+        sc: &Scales,
+        multiplier: Real,
+        status: SolverStatus,
+        iterations: u32,
+    ) -> LimitResult {
+        let blocks: Vec<BlockMotion> = self
+            .blocks
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                let dual = |d: usize| programme.row_of[6 * k + d].map_or(0.0, |r| solution.z[r]);
+                BlockMotion {
+                    centroid: b.centroid,
+                    velocity: Vector::new(dual(0), dual(1), dual(2)),
+                    angular_velocity: Vector::new(dual(3), dual(4), dual(5)) / sc.length,
+                }
+            })
+            .collect();
+        let velocity_at = |k: usize, p: Vector| {
+            let m = &blocks[k];
+            m.velocity + m.angular_velocity.cross(p - m.centroid)
+        };
+        let mut contacts: Vec<LimitContact> = self
+            .contacts
+            .iter()
+            .map(|c| LimitContact {
+                blocks: (BlockId(c.a as u32), BlockId(c.b as u32)),
+                normal: c.normal,
+                vertices: Vec::with_capacity(c.vertices.len()),
+            })
+            .collect();
+        for corner in &programme.corners {
+            let c = &self.contacts[corner.contact];
+            let (t1, t2) = corner.t.map_or((0.0, 0.0), |(i, j)| (solution.x[i], solution.x[j]));
+            let rel = velocity_at(c.b, corner.point) - velocity_at(c.a, corner.point);
+            let opening = c.normal.dot(rel);
+            contacts[corner.contact].vertices.push(LimitVertex {
+                point: corner.point,
+                normal_force: solution.x[corner.n] * sc.force,
+                shear_force: (c.t1 * t1 + c.t2 * t2) * sc.force,
+                opening,
+                sliding: (rel - c.normal * opening).length(),
+            });
+        }
+        LimitResult {
+            multiplier,
+            contacts,
+            blocks,
+            status: format!("{status:?}"),
+            iterations,
+        }
+    }
+}
+
+/// Below this (in units of the reference force) a negative multiplier is round-off.
+const FEASIBILITY_TOLERANCE: Real = 1e-7;
+
+fn free_dofs(f: &Fixity) -> [bool; 6] {
+    let free = |d: &Dof| matches!(d, Dof::Free);
+    [
+        free(&f.translation[0]),
+        free(&f.translation[1]),
+        free(&f.translation[2]),
+        free(&f.rotation[0]),
+        free(&f.rotation[1]),
+        free(&f.rotation[2]),
+    ]
+}
+
+fn describe_live(live: &[LiveLoad], blocks: &[BlockData]) -> String {
+    live.iter()
+        .map(|l| {
+            format!(
+                "{} N on block {} ({:?})",
+                l.force.length(),
+                l.block,
+                blocks.get(l.block.index()).map_or("?", |b| b.name.as_str())
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Scales {
+    /// Reference force (N): the free blocks' weight.
+    force: Real,
+    /// Reference length (m): their mean radius.
+    length: Real,
+    /// Sum of the live loads' magnitudes (N).
+    live: Real,
+    /// `λ = multiplier × λ̂`.
+    multiplier: Real,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Corner {
+    contact: usize,
+    point: Vector,
+    n: usize,
+    t: Option<(usize, usize)>,
+}
+
+#[derive(Debug, Default)]
+struct Triplets {
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    values: Vec<Real>,
+}
+
+impl Triplets {
+    fn push(&mut self, r: usize, c: usize, v: Real) {
+        if v != 0.0 {
+            self.rows.push(r);
+            self.cols.push(c);
+            self.values.push(v);
+        }
+    }
+    fn into_csc(self, m: usize, n: usize) -> CscMatrix<Real> {
+        CscMatrix::new_from_triplets(m, n, self.rows, self.cols, self.values)
+    }
+}
+
+struct Programme {
+    /// Number of equilibrium rows (the first rows).
+    equations: usize,
+    a: CscMatrix<Real>,
+    b: Vec<Real>,
+    q: Vec<Real>,
+    cones: Vec<SupportedConeT<Real>>,
+    row_of: Vec<Option<usize>>,
+    corners: Vec<Corner>,
+}
+
+struct Solution {
+    x: Vec<Real>,
+    z: Vec<Real>,
+}
+
+impl Programme {
+    fn run(&self, max_iterations: u32) -> Result<(Solution, SolverStatus, u32)> {
+        let n = self.q.len();
+        if n == 0 || self.equations == 0 {
+            // Nothing to solve: no contact forces, or no equation. With no equation the
+            // multiplier is unbounded (the programme's only cost) and the dead loads are carried.
+            let carried = self.b[..self.equations]
+                .iter()
+                .all(|v| v.abs() <= FEASIBILITY_TOLERANCE);
+            let status = match (carried, n > 0 && self.q[0] != 0.0 && self.equations == 0) {
+                (false, _) => SolverStatus::PrimalInfeasible,
+                (true, true) => SolverStatus::DualInfeasible,
+                (true, false) => SolverStatus::Solved,
+            };
+            return Ok((
+                Solution {
+                    x: vec![0.0; n],
+                    z: vec![0.0; self.b.len()],
+                },
+                status,
+                0,
+            ));
+        }
+        let p = CscMatrix::zeros((n, n));
+        let settings = DefaultSettings {
+            verbose: false,
+            max_iter: max_iterations,
+            ..DefaultSettings::default()
+        };
+        let mut solver = DefaultSolver::new(&p, &self.q, &self.a, &self.b, &self.cones, settings).map_err(|e| {
+            Error::LimitSolver {
+                status: format!("refused the programme: {e}"),
+                iterations: 0,
+            }
+        })?;
+        solver.solve();
+        let s = &solver.solution;
+        Ok((
+            Solution {
+                x: s.x.clone(),
+                z: s.z.clone(),
+            },
+            s.status,
+            s.iterations,
+        ))
+    }
+}
