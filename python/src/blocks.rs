@@ -100,12 +100,16 @@ impl PyBlock {
 
     /// A copy with an initial velocity (m/s) and angular velocity (rad/s).
     #[pyo3(signature = (velocity, angular_velocity=None))]
-    fn with_velocity(&self, velocity: &Bound<'_, PyAny>, angular_velocity: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+    fn with_velocity(
+        &self,
+        velocity: &Bound<'_, PyAny>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         Ok(Self {
-            inner: self
-                .inner
-                .clone()
-                .with_velocity(vec3(velocity, "velocity")?, vec3_or_zero(angular_velocity, "angular_velocity")?),
+            inner: self.inner.clone().with_velocity(
+                vec3(velocity, "velocity")?,
+                vec3_or_zero(angular_velocity, "angular_velocity")?,
+            ),
         })
     }
 
@@ -143,7 +147,10 @@ impl PyBlock {
     #[getter]
     fn vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let pose = self.inner.state().pose;
-        array_n3(py, self.inner.shape().vertices().iter().map(|v| pose.transform_point(*v)))
+        array_n3(
+            py,
+            self.inner.shape().vertices().iter().map(|v| pose.transform_point(*v)),
+        )
     }
     /// Fixity as a dict ``{"translation": [...], "rotation": [...]}``.
     #[getter]
@@ -223,15 +230,15 @@ pub fn running_bond_wall(
     material: u16,
     base_material: u16,
 ) -> PyResult<Vec<PyBlock>> {
-    let mut spec = WallSpec::default();
-    spec.bricks_per_course = bricks_per_course;
-    spec.courses = courses;
-    if let Some(b) = brick {
-        spec.brick = vec3(b, "brick")?;
-    }
-    spec.density = density;
-    spec.material = MaterialId(material);
-    spec.base_material = MaterialId(base_material);
+    let default = WallSpec::default();
+    let spec = WallSpec {
+        bricks_per_course,
+        courses,
+        brick: brick.map_or(Ok(default.brick), |b| vec3(b, "brick"))?,
+        density,
+        material: MaterialId(material),
+        base_material: MaterialId(base_material),
+    };
     Ok(wrap(voussoir::build::running_bond_wall(&spec).py()?))
 }
 
@@ -246,14 +253,16 @@ pub fn multi_leaf_wall(
     density: f64,
     material: u16,
 ) -> PyResult<Vec<PyBlock>> {
-    let mut spec = MultiLeafSpec::default();
-    spec.length = length;
-    spec.height = height;
-    if let Some(l) = leaves {
-        spec.leaves = points(l, "leaves")?;
-    }
-    spec.density = density;
-    spec.material = MaterialId(material);
+    let spec = MultiLeafSpec {
+        length,
+        height,
+        leaves: match leaves {
+            Some(l) => points(l, "leaves")?,
+            None => MultiLeafSpec::default().leaves,
+        },
+        density,
+        material: MaterialId(material),
+    };
     Ok(wrap(voussoir::build::multi_leaf_wall(&spec).py()?))
 }
 
@@ -272,14 +281,15 @@ pub fn barrel_vault(
     density: f64,
     material: u16,
 ) -> PyResult<Vec<PyBlock>> {
-    let mut spec = BarrelVaultSpec::default();
-    spec.radius = radius;
-    spec.thickness = thickness;
-    spec.ring_length = ring_length;
-    spec.rings = rings;
-    spec.voussoirs = voussoirs;
-    spec.density = density;
-    spec.material = MaterialId(material);
+    let spec = BarrelVaultSpec {
+        radius,
+        thickness,
+        ring_length,
+        rings,
+        voussoirs,
+        density,
+        material: MaterialId(material),
+    };
     Ok(wrap(voussoir::build::barrel_vault(&spec).py()?))
 }
 

@@ -85,7 +85,9 @@ pub fn fixity(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Fixity> {
     for key in d.keys() {
         let k: String = key.extract()?;
         if k != "translation" && k != "rotation" {
-            return Err(bad(format!("fixity: unknown key {k:?} (expected \"translation\", \"rotation\")")));
+            return Err(bad(format!(
+                "fixity: unknown key {k:?} (expected \"translation\", \"rotation\")"
+            )));
         }
     }
     let get = |key: &str| -> PyResult<[Dof; 3]> {

@@ -63,12 +63,12 @@ impl PyCoulombSlip {
     /// Friction angle (degrees).
     #[getter]
     fn friction_deg(&self) -> f64 {
-        self.inner.friction_angle()
+        degrees(&self.inner, "friction_deg")
     }
     /// Residual friction angle (degrees).
     #[getter]
     fn residual_friction_deg(&self) -> f64 {
-        self.inner.residual_friction_angle()
+        degrees(&self.inner, "residual_friction_deg")
     }
     /// Cohesion (Pa).
     #[getter]
@@ -94,10 +94,17 @@ impl PyCoulombSlip {
     }
 
     fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
-        other
-            .cast::<PyCoulombSlip>()
-            .is_ok_and(|o| o.get().inner == self.inner)
+        other.cast::<PyCoulombSlip>().is_ok_and(|o| o.get().inner == self.inner)
     }
+}
+
+/// An angle of the law in degrees as it was given (the accessors give radians; converting
+/// back could differ in the last bit), read from its serialised form.
+fn degrees(law: &CoulombSlip, field: &str) -> f64 {
+    serde_json::to_value(law)
+        .ok()
+        .and_then(|v| v.get(field).and_then(serde_json::Value::as_f64))
+        .unwrap_or(f64::NAN)
 }
 
 /// Linear springs with no strength limit: ``LinearElastic(kn, ks)`` in Pa/m.

@@ -5,9 +5,9 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use numpy::IntoPyArray;
 use numpy::{PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
-use numpy::IntoPyArray;
 use pyo3::types::PyDict;
 use voussoir::block::{Block, BlockId, Wrench};
 use voussoir::contact::DisplacementMode;
@@ -21,9 +21,7 @@ use voussoir::monitor::{Component, EnergyTerm, Monitor, Recorder};
 use voussoir::Error;
 
 use crate::blocks::PyBlock;
-use crate::convert::{
-    array1, array_n3, array_n33, array_nk, fixity, points, vec3, vec3_or_zero, vector,
-};
+use crate::convert::{array1, array_n3, array_n33, array_nk, fixity, points, vec3, vec3_or_zero, vector};
 use crate::errors::{bad, OrPy};
 use crate::laws::{law_from_py, law_to_py};
 
@@ -134,7 +132,13 @@ impl PyModel {
     /// Runs to `goal`, in chunks: the GIL is released during a chunk; between chunks Ctrl-C is
     /// looked for and, every `every` steps, `callback(step, time)` is called. Returns the steps
     /// taken and whether the goal was reached (false: the callback returned False).
-    fn run(&mut self, py: Python<'_>, goal: Goal, callback: Option<&Bound<'_, PyAny>>, every: u64) -> PyResult<(u64, bool)> {
+    fn run(
+        &mut self,
+        py: Python<'_>,
+        goal: Goal,
+        callback: Option<&Bound<'_, PyAny>>,
+        every: u64,
+    ) -> PyResult<(u64, bool)> {
         if every == 0 {
             return Err(bad("every: must be at least 1 step"));
         }
@@ -153,7 +157,11 @@ impl PyModel {
         let mut taken = 0u64;
         let mut since_callback = 0u64;
         loop {
-            let chunk = if callback.is_some() { every - since_callback } else { u64::MAX };
+            let chunk = if callback.is_some() {
+                every - since_callback
+            } else {
+                u64::MAX
+            };
             let (model, samples) = (&mut self.model, &mut self.samples);
             let outcome = py.detach(move || -> voussoir::Result<(u64, bool)> {
                 let start = Instant::now();
@@ -179,7 +187,7 @@ impl PyModel {
                     if done {
                         return Ok((n, true));
                     }
-                    if n >= chunk || (n % 16 == 0 && start.elapsed() >= SIGNAL_INTERVAL) {
+                    if n >= chunk || (n.is_multiple_of(16) && start.elapsed() >= SIGNAL_INTERVAL) {
                         return Ok((n, false));
                     }
                     model.step()?;
@@ -195,7 +203,7 @@ impl PyModel {
                 if since_callback >= every {
                     since_callback = 0;
                     let answer = cb.call1((self.model.step_count(), self.model.time()))?;
-                    if answer.is(&pyo3::types::PyBool::new(py, false)) {
+                    if answer.is(pyo3::types::PyBool::new(py, false)) {
                         return Ok((taken, false));
                     }
                 }
@@ -213,7 +221,9 @@ fn component(s: &str) -> PyResult<Component> {
         "y" => Ok(Component::Y),
         "z" => Ok(Component::Z),
         "magnitude" | "norm" => Ok(Component::Magnitude),
-        other => Err(bad(format!("component {other:?}: expected \"x\", \"y\", \"z\" or \"magnitude\""))),
+        other => Err(bad(format!(
+            "component {other:?}: expected \"x\", \"y\", \"z\" or \"magnitude\""
+        ))),
     }
 }
 
@@ -253,7 +263,11 @@ fn as_any_law(doc: &mut serde_json::Value) {
     fn wrap_law(law: &mut Value) {
         if let Value::Object(map) = law {
             if !map.contains_key("Coulomb") && !map.contains_key("Elastic") {
-                let kind = if map.contains_key("friction_deg") { "Coulomb" } else { "Elastic" };
+                let kind = if map.contains_key("friction_deg") {
+                    "Coulomb"
+                } else {
+                    "Elastic"
+                };
                 *law = serde_json::json!({ kind: law.take() });
             }
         }
@@ -418,7 +432,10 @@ impl PyModel {
         let need = |what: &str| -> PyResult<(f64, f64)> {
             match (ratio, frequency) {
                 (Some(r), Some(f)) => Ok((r, f)),
-                _ => Err(bad(format!("damping {what:?}: give ratio= and frequency=", what = what))),
+                _ => Err(bad(format!(
+                    "damping {what:?}: give ratio= and frequency=",
+                    what = what
+                ))),
             }
         };
         let damping = match kind.to_ascii_lowercase().as_str() {
@@ -563,7 +580,12 @@ impl PyModel {
 
     /// Sets the load on a block: a force (N) at its centroid and a moment (N·m).
     #[pyo3(signature = (block, force=None, moment=None))]
-    fn set_load(&mut self, block: usize, force: Option<&Bound<'_, PyAny>>, moment: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+    fn set_load(
+        &mut self,
+        block: usize,
+        force: Option<&Bound<'_, PyAny>>,
+        moment: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
         let id = self.id(block)?;
         let w = Wrench {
             force: vec3_or_zero(force, "force")?,
@@ -574,14 +596,25 @@ impl PyModel {
 
     /// Sets a block's velocity (m/s) and angular velocity (rad/s).
     #[pyo3(signature = (block, velocity, angular_velocity=None))]
-    fn set_velocity(&mut self, block: usize, velocity: &Bound<'_, PyAny>, angular_velocity: Option<&Bound<'_, PyAny>>) -> PyResult<()> {
+    fn set_velocity(
+        &mut self,
+        block: usize,
+        velocity: &Bound<'_, PyAny>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
         let id = self.id(block)?;
         self.model
-            .set_velocity(id, vec3(velocity, "velocity")?, vec3_or_zero(angular_velocity, "angular_velocity")?)
+            .set_velocity(
+                id,
+                vec3(velocity, "velocity")?,
+                vec3_or_zero(angular_velocity, "angular_velocity")?,
+            )
             .py()
     }
 
-    /// Prescribes a block's translational velocity (m/s), rotations fixed.
+    /// Changes the values of a block's prescribed translation velocities (m/s): each
+    /// translation that its fixity prescribes (a number in ``set_fixity``) takes the matching
+    /// component; free and fixed ones stay. Cheap enough to call between every step.
     fn set_prescribed_velocity(&mut self, block: usize, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
         let id = self.id(block)?;
         self.model.set_prescribed_velocity(id, vec3(velocity, "velocity")?).py()
@@ -604,7 +637,13 @@ impl PyModel {
     /// Runs until the simulated time reaches ``t`` (s); callback as ``run_steps``. Returns True
     /// if the time was reached.
     #[pyo3(signature = (t, callback=None, every=1000))]
-    fn run_until_time(&mut self, py: Python<'_>, t: f64, callback: Option<&Bound<'_, PyAny>>, every: u64) -> PyResult<bool> {
+    fn run_until_time(
+        &mut self,
+        py: Python<'_>,
+        t: f64,
+        callback: Option<&Bound<'_, PyAny>>,
+        every: u64,
+    ) -> PyResult<bool> {
         Ok(self.run(py, Goal::Time(t), callback, every)?.1)
     }
 
@@ -621,7 +660,15 @@ impl PyModel {
         every: u64,
     ) -> PyResult<u64> {
         Ok(self
-            .run(py, Goal::Equilibrium { target: ratio, max_steps }, callback, every)?
+            .run(
+                py,
+                Goal::Equilibrium {
+                    target: ratio,
+                    max_steps,
+                },
+                callback,
+                every,
+            )?
             .0)
     }
 
@@ -759,7 +806,10 @@ impl PyModel {
                 .into_pyarray(py),
         )?;
         d.set_item("normal", array_n3(py, cs.iter().map(|c| c.normal())))?;
-        d.set_item("normal_force", array1(py, cs.iter().map(|c| c.normal_force()).collect()))?;
+        d.set_item(
+            "normal_force",
+            array1(py, cs.iter().map(|c| c.normal_force()).collect()),
+        )?;
         d.set_item("force", array_n3(py, cs.iter().map(|c| c.resultant())))?;
         d.set_item("moment_a", array_n3(py, cs.iter().map(|c| c.wrench().moment_a)))?;
         d.set_item("moment_b", array_n3(py, cs.iter().map(|c| c.wrench().moment_b)))?;
@@ -882,9 +932,17 @@ impl PyModel {
                 let p = point.ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give point=")))?;
                 let (block, point) = (need_block()?, vec3(p, "point")?);
                 if kind.eq_ignore_ascii_case("displacement") {
-                    Monitor::Displacement { block, point, component: c }
+                    Monitor::Displacement {
+                        block,
+                        point,
+                        component: c,
+                    }
                 } else {
-                    Monitor::Velocity { block, point, component: c }
+                    Monitor::Velocity {
+                        block,
+                        point,
+                        component: c,
+                    }
                 }
             }
             "reaction" => Monitor::Reaction {
@@ -897,7 +955,9 @@ impl PyModel {
             },
             "contact_resultant" => {
                 let (Some(a), Some(b)) = (a, b) else {
-                    return Err(bad(format!("monitor {name:?} of kind \"contact_resultant\": give a= and b=")));
+                    return Err(bad(format!(
+                        "monitor {name:?} of kind \"contact_resultant\": give a= and b="
+                    )));
                 };
                 Monitor::ContactResultant {
                     a: self.id(a)?,
@@ -917,7 +977,9 @@ contact_resultant, energy or unbalanced_ratio"
             }
         };
         // The library's own checks, with its messages.
-        Recorder::<AnyLaw>::new(1).add_monitor(&self.model, name, monitor).py()?;
+        Recorder::<AnyLaw>::new(1)
+            .add_monitor(&self.model, name, monitor)
+            .py()?;
         self.samples.add(name, monitor);
         Ok(())
     }

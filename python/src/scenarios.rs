@@ -6,7 +6,6 @@
 //! `arch/src/cli/arch_impact.rs` `GroupSummary`), plus the data of the CSV files (`curve`,
 //! `history`).
 
-
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use serde_json::{json, Value};
