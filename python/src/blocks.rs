@@ -1,0 +1,329 @@
+//! Blocks, the generators (`voussoir.build`) and the ready-made scenes (`voussoir.scenes`).
+
+use numpy::{PyArray1, PyArray2};
+use pyo3::prelude::*;
+use voussoir::block::{Block, RigidBlock};
+use voussoir::build::arch::{AbutmentShape, Arch, ArchSpec};
+use voussoir::build::{BarrelVaultSpec, DomeSpec, MultiLeafSpec, WallSpec};
+use voussoir::law::MaterialId;
+
+use crate::convert::{array_n3, fixity, fixity_to_py, points, vec3, vec3_or_zero, vector};
+use crate::errors::OrPy;
+
+/// A rigid convex polyhedral block of uniform density, not yet in a model.
+///
+/// Build one with ``Block.cuboid`` or ``Block.from_vertices`` (or a generator of
+/// ``voussoir.build``) and add it with ``Model.add_block``; blocks are values: ``with_*``
+/// return a modified copy.
+#[pyclass(name = "Block", module = "voussoir", frozen)]
+#[derive(Clone)]
+pub struct PyBlock {
+    pub inner: RigidBlock,
+}
+
+fn finish(
+    block: RigidBlock,
+    material: u16,
+    fixed: Option<&Bound<'_, PyAny>>,
+    velocity: Option<&Bound<'_, PyAny>>,
+    angular_velocity: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyBlock> {
+    let v = vec3_or_zero(velocity, "velocity")?;
+    let w = vec3_or_zero(angular_velocity, "angular_velocity")?;
+    Ok(PyBlock {
+        inner: block
+            .with_material(MaterialId(material))
+            .with_fixity(fixity(fixed)?)
+            .with_velocity(v, w),
+    })
+}
+
+#[pymethods]
+impl PyBlock {
+    /// An axis-aligned box from its lowest and highest corners (m), density in kg/m³.
+    #[staticmethod]
+    #[pyo3(signature = (name, min, max, density, *, material=0, fixed=None, velocity=None, angular_velocity=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn cuboid(
+        name: &str,
+        min: &Bound<'_, PyAny>,
+        max: &Bound<'_, PyAny>,
+        density: f64,
+        material: u16,
+        fixed: Option<&Bound<'_, PyAny>>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let b = RigidBlock::cuboid(name, vec3(min, "min")?, vec3(max, "max")?, density).py()?;
+        finish(b, material, fixed, velocity, angular_velocity)
+    }
+
+    /// The convex hull of world points (an (n, 3) array or a list of triples), or, with
+    /// ``faces`` (vertex-index loops, counter-clockwise seen from outside), that polyhedron.
+    #[staticmethod]
+    #[pyo3(signature = (name, vertices, density, *, faces=None, material=0, fixed=None, velocity=None, angular_velocity=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_vertices(
+        name: &str,
+        vertices: &Bound<'_, PyAny>,
+        density: f64,
+        faces: Option<Vec<Vec<usize>>>,
+        material: u16,
+        fixed: Option<&Bound<'_, PyAny>>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let pts = points(vertices, "vertices")?;
+        let b = match faces {
+            Some(f) => RigidBlock::from_faces(name, &pts, &f, density),
+            None => RigidBlock::from_vertices(name, &pts, density),
+        }
+        .py()?;
+        finish(b, material, fixed, velocity, angular_velocity)
+    }
+
+    /// A copy with another material id.
+    fn with_material(&self, material: u16) -> Self {
+        Self {
+            inner: self.inner.clone().with_material(MaterialId(material)),
+        }
+    }
+
+    /// A copy with another fixity (``"fixed"``, ``"free"``, a bool, or
+    /// ``{"translation": [d, d, d], "rotation": [d, d, d]}``, each ``d`` ``"free"``, ``"fixed"``
+    /// or a velocity).
+    fn with_fixity(&self, fixity: &Bound<'_, PyAny>) -> PyResult<Self> {
+        Ok(Self {
+            inner: self.inner.clone().with_fixity(crate::convert::fixity(Some(fixity))?),
+        })
+    }
+
+    /// A copy with an initial velocity (m/s) and angular velocity (rad/s).
+    #[pyo3(signature = (velocity, angular_velocity=None))]
+    fn with_velocity(
+        &self,
+        velocity: &Bound<'_, PyAny>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            inner: self.inner.clone().with_velocity(
+                vec3(velocity, "velocity")?,
+                vec3_or_zero(angular_velocity, "angular_velocity")?,
+            ),
+        })
+    }
+
+    /// Name.
+    #[getter]
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+    /// Material id.
+    #[getter]
+    fn material(&self) -> u16 {
+        self.inner.material().0
+    }
+    /// Density (kg/m³).
+    #[getter]
+    fn density(&self) -> f64 {
+        self.inner.density()
+    }
+    /// Mass (kg).
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.inner.mass_properties().mass
+    }
+    /// Volume (m³).
+    #[getter]
+    fn volume(&self) -> f64 {
+        self.inner.mass_properties().volume
+    }
+    /// Centroid (m), a (3,) array.
+    #[getter]
+    fn centroid<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.inner.state().pose.translation)
+    }
+    /// Vertices in world coordinates (m), an (n, 3) array.
+    #[getter]
+    fn vertices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let pose = self.inner.state().pose;
+        array_n3(
+            py,
+            self.inner.shape().vertices().iter().map(|v| pose.transform_point(*v)),
+        )
+    }
+    /// Fixity as a dict ``{"translation": [...], "rotation": [...]}``.
+    #[getter]
+    fn fixity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        fixity_to_py(py, self.inner.fixity())
+    }
+    /// Whether all six degrees of freedom are fixed.
+    #[getter]
+    fn is_fixed(&self) -> bool {
+        self.inner.fixity().is_fixed()
+    }
+
+    fn __repr__(&self) -> String {
+        let c = self.inner.state().pose.translation;
+        format!(
+            "Block({:?}, mass={:.6} kg, centroid=({:.6}, {:.6}, {:.6}), material={}{})",
+            self.inner.name(),
+            self.mass(),
+            c.x,
+            c.y,
+            c.z,
+            self.material(),
+            if self.is_fixed() { ", fixed" } else { "" }
+        )
+    }
+}
+
+fn wrap(blocks: Vec<RigidBlock>) -> Vec<PyBlock> {
+    blocks.into_iter().map(|inner| PyBlock { inner }).collect()
+}
+
+/// A circular segmental arch in the x–y plane (gravity along −y: use
+/// ``Model(gravity=(0, -9.81, 0))``), extruded along z by ``width``: the left abutment, the
+/// voussoirs from left to right, the right abutment; the abutments are fixed. Defaults: the
+/// reference arch of Pulatsu, Gonen & Lourenço (2021) (span 1.2 m, rise 0.4 m, ring 0.2 m, 13
+/// voussoirs, 24 kN/m³).
+#[pyfunction]
+#[pyo3(signature = (*, span=1.2, rise=0.4, thickness=0.2, width=0.15, voussoirs=13, density=24_000.0 / 9.81,
+    abutment_outer_width=0.20, abutment_depth=0.30, voussoir_material=0, abutment_material=0))]
+#[allow(clippy::too_many_arguments)]
+pub fn arch(
+    span: f64,
+    rise: f64,
+    thickness: f64,
+    width: f64,
+    voussoirs: usize,
+    density: f64,
+    abutment_outer_width: f64,
+    abutment_depth: f64,
+    voussoir_material: u16,
+    abutment_material: u16,
+) -> PyResult<Vec<PyBlock>> {
+    let mut spec = ArchSpec::reference(width);
+    spec.span = span;
+    spec.rise = rise;
+    spec.thickness = thickness;
+    spec.voussoirs = voussoirs;
+    spec.density = density;
+    spec.abutment = AbutmentShape {
+        outer_width: abutment_outer_width,
+        depth: abutment_depth,
+    };
+    spec.voussoir_material = MaterialId(voussoir_material);
+    spec.abutment_material = MaterialId(abutment_material);
+    Ok(wrap(Arch::new(&spec).py()?.blocks))
+}
+
+/// A running-bond wall on a fixed base block (the first block), bricks in courses along x,
+/// courses along z (gravity along −z).
+#[pyfunction]
+#[pyo3(signature = (*, bricks_per_course=10, courses=10, brick=None, density=2000.0, material=0, base_material=0))]
+pub fn running_bond_wall(
+    bricks_per_course: usize,
+    courses: usize,
+    brick: Option<&Bound<'_, PyAny>>,
+    density: f64,
+    material: u16,
+    base_material: u16,
+) -> PyResult<Vec<PyBlock>> {
+    let default = WallSpec::default();
+    let spec = WallSpec {
+        bricks_per_course,
+        courses,
+        brick: brick.map_or(Ok(default.brick), |b| vec3(b, "brick"))?,
+        density,
+        material: MaterialId(material),
+        base_material: MaterialId(base_material),
+    };
+    Ok(wrap(voussoir::build::running_bond_wall(&spec).py()?))
+}
+
+/// A multi-leaf wall: leaves side by side along y, each of its own brick size (x, y, z), on a
+/// fixed base.
+#[pyfunction]
+#[pyo3(signature = (*, length=2.0, height=1.0, leaves=None, density=2000.0, material=0))]
+pub fn multi_leaf_wall(
+    length: f64,
+    height: f64,
+    leaves: Option<&Bound<'_, PyAny>>,
+    density: f64,
+    material: u16,
+) -> PyResult<Vec<PyBlock>> {
+    let spec = MultiLeafSpec {
+        length,
+        height,
+        leaves: match leaves {
+            Some(l) => points(l, "leaves")?,
+            None => MultiLeafSpec::default().leaves,
+        },
+        density,
+        material: MaterialId(material),
+    };
+    Ok(wrap(voussoir::build::multi_leaf_wall(&spec).py()?))
+}
+
+/// A semicircular barrel vault: ``rings`` arch rings side by side along z, each of
+/// ``voussoirs`` voussoirs (alternate rings shifted by half a voussoir), on two fixed springer
+/// beams.
+#[pyfunction]
+#[pyo3(signature = (*, radius=2.0, thickness=0.3, ring_length=0.25, rings=10, voussoirs=25, density=2200.0, material=0))]
+#[allow(clippy::too_many_arguments)]
+pub fn barrel_vault(
+    radius: f64,
+    thickness: f64,
+    ring_length: f64,
+    rings: usize,
+    voussoirs: usize,
+    density: f64,
+    material: u16,
+) -> PyResult<Vec<PyBlock>> {
+    let spec = BarrelVaultSpec {
+        radius,
+        thickness,
+        ring_length,
+        rings,
+        voussoirs,
+        density,
+        material: MaterialId(material),
+    };
+    Ok(wrap(voussoir::build::barrel_vault(&spec).py()?))
+}
+
+/// A dome of courses of voussoirs (``per_course``: voussoirs in each course, from the
+/// springing up) with an oculus whose rim lies at latitude ``oculus_angle`` (rad, in
+/// (0, π/2)); ``blocks`` (default 200) sets the default courses for about that many blocks.
+#[pyfunction]
+#[pyo3(signature = (*, blocks=None, radius=None, thickness=None, per_course=None, oculus_angle=None, density=None, material=0))]
+#[allow(clippy::too_many_arguments)]
+pub fn dome(
+    blocks: Option<usize>,
+    radius: Option<f64>,
+    thickness: Option<f64>,
+    per_course: Option<Vec<usize>>,
+    oculus_angle: Option<f64>,
+    density: Option<f64>,
+    material: u16,
+) -> PyResult<Vec<PyBlock>> {
+    let mut spec = DomeSpec::with_blocks(blocks.unwrap_or(200));
+    if let Some(r) = radius {
+        spec.radius = r;
+    }
+    if let Some(t) = thickness {
+        spec.thickness = t;
+    }
+    if let Some(p) = per_course {
+        spec.per_course = p;
+    }
+    if let Some(o) = oculus_angle {
+        spec.oculus_angle = o;
+    }
+    if let Some(d) = density {
+        spec.density = d;
+    }
+    spec.material = MaterialId(material);
+    Ok(wrap(voussoir::build::dome(&spec).py()?))
+}

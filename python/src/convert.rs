@@ -1,0 +1,167 @@
+//! Arguments from Python (vectors as any iterable of numbers: tuples, lists, numpy arrays) and
+//! results to numpy.
+
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use voussoir::block::{Dof, Fixity};
+use voussoir::math::Vector;
+
+use crate::errors::bad;
+
+/// Three numbers from any iterable (tuple, list, numpy array).
+pub fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector> {
+    let mut v = Vec::with_capacity(3);
+    for item in obj.try_iter()? {
+        v.push(item?.extract::<f64>()?);
+    }
+    if v.len() != 3 {
+        return Err(bad(format!("{what}: expected 3 numbers (x, y, z), got {}", v.len())));
+    }
+    Ok(Vector::new(v[0], v[1], v[2]))
+}
+
+/// An optional vector, zero when `None`.
+pub fn vec3_or_zero(obj: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vector> {
+    obj.map_or(Ok(Vector::ZERO), |o| vec3(o, what))
+}
+
+/// A list of points from an iterable of 3-iterables or an (n, 3) array.
+pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Vector>> {
+    obj.try_iter()?
+        .enumerate()
+        .map(|(k, item)| vec3(&item?, &format!("{what}[{k}]")))
+        .collect()
+}
+
+fn dof(obj: &Bound<'_, PyAny>) -> PyResult<Dof> {
+    if let Ok(s) = obj.cast::<PyString>() {
+        return match s.to_cow()?.to_ascii_lowercase().as_str() {
+            "free" => Ok(Dof::Free),
+            "fixed" => Ok(Dof::Fixed),
+            other => Err(bad(format!(
+                "degree of freedom {other:?}: expected \"free\", \"fixed\" or a velocity (number)"
+            ))),
+        };
+    }
+    if obj.is_none() {
+        return Ok(Dof::Free);
+    }
+    Ok(Dof::Velocity(obj.extract::<f64>()?))
+}
+
+fn dofs(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[Dof; 3]> {
+    let v: Vec<Dof> = obj.try_iter()?.map(|d| dof(&d?)).collect::<PyResult<_>>()?;
+    v.try_into()
+        .map_err(|v: Vec<Dof>| bad(format!("{what}: expected 3 degrees of freedom, got {}", v.len())))
+}
+
+/// A fixity: `True`/`"fixed"` (all six fixed), `False`/`None`/`"free"` (all free), or a dict
+/// `{"translation": [d, d, d], "rotation": [d, d, d]}` with each `d` `"free"`, `"fixed"` or a
+/// prescribed velocity (m/s, rad/s); a missing key means free.
+pub fn fixity(obj: Option<&Bound<'_, PyAny>>) -> PyResult<Fixity> {
+    let Some(obj) = obj else {
+        return Ok(Fixity::FREE);
+    };
+    if obj.is_none() {
+        return Ok(Fixity::FREE);
+    }
+    if let Ok(b) = obj.extract::<bool>() {
+        return Ok(if b { Fixity::FIXED } else { Fixity::FREE });
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        return match s.to_cow()?.to_ascii_lowercase().as_str() {
+            "fixed" => Ok(Fixity::FIXED),
+            "free" => Ok(Fixity::FREE),
+            other => Err(bad(format!(
+                "fixity {other:?}: expected \"fixed\", \"free\", a bool or a dict with \"translation\" and \"rotation\""
+            ))),
+        };
+    }
+    let d = obj.cast::<PyDict>().map_err(|_| {
+        bad("fixity: expected \"fixed\", \"free\", a bool or a dict with \"translation\" and \"rotation\"")
+    })?;
+    for key in d.keys() {
+        let k: String = key.extract()?;
+        if k != "translation" && k != "rotation" {
+            return Err(bad(format!(
+                "fixity: unknown key {k:?} (expected \"translation\", \"rotation\")"
+            )));
+        }
+    }
+    let get = |key: &str| -> PyResult<[Dof; 3]> {
+        match d.get_item(key)? {
+            Some(v) => dofs(&v, &format!("fixity[{key:?}]")),
+            None => Ok([Dof::Free; 3]),
+        }
+    };
+    Ok(Fixity {
+        translation: get("translation")?,
+        rotation: get("rotation")?,
+    })
+}
+
+/// A fixity as Python data (the dict form of [`fixity`]).
+pub fn fixity_to_py<'py>(py: Python<'py>, f: &Fixity) -> PyResult<Bound<'py, PyDict>> {
+    let conv = |d: &[Dof; 3]| -> PyResult<Vec<Bound<'py, PyAny>>> {
+        d.iter()
+            .map(|d| match d {
+                Dof::Free => Ok(PyString::new(py, "free").into_any()),
+                Dof::Fixed => Ok(PyString::new(py, "fixed").into_any()),
+                Dof::Velocity(v) => Ok(v.into_pyobject(py)?.into_any()),
+            })
+            .collect()
+    };
+    let out = PyDict::new(py);
+    out.set_item("translation", conv(&f.translation)?)?;
+    out.set_item("rotation", conv(&f.rotation)?)?;
+    Ok(out)
+}
+
+/// An (n, 3) array of vectors.
+pub fn array_n3<'py>(py: Python<'py>, v: impl Iterator<Item = Vector>) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = v.flat_map(|p| [p.x, p.y, p.z]).collect();
+    let n = flat.len() / 3;
+    Array2::from_shape_vec((n, 3), flat)
+        .expect("3 per row")
+        .into_pyarray(py)
+}
+
+/// An (n, k) array from rows of k numbers.
+pub fn array_nk<'py, const K: usize>(
+    py: Python<'py>,
+    rows: impl Iterator<Item = [f64; K]>,
+) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = rows.flatten().collect();
+    let n = flat.len() / K;
+    Array2::from_shape_vec((n, K), flat)
+        .expect("K per row")
+        .into_pyarray(py)
+}
+
+/// An (n, 3, 3) array of matrices, row-major.
+pub fn array_n33<'py>(py: Python<'py>, m: impl Iterator<Item = [[f64; 3]; 3]>) -> Bound<'py, PyArray3<f64>> {
+    let flat: Vec<f64> = m.flat_map(|r| r.into_iter().flatten()).collect();
+    let n = flat.len() / 9;
+    Array3::from_shape_vec((n, 3, 3), flat)
+        .expect("9 per matrix")
+        .into_pyarray(py)
+}
+
+/// A 1-D array.
+pub fn array1<'py, T: numpy::Element>(py: Python<'py>, v: Vec<T>) -> Bound<'py, PyArray1<T>> {
+    Array1::from_vec(v).into_pyarray(py)
+}
+
+/// A vector as a 1-D array of 3.
+pub fn vector<'py>(py: Python<'py>, v: Vector) -> Bound<'py, PyArray1<f64>> {
+    array1(py, vec![v.x, v.y, v.z])
+}
+
+/// A `serde_json::Value` as Python objects (through `json.loads`, so that numbers, `null`,
+/// lists and dicts map as JSON says).
+pub fn json_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value).map_err(|e| bad(e.to_string()))?;
+    py.import("json")?.call_method1("loads", (text,))
+}

@@ -1,0 +1,38 @@
+//! The Python package `voussoir` (PyO3): its native module `voussoir._voussoir`, which the
+//! package's `__init__.py` re-exports. See `python/README.md`.
+
+// The summaries' `serde_json::json!` literals are deep.
+#![recursion_limit = "256"]
+
+mod blocks;
+mod convert;
+mod errors;
+mod laws;
+mod model;
+mod scenarios;
+
+use pyo3::prelude::*;
+
+/// The native module.
+#[pymodule]
+fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("VoussoirError", py.get_type::<errors::VoussoirError>())?;
+    m.add("VoussoirIOError", py.get_type::<errors::VoussoirIOError>())?;
+    m.add_class::<laws::PyCoulombSlip>()?;
+    m.add_class::<laws::PyLinearElastic>()?;
+    m.add_class::<blocks::PyBlock>()?;
+    m.add_class::<model::PyModel>()?;
+    m.add_class::<model::PySeries>()?;
+    m.add_function(wrap_pyfunction!(blocks::arch, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::running_bond_wall, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::multi_leaf_wall, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::barrel_vault, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::dome, m)?)?;
+    m.add_function(wrap_pyfunction!(model::benchmark_wall, m)?)?;
+    m.add_function(wrap_pyfunction!(scenarios::arch_static, m)?)?;
+    m.add_function(wrap_pyfunction!(scenarios::arch_impact, m)?)?;
+    m.add_function(wrap_pyfunction!(scenarios::impact_setups, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,1203 @@
+//! `voussoir.Model`: a model of rigid blocks with the shipped joint laws (`Model<AnyLaw>`), its
+//! runs (GIL released, Ctrl-C and a progress callback between steps), its results as numpy
+//! arrays, its monitors and its files.
+
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use numpy::IntoPyArray;
+use numpy::{PyArray1, PyArray2, PyArray3};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use voussoir::block::{Block, BlockId, Wrench};
+use voussoir::contact::DisplacementMode;
+use voussoir::geometry::SubcontactDensity;
+use voussoir::integrate::{Damping, TimeStep};
+use voussoir::io::scene::Scene;
+use voussoir::law::{AnyLaw, CoulombSlip, JointStatus, MaterialId};
+use voussoir::math::Vector;
+use voussoir::model::{Model, ModelParameters};
+use voussoir::monitor::{Component, EnergyTerm, Monitor, Recorder};
+use voussoir::Error;
+
+use crate::blocks::PyBlock;
+use crate::convert::{array1, array_n3, array_n33, array_nk, fixity, points, vec3, vec3_or_zero, vector};
+use crate::errors::{bad, OrPy};
+use crate::laws::{law_from_py, law_to_py};
+
+/// How often a run without a callback comes back to Python to look for Ctrl-C (wall time).
+const SIGNAL_INTERVAL: Duration = Duration::from_millis(100);
+
+/// The monitors and their samples. Kept here rather than in a `voussoir::monitor::Recorder`
+/// so that a run can take it across `Python::detach` (a `Recorder` may hold probes that are
+/// not `Send`); it samples as a `Recorder` does, after every `interval`-th step.
+#[derive(Default)]
+struct Samples {
+    monitors: Vec<(String, Monitor)>,
+    interval: u64,
+    steps: Vec<u64>,
+    times: Vec<f64>,
+    columns: Vec<Vec<f64>>,
+}
+
+impl Samples {
+    fn new() -> Self {
+        Self {
+            interval: 1,
+            ..Self::default()
+        }
+    }
+
+    fn after_step(&mut self, model: &Model<AnyLaw>) {
+        if !self.monitors.is_empty() && model.step_count().is_multiple_of(self.interval) {
+            self.steps.push(model.step_count());
+            self.times.push(model.time());
+            for ((_, m), c) in self.monitors.iter().zip(&mut self.columns) {
+                c.push(m.evaluate(model));
+            }
+        }
+    }
+
+    fn add(&mut self, name: &str, monitor: Monitor) {
+        self.monitors.push((name.to_owned(), monitor));
+        // A monitor added late has NaN for the samples it missed, as in a Recorder.
+        self.columns.push(vec![f64::NAN; self.steps.len()]);
+    }
+
+    /// As a `voussoir::monitor::Recorder` (monitors and interval; no samples).
+    fn recorder(&self, model: &Model<AnyLaw>) -> voussoir::Result<Recorder<AnyLaw>> {
+        let mut r = Recorder::new(self.interval);
+        for (name, m) in &self.monitors {
+            r.add_monitor(model, name, *m)?;
+        }
+        Ok(r)
+    }
+
+    /// As a `voussoir::monitor::History`, through its JSON form.
+    fn history(&self) -> voussoir::Result<voussoir::monitor::History> {
+        let value = serde_json::json!({
+            "names": self.monitors.iter().map(|(n, _)| n.clone()).collect::<Vec<_>>(),
+            "units": self.monitors.iter().map(|(_, m)| m.unit()).collect::<Vec<_>>(),
+            "steps": self.steps,
+            "times": self.times,
+            "columns": self.columns.iter()
+                .map(|c| c.iter().map(|x| x.is_finite().then_some(*x)).collect::<Vec<_>>())
+                .collect::<Vec<_>>(),
+        });
+        serde_json::from_value(value).map_err(|e| Error::Io {
+            path: "(history)".into(),
+            message: e.to_string(),
+        })
+    }
+}
+
+/// What a run runs to.
+#[derive(Clone, Copy)]
+enum Goal {
+    Steps(u64),
+    Time(f64),
+    Equilibrium { target: f64, max_steps: u64 },
+}
+
+/// A discrete element model of rigid blocks.
+///
+/// ``Model(*, gravity=(0, 0, -9.81), contact_tolerance=1e-3, subcontacts_per_edge=15,
+/// subcontact_spacing=None, time_step=None, safety=0.5, mode="large", max_speed=1000.0,
+/// impact_step=0.1)``: ``time_step`` None is automatic at ``safety`` times the critical step,
+/// a number is a fixed step (s); ``subcontact_spacing`` (m), when given, replaces
+/// ``subcontacts_per_edge``; ``impact_step`` None turns the impact refinement off.
+///
+/// Joint laws are set per pair of materials (``set_joint_law``); block indices are ints, the
+/// rows of the arrays that ``positions()``, ``velocities()`` etc. return.
+#[pyclass(name = "Model", module = "voussoir")]
+pub struct PyModel {
+    model: Model<AnyLaw>,
+    samples: Samples,
+}
+
+impl PyModel {
+    fn wrap(model: Model<AnyLaw>) -> Self {
+        Self {
+            model,
+            samples: Samples::new(),
+        }
+    }
+
+    fn id(&self, block: usize) -> PyResult<BlockId> {
+        let id = BlockId(u32::try_from(block).map_err(|_| bad(format!("block index {block} is too large")))?);
+        self.model.block(id).py()?;
+        Ok(id)
+    }
+
+    /// Runs to `goal`, in chunks: the GIL is released during a chunk; between chunks Ctrl-C is
+    /// looked for and, every `every` steps, `callback(step, time)` is called. Returns the steps
+    /// taken and whether the goal was reached (false: the callback returned False).
+    fn run(
+        &mut self,
+        py: Python<'_>,
+        goal: Goal,
+        callback: Option<&Bound<'_, PyAny>>,
+        every: u64,
+    ) -> PyResult<(u64, bool)> {
+        if every == 0 {
+            return Err(bad("every: must be at least 1 step"));
+        }
+        match goal {
+            Goal::Time(t) if !t.is_finite() => {
+                return Err(Error::NonFinite {
+                    what: format!("end time {t} of run_until_time"),
+                })
+                .py()
+            }
+            Goal::Equilibrium { target, .. } => {
+                voussoir::error::positive("equilibrium target ratio", target).py()?;
+            }
+            _ => {}
+        }
+        let mut taken = 0u64;
+        let mut since_callback = 0u64;
+        loop {
+            let chunk = if callback.is_some() {
+                every - since_callback
+            } else {
+                u64::MAX
+            };
+            let (model, samples) = (&mut self.model, &mut self.samples);
+            let outcome = py.detach(move || -> voussoir::Result<(u64, bool)> {
+                let start = Instant::now();
+                let mut n = 0u64;
+                loop {
+                    let done = match goal {
+                        Goal::Steps(total) => taken + n >= total,
+                        Goal::Time(t) => model.time() >= t,
+                        Goal::Equilibrium { target, max_steps } => {
+                            if n > 0 && model.unbalanced_force_ratio() < target {
+                                true
+                            } else if taken + n >= max_steps {
+                                return Err(Error::NotConverged {
+                                    what: "unbalanced-force ratio target",
+                                    steps: max_steps,
+                                    last: model.unbalanced_force_ratio(),
+                                });
+                            } else {
+                                false
+                            }
+                        }
+                    };
+                    if done {
+                        return Ok((n, true));
+                    }
+                    if n >= chunk || (n.is_multiple_of(16) && start.elapsed() >= SIGNAL_INTERVAL) {
+                        return Ok((n, false));
+                    }
+                    model.step()?;
+                    samples.after_step(model);
+                    n += 1;
+                }
+            });
+            let (n, done) = outcome.py()?;
+            taken += n;
+            since_callback += n;
+            py.check_signals()?;
+            if let Some(cb) = callback {
+                if since_callback >= every {
+                    since_callback = 0;
+                    let answer = cb.call1((self.model.step_count(), self.model.time()))?;
+                    if answer.is(pyo3::types::PyBool::new(py, false)) {
+                        return Ok((taken, false));
+                    }
+                }
+            }
+            if done {
+                return Ok((taken, true));
+            }
+        }
+    }
+}
+
+fn component(s: &str) -> PyResult<Component> {
+    match s.to_ascii_lowercase().as_str() {
+        "x" => Ok(Component::X),
+        "y" => Ok(Component::Y),
+        "z" => Ok(Component::Z),
+        "magnitude" | "norm" => Ok(Component::Magnitude),
+        other => Err(bad(format!(
+            "component {other:?}: expected \"x\", \"y\", \"z\" or \"magnitude\""
+        ))),
+    }
+}
+
+fn energy_term(s: &str) -> PyResult<EnergyTerm> {
+    Ok(match s.to_ascii_lowercase().as_str() {
+        "kinetic" => EnergyTerm::Kinetic,
+        "elastic" => EnergyTerm::Elastic,
+        "gravity_work" => EnergyTerm::GravityWork,
+        "load_work" => EnergyTerm::LoadWork,
+        "boundary_work" => EnergyTerm::BoundaryWork,
+        "friction" => EnergyTerm::Friction,
+        "damping" => EnergyTerm::Damping,
+        "balance_error" => EnergyTerm::BalanceError,
+        other => {
+            return Err(bad(format!(
+                "energy term {other:?}: expected one of kinetic, elastic, gravity_work, load_work, boundary_work, \
+friction, damping, balance_error"
+            )))
+        }
+    })
+}
+
+fn status_name(s: JointStatus) -> &'static str {
+    match s {
+        JointStatus::Elastic => "elastic",
+        JointStatus::Sliding => "sliding",
+        JointStatus::Open => "open",
+    }
+}
+
+/// A scene or checkpoint document of a model with one law type, as one of `Model<AnyLaw>`: a
+/// law without its kind (`{"normal_stiffness": ..}` of a `Scene<CoulombSlip>`) is named
+/// (`{"Coulomb": ..}`, or `{"Elastic": ..}` without a friction angle), and so is a
+/// sub-contact's law state.
+fn as_any_law(doc: &mut serde_json::Value) {
+    use serde_json::Value;
+    fn wrap_law(law: &mut Value) {
+        if let Value::Object(map) = law {
+            if !map.contains_key("Coulomb") && !map.contains_key("Elastic") {
+                let kind = if map.contains_key("friction_deg") {
+                    "Coulomb"
+                } else {
+                    "Elastic"
+                };
+                *law = serde_json::json!({ kind: law.take() });
+            }
+        }
+    }
+    // Scenes: joints[k].law.
+    if let Some(Value::Array(joints)) = doc.get_mut("joints") {
+        for j in joints {
+            if let Some(law) = j.get_mut("law") {
+                wrap_law(law);
+            }
+        }
+    }
+    // Checkpoints: joints.laws[k], contacts[k].subcontacts[j].state.
+    if let Some(Value::Array(laws)) = doc.get_mut("joints").and_then(|j| j.get_mut("laws")) {
+        for law in laws {
+            wrap_law(law);
+        }
+    }
+    if let Some(Value::Array(contacts)) = doc.get_mut("contacts") {
+        for c in contacts {
+            if let Some(Value::Array(subs)) = c.get_mut("subcontacts") {
+                for s in subs {
+                    if let Some(state) = s.get_mut("state") {
+                        match state {
+                            Value::Null => *state = serde_json::json!({}),
+                            Value::Object(m) if !m.contains_key("coulomb") && m.contains_key("failed") => {
+                                *state = serde_json::json!({ "coulomb": state.take() });
+                            }
+                            _ => {}
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Parses JSON text for [`as_any_law`]; on a syntax error, `None` (the typed parser then
+/// reports it with its own message).
+fn normalised(text: &str) -> Option<String> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut doc: serde_json::Value = serde_json::from_str(text).ok()?;
+    as_any_law(&mut doc);
+    serde_json::to_string(&doc).ok()
+}
+
+fn read(path: &PathBuf) -> PyResult<String> {
+    std::fs::read_to_string(path)
+        .map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
+        .py()
+}
+
+/// A scene of `Model<AnyLaw>` as JSON, written as a `Scene<CoulombSlip>` when every law is
+/// Coulomb's (what a Rust program with the default `Model` reads).
+fn scene_json(scene: &Scene<AnyLaw>) -> voussoir::Result<String> {
+    let laws: Option<Vec<CoulombSlip>> = scene
+        .joints
+        .iter()
+        .map(|j| match j.law {
+            AnyLaw::Coulomb(c) => Some(c),
+            _ => None,
+        })
+        .collect();
+    let text = scene.to_json()?;
+    if laws.is_none() {
+        return Ok(text);
+    }
+    let mut doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::Io {
+        path: "(scene)".into(),
+        message: e.to_string(),
+    })?;
+    if let Some(serde_json::Value::Array(joints)) = doc.get_mut("joints") {
+        for j in joints {
+            if let Some(law) = j.get_mut("law") {
+                if let Some(inner) = law.get_mut("Coulomb").map(serde_json::Value::take) {
+                    *law = inner;
+                }
+            }
+        }
+    }
+    serde_json::to_string_pretty(&doc).map_err(|e| Error::Io {
+        path: "(scene)".into(),
+        message: e.to_string(),
+    })
+}
+
+#[pymethods]
+impl PyModel {
+    #[new]
+    #[pyo3(signature = (*, gravity=None, contact_tolerance=1e-3, subcontacts_per_edge=15, subcontact_spacing=None,
+        time_step=None, safety=0.5, mode="large", max_speed=1000.0, impact_step=Some(0.1)))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        gravity: Option<&Bound<'_, PyAny>>,
+        contact_tolerance: f64,
+        subcontacts_per_edge: u16,
+        subcontact_spacing: Option<f64>,
+        time_step: Option<f64>,
+        safety: f64,
+        mode: &str,
+        max_speed: f64,
+        impact_step: Option<f64>,
+    ) -> PyResult<Self> {
+        let mut params = ModelParameters::default();
+        if let Some(g) = gravity {
+            params.gravity = vec3(g, "gravity")?;
+        }
+        params.contact.tolerance = contact_tolerance;
+        params.contact.density = match subcontact_spacing {
+            Some(h) => SubcontactDensity::Spacing(h),
+            None => SubcontactDensity::PerEdge(subcontacts_per_edge),
+        };
+        params.time_step = match time_step {
+            Some(dt) => TimeStep::Fixed(dt),
+            None => TimeStep::Auto { safety },
+        };
+        params.mode = match mode.to_ascii_lowercase().as_str() {
+            "large" => DisplacementMode::Large,
+            "small" => DisplacementMode::Small,
+            other => return Err(bad(format!("mode {other:?}: expected \"large\" or \"small\""))),
+        };
+        params.max_speed = max_speed;
+        params.impact_step = impact_step;
+        Ok(Self::wrap(Model::new(params).py()?))
+    }
+
+    // ---- building -------------------------------------------------------------------------
+
+    /// Sets the joint law between two materials (ints, either order): a ``CoulombSlip`` or a
+    /// ``LinearElastic``.
+    fn set_joint_law(&mut self, a: u16, b: u16, law: &Bound<'_, PyAny>) -> PyResult<()> {
+        let law = law_from_py(law)?;
+        self.model.set_joint_law(MaterialId(a), MaterialId(b), law).py()
+    }
+
+    /// The joint law between two materials, or None.
+    fn joint_law<'py>(&self, py: Python<'py>, a: u16, b: u16) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.model
+            .law_table()
+            .get(MaterialId(a), MaterialId(b))
+            .map(|l| law_to_py(py, l))
+            .transpose()
+    }
+
+    /// Sets the damping: ``"none"``; ``"local"`` (Cundall, ``alpha`` in [0, 1), default 0.8);
+    /// ``"rayleigh"`` with ``ratio`` (of critical) at ``frequency`` (Hz), mass and stiffness
+    /// parts equal, or with the coefficients ``mass`` (1/s) and ``stiffness`` (s);
+    /// ``"rayleigh_mass"`` or ``"rayleigh_stiffness"`` with ``ratio`` and ``frequency``.
+    #[pyo3(signature = (kind, *, alpha=0.8, ratio=None, frequency=None, mass=None, stiffness=None))]
+    fn set_damping(
+        &mut self,
+        kind: &str,
+        alpha: f64,
+        ratio: Option<f64>,
+        frequency: Option<f64>,
+        mass: Option<f64>,
+        stiffness: Option<f64>,
+    ) -> PyResult<()> {
+        let need = |what: &str| -> PyResult<(f64, f64)> {
+            match (ratio, frequency) {
+                (Some(r), Some(f)) => Ok((r, f)),
+                _ => Err(bad(format!(
+                    "damping {what:?}: give ratio= and frequency=",
+                    what = what
+                ))),
+            }
+        };
+        let damping = match kind.to_ascii_lowercase().as_str() {
+            "none" => Damping::None,
+            "local" => Damping::Local { alpha },
+            "rayleigh" => match (mass, stiffness) {
+                (None, None) => {
+                    let (r, f) = need("rayleigh")?;
+                    Damping::rayleigh(r, f).py()?
+                }
+                (m, s) => Damping::Rayleigh {
+                    mass: m.unwrap_or(0.0),
+                    stiffness: s.unwrap_or(0.0),
+                },
+            },
+            "rayleigh_mass" => {
+                let (r, f) = need("rayleigh_mass")?;
+                Damping::rayleigh_mass(r, f).py()?
+            }
+            "rayleigh_stiffness" => {
+                let (r, f) = need("rayleigh_stiffness")?;
+                Damping::rayleigh_stiffness(r, f).py()?
+            }
+            other => {
+                return Err(bad(format!(
+                    "damping {other:?}: expected \"none\", \"local\", \"rayleigh\", \"rayleigh_mass\" or \"rayleigh_stiffness\""
+                )))
+            }
+        };
+        self.model.set_damping(damping).py()
+    }
+
+    /// The damping as a dict: ``{"kind": "none"}``, ``{"kind": "local", "alpha": α}`` or
+    /// ``{"kind": "rayleigh", "mass": a, "stiffness": b}``.
+    #[getter]
+    fn damping<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        match self.model.damping() {
+            Damping::None => d.set_item("kind", "none")?,
+            Damping::Local { alpha } => {
+                d.set_item("kind", "local")?;
+                d.set_item("alpha", alpha)?;
+            }
+            Damping::Rayleigh { mass, stiffness } => {
+                d.set_item("kind", "rayleigh")?;
+                d.set_item("mass", mass)?;
+                d.set_item("stiffness", stiffness)?;
+            }
+        }
+        Ok(d)
+    }
+
+    /// Gravity (m/s²), a (3,) array; settable.
+    #[getter]
+    fn gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.model.parameters().gravity)
+    }
+
+    #[setter]
+    fn set_gravity(&mut self, g: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut p = *self.model.parameters();
+        p.gravity = vec3(g, "gravity")?;
+        self.model.set_parameters(p).py()
+    }
+
+    /// Adds a ``Block``; returns its index.
+    fn add_block(&mut self, block: PyRef<'_, PyBlock>) -> PyResult<usize> {
+        Ok(self.model.add_block(block.inner.clone()).py()?.index())
+    }
+
+    /// Adds blocks (a list from ``voussoir.build``, say); returns their indices.
+    fn add_blocks(&mut self, blocks: Vec<PyRef<'_, PyBlock>>) -> PyResult<Vec<usize>> {
+        blocks
+            .iter()
+            .map(|b| Ok(self.model.add_block(b.inner.clone()).py()?.index()))
+            .collect()
+    }
+
+    /// Adds an axis-aligned box from its lowest and highest corners (m), density in kg/m³;
+    /// returns its index.
+    #[pyo3(signature = (name, min, max, density, *, material=0, fixed=None, velocity=None, angular_velocity=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_cuboid(
+        &mut self,
+        name: &str,
+        min: &Bound<'_, PyAny>,
+        max: &Bound<'_, PyAny>,
+        density: f64,
+        material: u16,
+        fixed: Option<&Bound<'_, PyAny>>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<usize> {
+        let b = voussoir::RigidBlock::cuboid(name, vec3(min, "min")?, vec3(max, "max")?, density)
+            .py()?
+            .with_material(MaterialId(material))
+            .with_fixity(fixity(fixed)?)
+            .with_velocity(
+                vec3_or_zero(velocity, "velocity")?,
+                vec3_or_zero(angular_velocity, "angular_velocity")?,
+            );
+        Ok(self.model.add_block(b).py()?.index())
+    }
+
+    /// Adds the convex hull of world points (an (n, 3) array or a list of triples), or, with
+    /// ``faces``, that polyhedron; returns its index.
+    #[pyo3(signature = (name, vertices, density, *, faces=None, material=0, fixed=None, velocity=None, angular_velocity=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_polyhedron(
+        &mut self,
+        name: &str,
+        vertices: &Bound<'_, PyAny>,
+        density: f64,
+        faces: Option<Vec<Vec<usize>>>,
+        material: u16,
+        fixed: Option<&Bound<'_, PyAny>>,
+        velocity: Option<&Bound<'_, PyAny>>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<usize> {
+        let pts = points(vertices, "vertices")?;
+        let b = match faces {
+            Some(f) => voussoir::RigidBlock::from_faces(name, &pts, &f, density),
+            None => voussoir::RigidBlock::from_vertices(name, &pts, density),
+        }
+        .py()?
+        .with_material(MaterialId(material))
+        .with_fixity(fixity(fixed)?)
+        .with_velocity(
+            vec3_or_zero(velocity, "velocity")?,
+            vec3_or_zero(angular_velocity, "angular_velocity")?,
+        );
+        Ok(self.model.add_block(b).py()?.index())
+    }
+
+    /// Sets a block's fixity: ``"fixed"``, ``"free"``, a bool, or ``{"translation": [d, d, d],
+    /// "rotation": [d, d, d]}`` with each ``d`` ``"free"``, ``"fixed"`` or a velocity.
+    fn set_fixity(&mut self, block: usize, fixity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let id = self.id(block)?;
+        let f = crate::convert::fixity(Some(fixity))?;
+        self.model.set_fixity(id, f).py()
+    }
+
+    /// Sets the load on a block: a force (N) at its centroid and a moment (N·m).
+    #[pyo3(signature = (block, force=None, moment=None))]
+    fn set_load(
+        &mut self,
+        block: usize,
+        force: Option<&Bound<'_, PyAny>>,
+        moment: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let id = self.id(block)?;
+        let w = Wrench {
+            force: vec3_or_zero(force, "force")?,
+            moment: vec3_or_zero(moment, "moment")?,
+        };
+        self.model.set_load(id, w).py()
+    }
+
+    /// Sets a block's velocity (m/s) and angular velocity (rad/s).
+    #[pyo3(signature = (block, velocity, angular_velocity=None))]
+    fn set_velocity(
+        &mut self,
+        block: usize,
+        velocity: &Bound<'_, PyAny>,
+        angular_velocity: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let id = self.id(block)?;
+        self.model
+            .set_velocity(
+                id,
+                vec3(velocity, "velocity")?,
+                vec3_or_zero(angular_velocity, "angular_velocity")?,
+            )
+            .py()
+    }
+
+    /// Changes the values of a block's prescribed translation velocities (m/s): each
+    /// translation that its fixity prescribes (a number in ``set_fixity``) takes the matching
+    /// component; free and fixed ones stay. Cheap enough to call between every step.
+    fn set_prescribed_velocity(&mut self, block: usize, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let id = self.id(block)?;
+        self.model.set_prescribed_velocity(id, vec3(velocity, "velocity")?).py()
+    }
+
+    // ---- running --------------------------------------------------------------------------
+
+    /// One step.
+    fn step(&mut self, py: Python<'_>) -> PyResult<()> {
+        self.run(py, Goal::Steps(1), None, 1).map(|_| ())
+    }
+
+    /// Runs ``n`` steps. ``callback(step, time)`` is called every ``every`` steps; the run stops
+    /// if it returns False (or raises). Returns True if all steps ran.
+    #[pyo3(signature = (n, callback=None, every=1000))]
+    fn run_steps(&mut self, py: Python<'_>, n: u64, callback: Option<&Bound<'_, PyAny>>, every: u64) -> PyResult<bool> {
+        Ok(self.run(py, Goal::Steps(n), callback, every)?.1)
+    }
+
+    /// Runs until the simulated time reaches ``t`` (s); callback as ``run_steps``. Returns True
+    /// if the time was reached.
+    #[pyo3(signature = (t, callback=None, every=1000))]
+    fn run_until_time(
+        &mut self,
+        py: Python<'_>,
+        t: f64,
+        callback: Option<&Bound<'_, PyAny>>,
+        every: u64,
+    ) -> PyResult<bool> {
+        Ok(self.run(py, Goal::Time(t), callback, every)?.1)
+    }
+
+    /// Runs until the unbalanced-force ratio falls below ``ratio``; returns the steps taken.
+    /// Raises ``VoussoirError`` after ``max_steps``; callback as ``run_steps`` (a run it stops
+    /// returns the steps taken so far).
+    #[pyo3(signature = (ratio=1e-5, max_steps=1_000_000, callback=None, every=1000))]
+    fn run_to_equilibrium(
+        &mut self,
+        py: Python<'_>,
+        ratio: f64,
+        max_steps: u64,
+        callback: Option<&Bound<'_, PyAny>>,
+        every: u64,
+    ) -> PyResult<u64> {
+        Ok(self
+            .run(
+                py,
+                Goal::Equilibrium {
+                    target: ratio,
+                    max_steps,
+                },
+                callback,
+                every,
+            )?
+            .0)
+    }
+
+    // ---- state ----------------------------------------------------------------------------
+
+    /// Number of blocks.
+    fn __len__(&self) -> usize {
+        self.model.blocks().len()
+    }
+
+    /// Number of blocks.
+    #[getter]
+    fn block_count(&self) -> usize {
+        self.model.blocks().len()
+    }
+    /// Simulated time (s).
+    #[getter]
+    fn time(&self) -> f64 {
+        self.model.time()
+    }
+    /// Steps taken.
+    #[getter]
+    fn step_count(&self) -> u64 {
+        self.model.step_count()
+    }
+    /// Current time step (s); 0 before the first step.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.model.dt()
+    }
+    /// The critical time step (s) of the last detection, or None before the first step.
+    #[getter]
+    fn critical_step(&self) -> Option<f64> {
+        self.model.critical_step().map(|c| c.dt)
+    }
+    /// Unbalanced-force ratio of the last step.
+    #[getter]
+    fn unbalanced_force_ratio(&self) -> f64 {
+        self.model.unbalanced_force_ratio()
+    }
+    /// Number of contacts.
+    #[getter]
+    fn contact_count(&self) -> usize {
+        self.model.contacts().len()
+    }
+    /// Number of sub-contacts.
+    #[getter]
+    fn subcontact_count(&self) -> usize {
+        self.model.subcontact_count()
+    }
+
+    /// A copy of block ``i`` as it is now (a ``Block``).
+    fn block(&self, i: usize) -> PyResult<PyBlock> {
+        let id = self.id(i)?;
+        Ok(PyBlock {
+            inner: self.model.block(id).py()?.clone(),
+        })
+    }
+
+    /// Block names, in index order.
+    fn block_names(&self) -> Vec<String> {
+        self.model.blocks().iter().map(|b| b.name().to_owned()).collect()
+    }
+
+    /// Centroids (m), an (n, 3) array.
+    fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array_n3(py, self.model.blocks().iter().map(|b| b.state().pose.translation))
+    }
+
+    /// Centroid displacements since the blocks were built (m), an (n, 3) array.
+    fn displacements<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array_n3(
+            py,
+            self.model
+                .blocks()
+                .iter()
+                .map(|b| b.state().pose.translation - b.initial_pose().translation),
+        )
+    }
+
+    /// Orientations as unit quaternions ``(x, y, z, w)`` (scalar last, as scipy's
+    /// ``Rotation.from_quat``), an (n, 4) array: the rotation from each block's principal frame
+    /// to the world.
+    fn rotations<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array_nk(
+            py,
+            self.model.blocks().iter().map(|b| {
+                let q = b.state().pose.rotation;
+                [q.x, q.y, q.z, q.w]
+            }),
+        )
+    }
+
+    /// Orientations as rotation matrices (principal frame to world), an (n, 3, 3) array.
+    fn rotation_matrices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        array_n33(
+            py,
+            self.model.blocks().iter().map(|b| {
+                let q = b.state().pose.rotation;
+                let (x, y, z) = (q * Vector::X, q * Vector::Y, q * Vector::Z); // the columns
+                [[x.x, y.x, z.x], [x.y, y.y, z.y], [x.z, y.z, z.z]]
+            }),
+        )
+    }
+
+    /// Velocities of the centroids (m/s), an (n, 3) array.
+    fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array_n3(py, self.model.blocks().iter().map(|b| b.state().velocity))
+    }
+
+    /// Angular velocities (rad/s, world), an (n, 3) array.
+    fn angular_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        array_n3(py, self.model.blocks().iter().map(|b| b.state().angular_velocity))
+    }
+
+    /// The contacts, as a dict of arrays (one row per contact): ``blocks`` (m, 2) ints (a < b),
+    /// ``normal`` (m, 3) unit normal a → b, ``normal_force`` (m,) N (compression positive),
+    /// ``force`` (m, 3) resultant on b (N), ``moment_a``, ``moment_b`` (m, 3) its moments about
+    /// the centroids (N·m), ``subcontact_count`` (m,) ints.
+    fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let cs: Vec<_> = self.model.contacts().collect();
+        let d = PyDict::new(py);
+        let pairs: Vec<i64> = cs
+            .iter()
+            .flat_map(|c| {
+                let (a, b) = c.blocks();
+                [i64::from(a.0), i64::from(b.0)]
+            })
+            .collect();
+        let n = cs.len();
+        d.set_item(
+            "blocks",
+            numpy::ndarray::Array2::from_shape_vec((n, 2), pairs)
+                .expect("2 per row")
+                .into_pyarray(py),
+        )?;
+        d.set_item("normal", array_n3(py, cs.iter().map(|c| c.normal())))?;
+        d.set_item(
+            "normal_force",
+            array1(py, cs.iter().map(|c| c.normal_force()).collect()),
+        )?;
+        d.set_item("force", array_n3(py, cs.iter().map(|c| c.resultant())))?;
+        d.set_item("moment_a", array_n3(py, cs.iter().map(|c| c.wrench().moment_a)))?;
+        d.set_item("moment_b", array_n3(py, cs.iter().map(|c| c.wrench().moment_b)))?;
+        d.set_item(
+            "subcontact_count",
+            array1(py, cs.iter().map(|c| c.subcontact_count() as i64).collect()),
+        )?;
+        Ok(d)
+    }
+
+    /// The sub-contacts of every contact, as a dict of arrays (one row per sub-contact):
+    /// ``contact`` (k,) index of its contact in ``contacts()``, ``point`` (k, 3) world position
+    /// (m), ``area`` (k,) m², ``normal_force`` (k,) N and ``normal_stress`` (k,) Pa (compression
+    /// positive), ``shear_force`` (k, 3) N on block b, ``normal_displacement`` (k,) m (positive
+    /// open), ``slip`` (k,) m, ``status`` a list of ``"elastic"``, ``"sliding"``, ``"open"``.
+    fn subcontacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let mut contact = Vec::new();
+        let mut point = Vec::new();
+        let mut area = Vec::new();
+        let mut fnormal = Vec::new();
+        let mut stress = Vec::new();
+        let mut shear = Vec::new();
+        let mut un = Vec::new();
+        let mut slip = Vec::new();
+        let mut status = Vec::new();
+        for (k, c) in self.model.contacts().enumerate() {
+            for s in c.subcontacts() {
+                contact.push(k as i64);
+                point.push(s.point());
+                area.push(s.area());
+                fnormal.push(s.normal_force());
+                stress.push(s.normal_stress());
+                shear.push(s.shear_force());
+                un.push(s.normal_displacement());
+                slip.push(s.slip());
+                status.push(status_name(s.status()));
+            }
+        }
+        let d = PyDict::new(py);
+        d.set_item("contact", array1(py, contact))?;
+        d.set_item("point", array_n3(py, point.into_iter()))?;
+        d.set_item("area", array1(py, area))?;
+        d.set_item("normal_force", array1(py, fnormal))?;
+        d.set_item("normal_stress", array1(py, stress))?;
+        d.set_item("shear_force", array_n3(py, shear.into_iter()))?;
+        d.set_item("normal_displacement", array1(py, un))?;
+        d.set_item("slip", array1(py, slip))?;
+        d.set_item("status", status)?;
+        Ok(d)
+    }
+
+    /// The energy terms (J) as a dict: ``kinetic``, ``initial_kinetic``, ``elastic``,
+    /// ``gravity_work``, ``load_work``, ``boundary_work``, ``friction``, ``damping``,
+    /// ``joint_work``, and ``input``, ``accounted``, ``balance_error``.
+    fn energies<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let e = self.model.energies();
+        let d = PyDict::new(py);
+        for (k, v) in [
+            ("kinetic", e.kinetic),
+            ("initial_kinetic", e.initial_kinetic),
+            ("elastic", e.elastic),
+            ("gravity_work", e.gravity_work),
+            ("load_work", e.load_work),
+            ("boundary_work", e.boundary_work),
+            ("friction", e.friction),
+            ("damping", e.damping),
+            ("joint_work", e.joint_work),
+            ("input", e.input()),
+            ("accounted", e.accounted()),
+            ("balance_error", e.balance_error()),
+        ] {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
+    }
+
+    /// The force (N) and moment (N·m) that supports and prescribed velocities applied to a
+    /// block in the last step: ``{"force": (3,), "moment": (3,)}``.
+    fn reaction<'py>(&self, py: Python<'py>, block: usize) -> PyResult<Bound<'py, PyDict>> {
+        let w = self.model.reaction(self.id(block)?).py()?;
+        wrench(py, w)
+    }
+
+    /// The total contact force (N) and moment (N·m, about the centroid) on a block:
+    /// ``{"force": (3,), "moment": (3,)}``.
+    fn contact_wrench<'py>(&self, py: Python<'py>, block: usize) -> PyResult<Bound<'py, PyDict>> {
+        let w = self.model.contact_wrench(self.id(block)?).py()?;
+        wrench(py, w)
+    }
+
+    // ---- monitors -------------------------------------------------------------------------
+
+    /// Adds a monitor, sampled after every ``monitor_interval``-th step of the runs:
+    /// ``"displacement"`` or ``"velocity"`` of the material point of ``block`` that was at
+    /// ``point`` (world) when it was built; ``"reaction"`` or ``"contact_force"`` of ``block``;
+    /// ``"contact_resultant"`` between blocks ``a`` and ``b`` (on b); each with ``component``
+    /// ``"x"``, ``"y"``, ``"z"`` or ``"magnitude"``; ``"energy"`` with ``term`` (kinetic,
+    /// elastic, gravity_work, load_work, boundary_work, friction, damping, balance_error);
+    /// ``"unbalanced_ratio"``.
+    #[pyo3(signature = (name, kind, *, block=None, point=None, component="z", a=None, b=None, term=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_monitor(
+        &mut self,
+        name: &str,
+        kind: &str,
+        block: Option<usize>,
+        point: Option<&Bound<'_, PyAny>>,
+        component: &str,
+        a: Option<usize>,
+        b: Option<usize>,
+        term: Option<&str>,
+    ) -> PyResult<()> {
+        let c = self::component(component)?;
+        let need_block = || -> PyResult<BlockId> {
+            let k = block.ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give block=")))?;
+            self.id(k)
+        };
+        let monitor = match kind.to_ascii_lowercase().as_str() {
+            "displacement" | "velocity" => {
+                let p = point.ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give point=")))?;
+                let (block, point) = (need_block()?, vec3(p, "point")?);
+                if kind.eq_ignore_ascii_case("displacement") {
+                    Monitor::Displacement {
+                        block,
+                        point,
+                        component: c,
+                    }
+                } else {
+                    Monitor::Velocity {
+                        block,
+                        point,
+                        component: c,
+                    }
+                }
+            }
+            "reaction" => Monitor::Reaction {
+                block: need_block()?,
+                component: c,
+            },
+            "contact_force" => Monitor::ContactForce {
+                block: need_block()?,
+                component: c,
+            },
+            "contact_resultant" => {
+                let (Some(a), Some(b)) = (a, b) else {
+                    return Err(bad(format!(
+                        "monitor {name:?} of kind \"contact_resultant\": give a= and b="
+                    )));
+                };
+                Monitor::ContactResultant {
+                    a: self.id(a)?,
+                    b: self.id(b)?,
+                    component: c,
+                }
+            }
+            "energy" => Monitor::Energy(energy_term(
+                term.ok_or_else(|| bad(format!("monitor {name:?} of kind \"energy\": give term=")))?,
+            )?),
+            "unbalanced_ratio" => Monitor::UnbalancedRatio,
+            other => {
+                return Err(bad(format!(
+                    "monitor kind {other:?}: expected displacement, velocity, reaction, contact_force, \
+contact_resultant, energy or unbalanced_ratio"
+                )))
+            }
+        };
+        // The library's own checks, with its messages.
+        Recorder::<AnyLaw>::new(1)
+            .add_monitor(&self.model, name, monitor)
+            .py()?;
+        self.samples.add(name, monitor);
+        Ok(())
+    }
+
+    /// Steps between monitor samples (default 1).
+    #[getter]
+    fn monitor_interval(&self) -> u64 {
+        self.samples.interval
+    }
+
+    #[setter]
+    fn set_monitor_interval(&mut self, n: u64) -> PyResult<()> {
+        if n == 0 {
+            return Err(bad("monitor_interval: must be at least 1 step"));
+        }
+        self.samples.interval = n;
+        Ok(())
+    }
+
+    /// Names of the monitors, in order.
+    fn monitor_names(&self) -> Vec<String> {
+        self.samples.monitors.iter().map(|(n, _)| n.clone()).collect()
+    }
+
+    /// The sampled histories: ``{"step": ints, "time": s, <monitor name>: values, ...}``, each
+    /// a 1-D array (NaN where a monitor added late has no sample).
+    fn history<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("step", array1(py, self.samples.steps.clone()))?;
+        d.set_item("time", array1(py, self.samples.times.clone()))?;
+        for ((name, _), c) in self.samples.monitors.iter().zip(&self.samples.columns) {
+            d.set_item(name, array1(py, c.clone()))?;
+        }
+        Ok(d)
+    }
+
+    /// SI units of the monitors: ``{name: unit}``.
+    fn history_units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (name, m) in &self.samples.monitors {
+            d.set_item(name, m.unit())?;
+        }
+        Ok(d)
+    }
+
+    /// Forgets the samples (keeps the monitors).
+    fn clear_history(&mut self) {
+        self.samples.steps.clear();
+        self.samples.times.clear();
+        for c in &mut self.samples.columns {
+            c.clear();
+        }
+    }
+
+    // ---- files ----------------------------------------------------------------------------
+
+    /// Writes the histories as CSV (``time [s],step,<name> [unit],...``), creating the folder.
+    fn write_history_csv(&self, path: PathBuf) -> PyResult<()> {
+        let h = self.samples.history().py()?;
+        voussoir::io::csv::write_history(&path, &h).py()
+    }
+
+    /// Writes the blocks as a ParaView file (``.vtu``) at ``path``.
+    fn write_vtk_blocks(&self, path: PathBuf) -> PyResult<()> {
+        let blocks = self.model.blocks();
+        voussoir::io::vtk::write_blocks(&path, blocks, |i| *blocks[i].initial_pose()).py()
+    }
+
+    /// Writes the sub-contacts (points with forces, stresses, status) as a ParaView file
+    /// (``.vtu``) at ``path``.
+    fn write_vtk_subcontacts(&self, path: PathBuf) -> PyResult<()> {
+        voussoir::io::vtk::write_subcontacts(&path, &self.model).py()
+    }
+
+    /// The model's definition (parameters, damping, laws, blocks as they are now, monitors) as
+    /// scene JSON (``docs/scene-format.md``). With Coulomb laws only, the laws are written as a
+    /// Rust ``Scene<CoulombSlip>`` reads them; otherwise with their kind (``Scene<AnyLaw>``).
+    fn to_scene_json(&self) -> PyResult<String> {
+        let recorder = self.samples.recorder(&self.model).py()?;
+        scene_json(&Scene::from_model(&self.model).with_recorder(&recorder)).py()
+    }
+
+    /// Writes ``to_scene_json()`` to a file.
+    fn save_scene(&self, path: PathBuf) -> PyResult<()> {
+        let text = self.to_scene_json()?;
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| Error::Io {
+                    path: dir.display().to_string(),
+                    message: e.to_string(),
+                })
+                .py()?;
+        }
+        std::fs::write(&path, text)
+            .map_err(|e| Error::Io {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })
+            .py()
+    }
+
+    /// A model from scene JSON, with its monitors (laws with or without their kind).
+    #[staticmethod]
+    fn from_scene_json(text: &str) -> PyResult<Self> {
+        let scene = match normalised(text) {
+            Some(t) => Scene::<AnyLaw>::from_json(&t),
+            None => Scene::<AnyLaw>::from_json(text),
+        }
+        .py()?;
+        let model = scene.build().py()?;
+        let recorder = scene.recorder(&model).py()?;
+        let mut m = Self::wrap(model);
+        m.samples.interval = recorder.interval();
+        for (name, monitor) in recorder.monitors() {
+            m.samples.add(name, *monitor);
+        }
+        Ok(m)
+    }
+
+    /// Reads a scene file (``docs/scene-format.md``).
+    #[staticmethod]
+    fn load_scene(path: PathBuf) -> PyResult<Self> {
+        Self::from_scene_json(&read(&path)?)
+    }
+
+    /// The full state as checkpoint JSON (a run restored from it continues bit-identically).
+    /// Monitors and histories are not in it.
+    fn to_checkpoint_string(&self) -> PyResult<String> {
+        self.model.to_checkpoint_string().py()
+    }
+
+    /// Writes a checkpoint file.
+    fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
+        self.model.save_checkpoint(&path).py()
+    }
+
+    /// A model from checkpoint JSON (of this package, or of a Rust model with one law type).
+    #[staticmethod]
+    fn from_checkpoint_string(text: &str) -> PyResult<Self> {
+        let model = match normalised(text) {
+            Some(t) => Model::<AnyLaw>::from_checkpoint_str(&t),
+            None => Model::<AnyLaw>::from_checkpoint_str(text),
+        }
+        .py()?;
+        Ok(Self::wrap(model))
+    }
+
+    /// Reads a checkpoint file.
+    #[staticmethod]
+    fn load_checkpoint(path: PathBuf) -> PyResult<Self> {
+        Self::from_checkpoint_string(&read(&path)?)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Model({} blocks, {} contacts, step {}, t = {} s)",
+            self.model.blocks().len(),
+            self.model.contacts().len(),
+            self.model.step_count(),
+            self.model.time()
+        )
+    }
+}
+
+fn wrench<'py>(py: Python<'py>, w: Wrench) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("force", vector(py, w.force))?;
+    d.set_item("moment", vector(py, w.moment))?;
+    Ok(d)
+}
+
+/// A ParaView series: ``ParaviewSeries(folder, name)``; ``write_frame(model)`` writes the
+/// blocks and sub-contacts of the model as a frame and rewrites the ``.pvd`` collections
+/// (``blocks_pvd``), which ParaView opens as a time series.
+#[pyclass(name = "ParaviewSeries", module = "voussoir")]
+pub struct PySeries {
+    inner: voussoir::io::vtk::Series,
+}
+
+#[pymethods]
+impl PySeries {
+    #[new]
+    #[pyo3(signature = (folder, name="model"))]
+    fn new(folder: PathBuf, name: &str) -> Self {
+        Self {
+            inner: voussoir::io::vtk::Series::new(folder, name),
+        }
+    }
+
+    /// Writes a frame of the model.
+    fn write_frame(&mut self, model: PyRef<'_, PyModel>) -> PyResult<()> {
+        self.inner.write_frame(&model.model).py()
+    }
+
+    /// The blocks' ``.pvd`` collection.
+    #[getter]
+    fn blocks_pvd(&self) -> PathBuf {
+        self.inner.blocks_pvd()
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+}
+
+/// The benchmarks' wall (``voussoir::scenes::benchmark_wall``): about ``blocks`` bricks in
+/// running bond on a fixed base, dry Coulomb joints (kn 1 GPa/m, ks 0.4 GPa/m, φ 30°),
+/// sub-contacts at most ``spacing`` m apart (default 0.025), local damping; not yet stepped.
+#[pyfunction]
+#[pyo3(signature = (blocks, *, spacing=None))]
+pub fn benchmark_wall(blocks: usize, spacing: Option<f64>) -> PyResult<PyModel> {
+    let model = match spacing {
+        Some(h) => voussoir::scenes::benchmark_wall_with_spacing(blocks, h),
+        None => voussoir::scenes::benchmark_wall(blocks),
+    }
+    .py()?;
+    // A Model<CoulombSlip> as a Model<AnyLaw>, through its scene.
+    let scene = Scene::from_model(&model);
+    let text = scene.to_json().py()?;
+    PyModel::from_scene_json(&text)
+}

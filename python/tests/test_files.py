@@ -1,0 +1,97 @@
+"""ParaView, CSV, scenes and checkpoints."""
+
+import json
+import pathlib
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+import voussoir as vs
+from conftest import PUSH, block_on_base
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+
+
+def test_paraview(tmp_path, model):
+    model.run_steps(10)
+    model.write_vtk_blocks(tmp_path / "blocks.vtu")
+    model.write_vtk_subcontacts(tmp_path / "sub.vtu")
+    for f in ("blocks.vtu", "sub.vtu"):
+        assert ET.parse(tmp_path / f).getroot().tag == "VTKFile"
+    series = vs.ParaviewSeries(tmp_path / "series", "demo")
+    for _ in range(3):
+        model.run_steps(5)
+        series.write_frame(model)
+    assert len(series) == 3
+    pvd = pathlib.Path(series.blocks_pvd)
+    assert pvd.exists() and len(ET.parse(pvd).getroot().findall(".//DataSet")) == 3
+
+
+def test_history_csv(tmp_path, model):
+    model.add_monitor("ux", "displacement", block=1, point=(0.2, 0.15, 0.1), component="x")
+    model.add_monitor("Ek", "energy", term="kinetic")
+    model.run_steps(3)
+    model.write_history_csv(tmp_path / "out" / "h.csv")
+    lines = (tmp_path / "out" / "h.csv").read_text().splitlines()
+    assert lines[0] == "time [s],step,ux [m],Ek [J]"
+    assert len(lines) == 4
+    assert [float(x) for x in lines[-1].split(",")][:2] == pytest.approx([model.time, 3])
+
+
+def test_scene_round_trip(tmp_path, model):
+    model.set_load(1, force=(PUSH, 0, 0))
+    model.add_monitor("ux", "displacement", block=1, point=(0.2, 0.15, 0.1), component="x")
+    model.monitor_interval = 5
+    path = tmp_path / "scene.json"
+    model.save_scene(path)
+    doc = json.loads(path.read_text())
+    # Coulomb laws only: written as a Rust Scene<CoulombSlip> reads them.
+    assert "friction_deg" in doc["joints"][0]["law"]
+    loaded = vs.Model.load_scene(path)
+    assert loaded.monitor_names() == ["ux"] and loaded.monitor_interval == 5
+    assert np.array_equal(loaded.positions(), model.positions())
+    model.run_steps(50)
+    loaded.run_steps(50)
+    assert np.array_equal(loaded.positions(), model.positions())
+    assert np.array_equal(loaded.history()["ux"], model.history()["ux"])
+    # Mixed laws: written with their kind.
+    model.set_joint_law(0, 1, vs.LinearElastic(1e8, 1e8))
+    doc = json.loads(model.to_scene_json())
+    assert {next(iter(j["law"])) for j in doc["joints"]} == {"Coulomb", "Elastic"}
+    assert vs.Model.from_scene_json(model.to_scene_json()).joint_law(1, 0) == vs.LinearElastic(1e8, 1e8)
+
+
+def test_repository_scene_example():
+    m = vs.Model.load_scene(REPO / "docs" / "examples" / "block-on-base.json")
+    assert len(m) >= 2
+    m.run_steps(10)
+
+
+def test_bad_scene():
+    with pytest.raises(vs.VoussoirError, match="density"):
+        vs.Model.from_scene_json(
+            '{"joints": [], "blocks": [{"name": "a", "vertices": [[0,0,0],[1,0,0],[0,1,0],[0,0,1]], "density": "heavy"}]}'
+        )
+    with pytest.raises(vs.VoussoirError):
+        vs.Model.from_scene_json("{not json")
+
+
+def test_checkpoint_bit_identical(tmp_path):
+    m = block_on_base()
+    m.set_load(1, force=(PUSH, 0, 0))
+    m.run_steps(50)
+    m.save_checkpoint(tmp_path / "c.json")
+    restarted = vs.Model.load_checkpoint(tmp_path / "c.json")
+    assert restarted.step_count == 50 and restarted.time == m.time
+    m.run_steps(50)
+    restarted.run_steps(50)
+    assert np.array_equal(m.positions(), restarted.positions())
+    assert np.array_equal(m.velocities(), restarted.velocities())
+    assert np.array_equal(m.subcontacts()["normal_force"], restarted.subcontacts()["normal_force"])
+    again = vs.Model.from_checkpoint_string(m.to_checkpoint_string())
+    assert np.array_equal(again.rotations(), m.rotations())
+    with pytest.raises(vs.VoussoirError, match="checkpoint"):
+        vs.Model.from_checkpoint_string('{"format": 3')
+    with pytest.raises(vs.VoussoirIOError):
+        m.save_checkpoint(tmp_path / "missing-dir" / "x" / "c.json" / "\0")

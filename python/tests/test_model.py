@@ -1,0 +1,290 @@
+"""Building, running and reading a model."""
+
+import math
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import voussoir as vs
+from conftest import PUSH, WEIGHT, block_on_base
+
+
+def test_readme_example_equilibrium(model):
+    """The README's Rust example: half the friction capacity sideways, no sliding."""
+    model.set_load(1, force=(PUSH, 0, 0))
+    steps = model.run_to_equilibrium(1e-5, 50_000)
+    assert 0 < steps < 50_000
+    c = model.contacts()
+    assert c["blocks"].tolist() == [[0, 1]]
+    assert abs(c["normal_force"][0] - WEIGHT) < 1e-3 * WEIGHT
+    # The resultant on the block balances its weight and the push.
+    assert np.allclose(c["force"][0], (-PUSH, 0, WEIGHT), rtol=1e-3, atol=1e-3 * WEIGHT)
+    # The support holds the base's weight and the block's, and the push.
+    base_weight = 2600.0 * 2 * 2 * 0.2 * 9.81
+    assert np.allclose(model.reaction(0)["force"], (-PUSH, 0.0, WEIGHT + base_weight), rtol=1e-3, atol=1e-3 * WEIGHT)
+    assert model.unbalanced_force_ratio < 1e-5
+
+
+def test_arrays(model):
+    model.run_steps(20)
+    n = len(model)
+    assert n == model.block_count == 2
+    for f, shape in [
+        (model.positions, (2, 3)),
+        (model.displacements, (2, 3)),
+        (model.velocities, (2, 3)),
+        (model.angular_velocities, (2, 3)),
+        (model.rotations, (2, 4)),
+        (model.rotation_matrices, (2, 3, 3)),
+    ]:
+        a = f()
+        assert isinstance(a, np.ndarray) and a.dtype == np.float64 and a.shape == shape
+    assert np.allclose(model.positions()[1], (0.2, 0.15, 0.1), atol=1e-4)
+    q = model.rotations()
+    assert np.allclose(np.linalg.norm(q, axis=1), 1.0)
+    r = model.rotation_matrices()
+    assert np.allclose(r @ np.swapaxes(r, 1, 2), np.eye(3), atol=1e-12)
+    assert np.allclose(np.linalg.det(r), 1.0)
+    # The matrices are the quaternions' (x, y, z, w).
+    x, y, z, w = q[1]
+    rq = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    assert np.allclose(rq, r[1], atol=1e-12)
+    sub = model.subcontacts()
+    k = model.subcontact_count
+    assert k == 15 * 15 and len(sub["status"]) == k
+    assert sub["point"].shape == (k, 3) and sub["shear_force"].shape == (k, 3)
+    assert set(sub["status"]) <= {"elastic", "sliding", "open"}
+    assert np.all(sub["contact"] == 0)
+    assert np.isclose(sub["area"].sum(), 0.4 * 0.3)
+    assert np.isclose(sub["normal_force"].sum(), model.contacts()["normal_force"][0])
+    e = model.energies()
+    assert {"kinetic", "elastic", "gravity_work", "friction", "damping", "balance_error"} <= set(e)
+    assert model.time > 0 and model.step_count == 20 and model.dt > 0
+    assert model.critical_step is not None and model.dt <= model.critical_step
+
+
+def test_blocks_and_generators():
+    cube = vs.Block.from_vertices(
+        "cube", [(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)], 1000.0
+    )
+    assert math.isclose(cube.mass, 1000.0) and math.isclose(cube.volume, 1.0)
+    assert np.allclose(cube.centroid, (0.5, 0.5, 0.5))
+    assert cube.vertices.shape == (8, 3)
+    # A tetrahedron with explicit faces, from a numpy array.
+    tet = vs.Block.from_vertices(
+        "tet",
+        np.array([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1.0)]),
+        2000.0,
+        faces=[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    )
+    assert math.isclose(tet.volume, 1 / 6)
+    fixed = cube.with_fixity("fixed").with_material(3)
+    assert fixed.is_fixed and fixed.material == 3 and not cube.is_fixed
+    plate = cube.with_fixity({"translation": ["free", -0.01, "free"], "rotation": ["fixed"] * 3})
+    assert plate.fixity == {"translation": ["free", -0.01, "free"], "rotation": ["fixed"] * 3}
+
+    arch = vs.build.arch()
+    assert len(arch) == 15 and arch[0].is_fixed and arch[-1].is_fixed
+    assert not any(b.is_fixed for b in arch[1:-1])
+    assert len(vs.build.arch(voussoirs=7, width=0.2)) == 9
+    wall = vs.build.running_bond_wall(bricks_per_course=4, courses=3)
+    assert wall[0].is_fixed and len(wall) == 1 + 4 + 5 + 4
+    assert len(vs.build.barrel_vault(rings=2, voussoirs=9)) > 18
+    assert len(vs.build.dome(blocks=100)) > 50
+    assert len(vs.build.multi_leaf_wall(length=1.0, height=0.4)) > 10
+    w = vs.scenes.benchmark_wall(50)
+    assert len(w) > 30 and isinstance(w.joint_law(0, 0), vs.CoulombSlip)
+
+
+def test_arch_stands_under_gravity():
+    m = vs.Model(gravity=(0, -9.81, 0), subcontacts_per_edge=5)
+    m.set_joint_law(0, 0, vs.CoulombSlip.dry(4e9, 1.6e9, 30.5))
+    ids = m.add_blocks(vs.build.arch())
+    assert ids == list(range(15))
+    m.run_to_equilibrium(1e-5, 100_000)
+    assert np.abs(m.displacements()).max() < 1e-3
+    assert m.contact_count == 14
+
+
+def test_laws():
+    law = vs.CoulombSlip(4e9, 1.6e9, 35.0, residual_friction_deg=25.0, cohesion=1e5, tensile_strength=5e4)
+    assert (law.kn, law.ks, law.friction_deg, law.residual_friction_deg) == (4e9, 1.6e9, 35.0, 25.0)
+    assert (law.cohesion, law.tensile_strength) == (1e5, 5e4)
+    assert vs.CoulombSlip.dry(1e9, 4e8, 30).residual_friction_deg == 30
+    pad = vs.LinearElastic(2e8, 8e7)
+    m = vs.Model()
+    m.set_joint_law(0, 0, law)
+    m.set_joint_law(1, 0, pad)
+    assert m.joint_law(0, 0) == law and m.joint_law(0, 1) == pad and m.joint_law(1, 1) is None
+    # Mixed laws in one model (AnyLaw): a stone cube (Coulomb), an elastic pad beside it.
+    m.add_cuboid("base", (-1, -1, -0.2), (1, 1, 0), 2500.0, fixed=True)
+    m.add_cuboid("cube", (0, 0, 0), (0.2, 0.2, 0.2), 2500.0)
+    m.add_cuboid("pad", (0.5, 0, 0), (0.7, 0.2, 0.05), 1200.0, material=1)
+    m.run_to_equilibrium(1e-4, 20_000)
+    weight = (2500.0 * 0.008 + 1200.0 * 0.002) * 9.81
+    assert abs(m.contacts()["normal_force"].sum() - weight) < 1e-3 * weight
+
+
+def test_damping_and_parameters(model):
+    assert model.damping == {"kind": "local", "alpha": 0.8}
+    model.set_damping("none")
+    assert model.damping == {"kind": "none"}
+    model.set_damping("rayleigh", ratio=0.01, frequency=25.0)
+    d = model.damping
+    assert d["kind"] == "rayleigh" and d["mass"] > 0 and d["stiffness"] > 0
+    model.set_damping("rayleigh_stiffness", ratio=0.01, frequency=25.0)
+    assert model.damping["mass"] == 0
+    model.gravity = (0, 0, -10.0)
+    assert model.gravity.tolist() == [0, 0, -10.0]
+    with pytest.raises(vs.VoussoirError, match="alpha"):
+        model.set_damping("local", alpha=1.5)
+    with pytest.raises(vs.VoussoirError, match="ratio= and frequency="):
+        model.set_damping("rayleigh_mass")
+    fixed = vs.Model(time_step=1e-6, mode="small", subcontact_spacing=0.05)
+    fixed.set_joint_law(0, 0, vs.LinearElastic(1e9, 1e9))
+    fixed.add_cuboid("a", (0, 0, 0), (1, 1, 1), 1000.0)
+    fixed.step()
+    assert fixed.dt == 1e-6
+
+
+def test_fixity_velocity_load(model):
+    model.set_fixity(1, {"translation": [0.02, "free", "free"], "rotation": ["fixed"] * 3})
+    model.set_velocity(1, (0.0, 0.0, 0.0), (0, 0, 0))
+    model.set_prescribed_velocity(1, (0.01, 0, 0))
+    model.run_steps(100)
+    assert math.isclose(model.velocities()[1, 0], 0.01)
+    assert model.block(1).fixity == {"translation": [0.01, "free", "free"], "rotation": ["fixed"] * 3}
+    model.set_fixity(1, "free")
+    model.set_load(1, force=(0, 0, -1000.0), moment=None)
+    assert model.block(1).fixity["translation"] == ["free"] * 3
+
+
+def test_errors_are_python_exceptions():
+    # ValueError subclass, the Rust message.
+    with pytest.raises(vs.VoussoirError) as e:
+        vs.CoulombSlip.dry(-1.0, 1e9, 30.0)
+    assert isinstance(e.value, ValueError)
+    assert str(e.value) == "invalid parameter `normal_stiffness` = -1: must be positive and finite"
+    with pytest.raises(ValueError, match="friction"):
+        vs.CoulombSlip.dry(1e9, 1e9, 95.0)
+    m = vs.Model()
+    with pytest.raises(vs.VoussoirError, match="the model has no blocks"):
+        m.step()
+    with pytest.raises(vs.VoussoirError, match=r"block #5 does not exist \(the model has 0 blocks\)"):
+        m.set_load(5, force=(1, 0, 0))
+    with pytest.raises(vs.VoussoirError, match="degenerate geometry"):
+        m.add_polyhedron("flat", [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)], 1000.0)
+    with pytest.raises(vs.VoussoirError, match="expected 3 numbers"):
+        m.add_cuboid("a", (0, 0), (1, 1, 1), 1000.0)
+    with pytest.raises(vs.VoussoirError, match="custom-law.md"):
+        m.set_joint_law(0, 0, object())
+    m.add_cuboid("a", (0, 0, 0), (1, 1, 1), 1000.0)
+    m.add_cuboid("b", (0, 0, 0.5), (1, 1, 1.5), 1000.0)
+    with pytest.raises(vs.VoussoirError, match="no joint law for materials|overlap"):
+        m.step()
+    m2 = block_on_base()
+    with pytest.raises(vs.VoussoirError, match="not reached after 3 steps"):
+        m2.run_to_equilibrium(1e-12, 3)
+    with pytest.raises(vs.VoussoirError, match="end time"):
+        m2.run_until_time(float("nan"))
+    # I/O: an OSError subclass naming the file.
+    with pytest.raises(vs.VoussoirIOError) as e:
+        vs.Model.load_scene("/nonexistent/scene.json")
+    assert isinstance(e.value, OSError) and "/nonexistent/scene.json" in str(e.value)
+
+
+def test_progress_callback(model):
+    calls = []
+    assert model.run_steps(1000, callback=lambda step, t: calls.append((step, t)), every=250)
+    assert [c[0] for c in calls] == [250, 500, 750, 1000]
+    assert all(t > 0 for _, t in calls)
+    # Returning False stops the run after that call.
+    assert not model.run_steps(1000, callback=lambda step, t: step < 1500, every=100)
+    assert model.step_count == 1500
+    assert not model.run_until_time(10.0, callback=lambda step, t: False, every=10)
+    assert model.step_count == 1510
+
+    # Raising stops the run and propagates.
+    class Stop(Exception):
+        pass
+
+    def boom(step, t):
+        raise Stop(step)
+
+    with pytest.raises(Stop):
+        model.run_to_equilibrium(1e-30, 10_000, callback=boom, every=7)
+    assert model.step_count == 1517
+    # The equilibrium run reports its steps.
+    fresh = block_on_base()
+    seen = []
+    n = fresh.run_to_equilibrium(1e-5, 100_000, callback=lambda s, t: seen.append(s), every=100)
+    assert len(seen) == n // 100 and fresh.step_count == n
+
+
+def test_monitors_and_history(model):
+    model.add_monitor("uz", "displacement", block=1, point=(0.2, 0.15, 0.2), component="z")
+    model.add_monitor("N", "contact_resultant", a=0, b=1, component="z")
+    model.add_monitor("Ek", "energy", term="kinetic")
+    model.add_monitor("ratio", "unbalanced_ratio")
+    model.monitor_interval = 10
+    model.run_steps(100)
+    h = model.history()
+    assert list(h) == ["step", "time", "uz", "N", "Ek", "ratio"]
+    assert h["step"].tolist() == list(range(10, 101, 10))
+    assert all(len(v) == 10 for v in h.values())
+    assert h["uz"][-1] < 0  # it settles into its joint
+    assert model.history_units() == {"uz": "m", "N": "N", "Ek": "J", "ratio": "-"}
+    with pytest.raises(vs.VoussoirError, match="block #7 does not exist"):
+        model.add_monitor("bad", "reaction", block=7)
+    with pytest.raises(vs.VoussoirError, match="monitor kind"):
+        model.add_monitor("bad", "temperature")
+    model.clear_history()
+    assert len(model.history()["time"]) == 0 and model.monitor_names() == ["uz", "N", "Ek", "ratio"]
+
+
+def test_gil_released_during_run():
+    """Another Python thread runs while the model steps."""
+    m = vs.scenes.benchmark_wall(200)
+    ticks = []
+    done = threading.Event()
+
+    def count():
+        while not done.is_set():
+            ticks.append(1)
+            time.sleep(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    start = time.perf_counter()
+    m.run_steps(400)
+    elapsed = time.perf_counter() - start
+    done.set()
+    t.join()
+    # A thread blocked on the GIL would count (almost) nothing during the run.
+    assert len(ticks) > 0.2 * elapsed / 0.001 or elapsed < 0.05, (len(ticks), elapsed)
+
+
+def test_ctrl_c_stops_a_run_cleanly():
+    m = vs.scenes.benchmark_wall(200)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    start = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        m.run_steps(10**9)
+    timer.join()
+    assert time.perf_counter() - start < 5.0
+    # Stopped between steps: the model is still usable.
+    n = m.step_count
+    assert n > 0
+    m.run_steps(1)
+    assert m.step_count == n + 1 and np.isfinite(m.positions()).all()

@@ -1,0 +1,36 @@
+"""voussoir: discrete element modelling of masonry built from rigid blocks.
+
+The Python face of the Rust library of the same name (PyO3): build models from blocks and
+generators, run them (the GIL released; Ctrl-C and a progress callback between steps), read the
+results as numpy arrays, write ParaView and CSV files, save and load scenes and checkpoints, and
+run the reference arch's benchmarks (``voussoir.scenarios``).
+
+Joint laws are the shipped ones (``CoulombSlip``, ``LinearElastic``); a law of your own is
+written in Rust (``docs/custom-law.md``), not in Python.
+"""
+
+from ._voussoir import (
+    Block,
+    CoulombSlip,
+    LinearElastic,
+    Model,
+    ParaviewSeries,
+    VoussoirError,
+    VoussoirIOError,
+    __version__,
+)
+from . import build, scenarios, scenes
+
+__all__ = [
+    "Block",
+    "CoulombSlip",
+    "LinearElastic",
+    "Model",
+    "ParaviewSeries",
+    "VoussoirError",
+    "VoussoirIOError",
+    "__version__",
+    "build",
+    "scenarios",
+    "scenes",
+]

@@ -1,0 +1,352 @@
+"""Type stubs of the native module ``voussoir._voussoir`` (re-exported by ``voussoir``)."""
+
+from os import PathLike
+from typing import Any, Callable, Dict, Iterable, List, Literal, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+Vec3 = Union[Sequence[float], npt.ArrayLike]
+Points = Union[Sequence[Sequence[float]], npt.ArrayLike]
+Dof = Union[Literal["free", "fixed"], float]
+FixitySpec = Union[bool, None, Literal["fixed", "free"], Dict[str, Sequence[Dof]]]
+Path = Union[str, "PathLike[str]"]
+Progress = Callable[[int, float], Optional[bool]]
+FloatArray = npt.NDArray[np.float64]
+IntArray = npt.NDArray[np.int64]
+
+class VoussoirError(ValueError):
+    """Bad input, divergence, no convergence, a corrupt scene or checkpoint."""
+
+class VoussoirIOError(OSError):
+    """Reading or writing a file failed."""
+
+class CoulombSlip:
+    def __init__(
+        self,
+        kn: float,
+        ks: float,
+        friction_deg: float,
+        residual_friction_deg: Optional[float] = None,
+        cohesion: float = 0.0,
+        tensile_strength: float = 0.0,
+    ) -> None: ...
+    @staticmethod
+    def dry(kn: float, ks: float, friction_deg: float) -> "CoulombSlip": ...
+    @property
+    def kn(self) -> float: ...
+    @property
+    def ks(self) -> float: ...
+    @property
+    def friction_deg(self) -> float: ...
+    @property
+    def residual_friction_deg(self) -> float: ...
+    @property
+    def cohesion(self) -> float: ...
+    @property
+    def tensile_strength(self) -> float: ...
+
+class LinearElastic:
+    def __init__(self, kn: float, ks: float) -> None: ...
+    @property
+    def kn(self) -> float: ...
+    @property
+    def ks(self) -> float: ...
+
+JointLaw = Union[CoulombSlip, LinearElastic]
+
+class Block:
+    @staticmethod
+    def cuboid(
+        name: str,
+        min: Vec3,
+        max: Vec3,
+        density: float,
+        *,
+        material: int = 0,
+        fixed: FixitySpec = None,
+        velocity: Optional[Vec3] = None,
+        angular_velocity: Optional[Vec3] = None,
+    ) -> "Block": ...
+    @staticmethod
+    def from_vertices(
+        name: str,
+        vertices: Points,
+        density: float,
+        *,
+        faces: Optional[Sequence[Sequence[int]]] = None,
+        material: int = 0,
+        fixed: FixitySpec = None,
+        velocity: Optional[Vec3] = None,
+        angular_velocity: Optional[Vec3] = None,
+    ) -> "Block": ...
+    def with_material(self, material: int) -> "Block": ...
+    def with_fixity(self, fixity: FixitySpec) -> "Block": ...
+    def with_velocity(self, velocity: Vec3, angular_velocity: Optional[Vec3] = None) -> "Block": ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def material(self) -> int: ...
+    @property
+    def density(self) -> float: ...
+    @property
+    def mass(self) -> float: ...
+    @property
+    def volume(self) -> float: ...
+    @property
+    def centroid(self) -> FloatArray: ...
+    @property
+    def vertices(self) -> FloatArray: ...
+    @property
+    def fixity(self) -> Dict[str, List[Dof]]: ...
+    @property
+    def is_fixed(self) -> bool: ...
+
+class Model:
+    def __init__(
+        self,
+        *,
+        gravity: Optional[Vec3] = None,
+        contact_tolerance: float = 1e-3,
+        subcontacts_per_edge: int = 15,
+        subcontact_spacing: Optional[float] = None,
+        time_step: Optional[float] = None,
+        safety: float = 0.5,
+        mode: Literal["large", "small"] = "large",
+        max_speed: float = 1000.0,
+        impact_step: Optional[float] = 0.1,
+    ) -> None: ...
+    # building
+    def set_joint_law(self, a: int, b: int, law: JointLaw) -> None: ...
+    def joint_law(self, a: int, b: int) -> Optional[JointLaw]: ...
+    def set_damping(
+        self,
+        kind: Literal["none", "local", "rayleigh", "rayleigh_mass", "rayleigh_stiffness"],
+        *,
+        alpha: float = 0.8,
+        ratio: Optional[float] = None,
+        frequency: Optional[float] = None,
+        mass: Optional[float] = None,
+        stiffness: Optional[float] = None,
+    ) -> None: ...
+    @property
+    def damping(self) -> Dict[str, Any]: ...
+    @property
+    def gravity(self) -> FloatArray: ...
+    @gravity.setter
+    def gravity(self, g: Vec3) -> None: ...
+    def add_block(self, block: Block) -> int: ...
+    def add_blocks(self, blocks: Iterable[Block]) -> List[int]: ...
+    def add_cuboid(
+        self,
+        name: str,
+        min: Vec3,
+        max: Vec3,
+        density: float,
+        *,
+        material: int = 0,
+        fixed: FixitySpec = None,
+        velocity: Optional[Vec3] = None,
+        angular_velocity: Optional[Vec3] = None,
+    ) -> int: ...
+    def add_polyhedron(
+        self,
+        name: str,
+        vertices: Points,
+        density: float,
+        *,
+        faces: Optional[Sequence[Sequence[int]]] = None,
+        material: int = 0,
+        fixed: FixitySpec = None,
+        velocity: Optional[Vec3] = None,
+        angular_velocity: Optional[Vec3] = None,
+    ) -> int: ...
+    def set_fixity(self, block: int, fixity: FixitySpec) -> None: ...
+    def set_load(self, block: int, force: Optional[Vec3] = None, moment: Optional[Vec3] = None) -> None: ...
+    def set_velocity(self, block: int, velocity: Vec3, angular_velocity: Optional[Vec3] = None) -> None: ...
+    def set_prescribed_velocity(self, block: int, velocity: Vec3) -> None: ...
+    # running
+    def step(self) -> None: ...
+    def run_steps(self, n: int, callback: Optional[Progress] = None, every: int = 1000) -> bool: ...
+    def run_until_time(self, t: float, callback: Optional[Progress] = None, every: int = 1000) -> bool: ...
+    def run_to_equilibrium(
+        self,
+        ratio: float = 1e-5,
+        max_steps: int = 1_000_000,
+        callback: Optional[Progress] = None,
+        every: int = 1000,
+    ) -> int: ...
+    # state
+    def __len__(self) -> int: ...
+    @property
+    def block_count(self) -> int: ...
+    @property
+    def time(self) -> float: ...
+    @property
+    def step_count(self) -> int: ...
+    @property
+    def dt(self) -> float: ...
+    @property
+    def critical_step(self) -> Optional[float]: ...
+    @property
+    def unbalanced_force_ratio(self) -> float: ...
+    @property
+    def contact_count(self) -> int: ...
+    @property
+    def subcontact_count(self) -> int: ...
+    def block(self, i: int) -> Block: ...
+    def block_names(self) -> List[str]: ...
+    def positions(self) -> FloatArray: ...
+    def displacements(self) -> FloatArray: ...
+    def rotations(self) -> FloatArray: ...
+    def rotation_matrices(self) -> FloatArray: ...
+    def velocities(self) -> FloatArray: ...
+    def angular_velocities(self) -> FloatArray: ...
+    def contacts(self) -> Dict[str, Any]: ...
+    def subcontacts(self) -> Dict[str, Any]: ...
+    def energies(self) -> Dict[str, float]: ...
+    def reaction(self, block: int) -> Dict[str, FloatArray]: ...
+    def contact_wrench(self, block: int) -> Dict[str, FloatArray]: ...
+    # monitors
+    def add_monitor(
+        self,
+        name: str,
+        kind: Literal[
+            "displacement",
+            "velocity",
+            "reaction",
+            "contact_force",
+            "contact_resultant",
+            "energy",
+            "unbalanced_ratio",
+        ],
+        *,
+        block: Optional[int] = None,
+        point: Optional[Vec3] = None,
+        component: Literal["x", "y", "z", "magnitude"] = "z",
+        a: Optional[int] = None,
+        b: Optional[int] = None,
+        term: Optional[str] = None,
+    ) -> None: ...
+    @property
+    def monitor_interval(self) -> int: ...
+    @monitor_interval.setter
+    def monitor_interval(self, n: int) -> None: ...
+    def monitor_names(self) -> List[str]: ...
+    def history(self) -> Dict[str, npt.NDArray[Any]]: ...
+    def history_units(self) -> Dict[str, str]: ...
+    def clear_history(self) -> None: ...
+    # files
+    def write_history_csv(self, path: Path) -> None: ...
+    def write_vtk_blocks(self, path: Path) -> None: ...
+    def write_vtk_subcontacts(self, path: Path) -> None: ...
+    def to_scene_json(self) -> str: ...
+    def save_scene(self, path: Path) -> None: ...
+    @staticmethod
+    def from_scene_json(text: str) -> "Model": ...
+    @staticmethod
+    def load_scene(path: Path) -> "Model": ...
+    def to_checkpoint_string(self) -> str: ...
+    def save_checkpoint(self, path: Path) -> None: ...
+    @staticmethod
+    def from_checkpoint_string(text: str) -> "Model": ...
+    @staticmethod
+    def load_checkpoint(path: Path) -> "Model": ...
+
+class ParaviewSeries:
+    def __init__(self, folder: Path, name: str = "model") -> None: ...
+    def write_frame(self, model: Model) -> None: ...
+    @property
+    def blocks_pvd(self) -> str: ...
+    def __len__(self) -> int: ...
+
+# voussoir.build
+def arch(
+    *,
+    span: float = 1.2,
+    rise: float = 0.4,
+    thickness: float = 0.2,
+    width: float = 0.15,
+    voussoirs: int = 13,
+    density: float = ...,
+    abutment_outer_width: float = 0.20,
+    abutment_depth: float = 0.30,
+    voussoir_material: int = 0,
+    abutment_material: int = 0,
+) -> List[Block]: ...
+def running_bond_wall(
+    *,
+    bricks_per_course: int = 10,
+    courses: int = 10,
+    brick: Optional[Vec3] = None,
+    density: float = 2000.0,
+    material: int = 0,
+    base_material: int = 0,
+) -> List[Block]: ...
+def multi_leaf_wall(
+    *,
+    length: float = 2.0,
+    height: float = 1.0,
+    leaves: Optional[Points] = None,
+    density: float = 2000.0,
+    material: int = 0,
+) -> List[Block]: ...
+def barrel_vault(
+    *,
+    radius: float = 2.0,
+    thickness: float = 0.3,
+    ring_length: float = 0.25,
+    rings: int = 10,
+    voussoirs: int = 25,
+    density: float = 2200.0,
+    material: int = 0,
+) -> List[Block]: ...
+def dome(
+    *,
+    blocks: Optional[int] = None,
+    radius: Optional[float] = None,
+    thickness: Optional[float] = None,
+    per_course: Optional[Sequence[int]] = None,
+    oculus_angle: Optional[float] = None,
+    density: Optional[float] = None,
+    material: int = 0,
+) -> List[Block]: ...
+
+# voussoir.scenes
+def benchmark_wall(blocks: int, *, spacing: Optional[float] = None) -> Model: ...
+
+# voussoir.scenarios
+def arch_static(
+    *,
+    friction_deg: float = 30.5,
+    kn: float = 4e9,
+    ks: Optional[float] = None,
+    width: float = 0.15,
+    mode: Literal["large", "small"] = "large",
+    per_edge: int = 15,
+    servo_increment: float = 2e-5,
+    servo_ratio: float = 1e-3,
+    rate: Optional[float] = None,
+    max_displacement: float = 0.012,
+    stop_fraction: float = 0.5,
+    local_damping: float = 0.8,
+    convergence_check: bool = False,
+    label: Optional[str] = None,
+) -> Dict[str, Any]: ...
+def arch_impact(
+    setup: str = "M60H20",
+    *,
+    kn: float = 4e9,
+    damping: float = 0.01,
+    width: float = 0.15,
+    duration: float = 1.0,
+    friction_deg: float = 30.5,
+    per_edge: int = 15,
+    guide: Literal["frame", "seat"] = "frame",
+    base: Literal["sloped", "flat"] = "sloped",
+    release: Literal["above", "full"] = "above",
+    offsets_mm: Sequence[float] = (0.0,),
+) -> Dict[str, Any]: ...
+def impact_setups() -> List[Dict[str, Any]]: ...
