@@ -13,32 +13,46 @@
 use clap::Args;
 use serde::Serialize;
 
-use super::{finite, BoxError, Outputs, Run};
+use std::ops::Bound::{Excluded, Included};
+
+use super::args::{whole, Interval};
+use super::{BoxError, Outputs, Run};
 use crate::scenarios::arch_limit::{run, write_mechanism, LimitCase};
 use crate::scenarios::arch_static::{LimitSummary, StaticCase};
 
 /// Options of the limit analysis.
 #[derive(Debug, Clone, Args)]
 pub struct LimitArgs {
-    /// Joint friction angle (°)
-    #[arg(long, value_name = "DEG", value_parser = finite, default_value = "30.5")]
+    /// Joint friction angle (°), in (0, 90)
+    #[arg(long, value_name = "DEG", value_parser = super::arch_static::FRICTION_RANGE.parser(), default_value = "30.5")]
     pub friction: f64,
     /// Analyse the arch as built instead of settled under gravity
     #[arg(long)]
     pub no_settle: bool,
     /// Frames of the mechanism in the ParaView series
-    #[arg(long, value_name = "N", default_value = "21")]
+    #[arg(long, value_name = "N", value_parser = whole::<usize>(2), default_value = "21")]
     pub frames: usize,
-    /// Largest displacement of a block's vertex in the last frame of the mechanism (m)
-    #[arg(long, value_name = "M", value_parser = finite, default_value = "0.03")]
+    /// Largest displacement of a block's vertex in the last frame of the mechanism (m), in
+    /// (0, 1]
+    #[arg(long, value_name = "M", value_parser = AMPLITUDE_RANGE.parser(), default_value = "0.03")]
     pub amplitude: f64,
 }
+
+/// Range of `--amplitude` (m): a visible mechanism on a 1.2 m span.
+pub const AMPLITUDE_RANGE: Interval = Interval {
+    lo: Excluded(0.0),
+    hi: Included(1.0),
+};
 
 impl Run for LimitArgs {
     const NAME: &'static str = "limit_arch";
     const OUT: &'static str = "out/limit_arch";
     const ABOUT: &'static str = "Limit analysis of the reference arch (Pulatsu, Gonen & Lourenço 2021) under a point \
 load on voussoir 5: collapse load and mechanism";
+
+    fn outputs(&self) -> Vec<String> {
+        vec!["limit.json".into()]
+    }
 
     fn run(&self, out: &Outputs) -> Result<(), BoxError> {
         let case = LimitCase {
