@@ -12,7 +12,7 @@ use crate::error::{io_error, Result};
 ///
 /// # Errors
 /// [`crate::Error::Io`] naming the folder, the temporary file or the target.
-pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     if let Some(dir) = dir {
         std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;

@@ -409,6 +409,18 @@ fn edited_derived_data_is_refused() -> Result<()> {
             Box::new(move |j| j["blocks"][i]["shape"]["radius"] = scale(&j["blocks"][i]["shape"]["radius"], 0.5)),
             "shape.radius",
         ),
+        (
+            // Construction refuses hulls beyond geometry::MAX_HULL_VERTICES (their detection
+            // costs seconds); a file must not bring one in.
+            "300 more vertices",
+            Box::new(move |j| {
+                let v = j["blocks"][i]["shape"]["vertices"][0].clone();
+                if let Some(list) = j["blocks"][i]["shape"]["vertices"].as_array_mut() {
+                    list.extend(std::iter::repeat_n(v, 300));
+                }
+            }),
+            "shape.vertices",
+        ),
     ];
     for (what, edit, field) in &cases {
         let mut json = original.clone();

@@ -126,13 +126,6 @@ fn span(v: &[f64]) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
-fn io_error(path: &Path, e: &std::io::Error) -> Error {
-    Error::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    }
-}
-
 impl LinePlot {
     /// Renders the plot as an SVG document. Total over any input: points and references with a
     /// non-finite coordinate are skipped, finite coordinates beyond ±[`COORDINATE_LIMIT`] are
@@ -158,10 +151,7 @@ impl LinePlot {
     /// [`Error::Io`] naming the file.
     pub fn write_svg(&self, path: &Path) -> Result<()> {
         let svg = self.to_svg_string()?;
-        if let Some(dir) = path.parent() {
-            std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
-        }
-        std::fs::write(path, svg).map_err(|e| io_error(path, &e))
+        voussoir::io::write_atomically(path, svg.as_bytes())
     }
 
     /// The axis ranges: every finite curve point and reference, each coordinate clamped to

@@ -197,15 +197,13 @@ fn create_folder(dir: &Path) -> voussoir::Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| io_error(dir, format!("cannot create the output folder ({e})")))
 }
 
-/// Writes `text` to `path`, creating its folder.
+/// Writes `text` to `path`, creating its folder, atomically (a temporary file beside it renamed
+/// over it: a failure never leaves a half-written file).
 ///
 /// # Errors
 /// [`voussoir::Error::Io`] naming the file (or its folder).
 pub fn write_text(path: &Path, text: &str) -> voussoir::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| io_error(dir, e.to_string()))?;
-    }
-    std::fs::write(path, text).map_err(|e| io_error(path, e.to_string()))
+    voussoir::io::write_atomically(path, text.as_bytes())
 }
 
 fn io_error(path: &Path, message: String) -> voussoir::Error {

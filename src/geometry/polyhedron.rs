@@ -359,6 +359,15 @@ impl Polyhedron {
                 format!("is {stored:?} in the file, its vertices give {computed:?}"),
             ))
         };
+        if self.vertices.len() > MAX_HULL_VERTICES {
+            return Err((
+                "shape.vertices".into(),
+                format!(
+                    "has {} vertices, more than the {MAX_HULL_VERTICES} a block may have",
+                    self.vertices.len()
+                ),
+            ));
+        }
         let mut edges: Vec<[u32; 2]> = Vec::new();
         for (i, f) in self.faces.iter().enumerate() {
             let ids = self.face_loop(i);

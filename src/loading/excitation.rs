@@ -202,7 +202,10 @@ impl TimeHistory {
     /// # Errors
     /// [`Error::Io`] naming the file, and as [`TimeHistory::from_csv`].
     pub fn from_csv_file(path: &std::path::Path, time_column: usize, value_column: usize, scale: Real) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| crate::error::io_error(path, &e))?;
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
         Self::from_csv(&text, time_column, value_column, scale)
     }
 

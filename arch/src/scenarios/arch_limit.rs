@@ -129,9 +129,6 @@ pub fn write_mechanism(
     }
     pvd.push_str("</Collection>\n</VTKFile>\n");
     let path = dir.join(format!("{name}_blocks.pvd"));
-    std::fs::write(&path, pvd).map_err(|e| Error::Io {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+    voussoir::io::write_atomically(&path, pvd.as_bytes())?;
     Ok(path)
 }
