@@ -211,3 +211,37 @@ fn a_checkpoint_resumes_the_shaking() {
         "the table moved"
     );
 }
+
+/// The scene-file form: a block's `motion`, read, built and written back.
+#[test]
+fn scene_files_carry_base_motions() {
+    let text = r#"{
+      "damping": "None",
+      "joints": [{ "materials": [0, 0], "law": { "normal_stiffness": 1e9, "shear_stiffness": 4e8, "friction_deg": 30.0, "residual_friction_deg": 30.0 } }],
+      "blocks": [{
+        "name": "table",
+        "vertices": [[-1, -1, -0.2], [1, -1, -0.2], [1, 1, -0.2], [-1, 1, -0.2], [-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]],
+        "density": 2500.0,
+        "fixity": { "translation": ["Fixed", "Fixed", "Fixed"], "rotation": ["Fixed", "Fixed", "Fixed"] },
+        "motion": { "kind": "Velocity", "axes": [{ "times": [0.0, 1.0], "values": [0.1, 0.1] }, null, null] }
+      }]
+    }"#;
+    let scene = voussoir::io::scene::Scene::<CoulombSlip>::from_json(text).expect("scene");
+    let mut model = scene.build().expect("build");
+    model.run_until_time(0.5).expect("run");
+    let x = model.block(BlockId(0)).expect("table").state().pose.translation.x;
+    // 0.1 m/s for the time run (the last step may end past 0.5 s).
+    assert!((x - 0.1 * model.time()).abs() < 1e-12, "{x} at {}", model.time());
+    let again = voussoir::io::scene::Scene::from_model(&model);
+    assert_eq!(again.blocks[0].motion, scene.blocks[0].motion);
+    // A motion on a free axis is refused with its path.
+    let free = text.replace(
+        r#""translation": ["Fixed", "Fixed", "Fixed"]"#,
+        r#""translation": ["Free", "Fixed", "Fixed"]"#,
+    );
+    let e = voussoir::io::scene::Scene::<CoulombSlip>::from_json(&free)
+        .expect("scene")
+        .build()
+        .expect_err("free axis");
+    assert!(e.to_string().contains("blocks[0].motion"), "{e}");
+}

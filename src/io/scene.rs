@@ -46,6 +46,11 @@ pub struct BlockSpec {
     /// Constant applied load (force and moment about the centroid).
     #[serde(default)]
     pub load: Wrench,
+    /// Base motion of the block's translations from time 0 (a shaking table), see
+    /// [`Model::set_base_motion`]: `{"kind": "Acceleration", "axes": [{"times": [..], "values":
+    /// [..]}, null, null]}`; the driven axes must be fixed or prescribed in `fixity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<crate::loading::BaseMotion>,
 }
 
 /// The joint law between two materials.
@@ -182,7 +187,8 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
         let blocks = model
             .blocks()
             .iter()
-            .map(|b| {
+            .enumerate()
+            .map(|(i, b)| {
                 let s = b.state();
                 BlockSpec {
                     name: b.name().to_owned(),
@@ -203,6 +209,8 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                     velocity: s.velocity,
                     angular_velocity: s.angular_velocity,
                     load: b.load(),
+                    // A scene starts at time 0: the motion from the start of its history.
+                    motion: model.base_motions().find(|m| m.0.index() == i).map(|m| m.1.clone()),
                 }
             })
             .collect();
@@ -298,7 +306,12 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                 .with_fixity(b.fixity)
                 .with_velocity(b.velocity, b.angular_velocity);
             let id = model.add_block(block).map_err(at(path.clone()))?;
-            model.set_load(id, b.load).map_err(at(path))?;
+            model.set_load(id, b.load).map_err(at(path.clone()))?;
+            if let Some(motion) = &b.motion {
+                model
+                    .set_base_motion(id, Some(motion.clone()))
+                    .map_err(at(format!("{path}.motion")))?;
+            }
         }
         Ok(model)
     }
