@@ -221,6 +221,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
             "joints",
             "last_forces",
             "law_type",
+            "motions",
             "params",
             "pending_detection",
             "ref_poses",
