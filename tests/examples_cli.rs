@@ -174,3 +174,36 @@ fn scaling_checks_its_counts_and_folder_first() {
     assert!(dir.join("s/summary.json").is_file());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn scaling_shakes_the_wall_on_request() {
+    let dir = scratch("scaling-shake");
+    for (args, expected) in [(&["--scene", "quake"][..], "--scene"), (&["--warmup", "0"], "--warmup")] {
+        let (code, _, stderr, _) = run("scaling", args, &dir);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+    // The base moves about 0.8 mm by the end: beyond the 0.25 mm re-detection trigger.
+    let args = [
+        "--scene", "shake", "--blocks", "20", "--warmup", "100", "--steps", "100", "--out", "s",
+    ];
+    let (code, stdout, stderr, _) = run("scaling", &args, &dir);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("shaking"), "{stdout}");
+    let summary = std::fs::read_to_string(dir.join("s/summary.json")).expect("summary");
+    let runs: serde_json::Value = serde_json::from_str(&summary).expect("json");
+    let first = &runs["runs"][0];
+    assert_eq!(first["scene"], "shake", "{summary}");
+    assert!(
+        first["redetections_per_step"].as_f64().expect("redetections") > 0.0,
+        "{summary}"
+    );
+    assert!(first["peak_rss_bytes"].as_u64().expect("memory") > 0, "{summary}");
+    // The default is the resting wall.
+    let (code, stdout, stderr, _) = run("scaling", &["--blocks", "20", "--steps", "1", "--out", "r"], &dir);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(stdout.contains("settling"), "{stdout}");
+    let summary = std::fs::read_to_string(dir.join("r/summary.json")).expect("summary");
+    assert!(summary.contains("\"scene\": \"rest\""), "{summary}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
