@@ -116,6 +116,7 @@ fn wall_and_base(blocks: usize, spacing: Real) -> Result<(crate::Model, usize)> 
 /// to settle it anyway. Not yet stepped.
 ///
 /// ```
+/// use voussoir::block::Block;
 /// use voussoir::scenes::shaking_wall;
 /// let mut wall = shaking_wall(100, voussoir::scenes::BENCHMARK_SPACING)?;
 /// let start = wall.blocks()[0].state().pose.translation;
