@@ -83,6 +83,9 @@ fn benchmark_walls_of_every_size_build() {
     for blocks in [1_000, 10_000] {
         let model = voussoir::scenes::benchmark_wall(blocks).expect("wall");
         let n = model.blocks().len();
-        assert!(n as f64 > 0.95 * blocks as f64 && (n as f64) < 1.05 * blocks as f64, "{blocks}: {n}");
+        assert!(
+            n as f64 > 0.95 * blocks as f64 && (n as f64) < 1.05 * blocks as f64,
+            "{blocks}: {n}"
+        );
     }
 }
