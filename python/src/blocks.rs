@@ -44,7 +44,7 @@ impl PyBlock {
     #[staticmethod]
     #[pyo3(signature = (name, min, max, density, *, material=0, fixed=None, velocity=None, angular_velocity=None))]
     #[allow(clippy::too_many_arguments)]
-    fn cuboid(
+    pub(crate) fn cuboid(
         name: &str,
         min: &Bound<'_, PyAny>,
         max: &Bound<'_, PyAny>,
@@ -63,7 +63,7 @@ impl PyBlock {
     #[staticmethod]
     #[pyo3(signature = (name, vertices, density, *, faces=None, material=0, fixed=None, velocity=None, angular_velocity=None))]
     #[allow(clippy::too_many_arguments)]
-    fn from_vertices(
+    pub(crate) fn from_vertices(
         name: &str,
         vertices: &Bound<'_, PyAny>,
         density: f64,

@@ -21,7 +21,7 @@ use voussoir::monitor::{Component, EnergyTerm, Monitor, Recorder};
 use voussoir::Error;
 
 use crate::blocks::PyBlock;
-use crate::convert::{array1, array_n3, array_n33, array_nk, fixity, points, vec3, vec3_or_zero, vector};
+use crate::convert::{array1, array_n3, array_n33, array_nk, vec3, vec3_or_zero, vector};
 use crate::errors::{bad, OrPy};
 use crate::laws::{law_from_py, law_to_py};
 
@@ -529,14 +529,8 @@ impl PyModel {
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<usize> {
-        let b = voussoir::RigidBlock::cuboid(name, vec3(min, "min")?, vec3(max, "max")?, density)
-            .py()?
-            .with_material(MaterialId(material))
-            .with_fixity(fixity(fixed)?)
-            .with_velocity(
-                vec3_or_zero(velocity, "velocity")?,
-                vec3_or_zero(angular_velocity, "angular_velocity")?,
-            );
+        let b =
+            crate::blocks::PyBlock::cuboid(name, min, max, density, material, fixed, velocity, angular_velocity)?.inner;
         Ok(self.model.add_block(b).py()?.index())
     }
 
@@ -555,18 +549,17 @@ impl PyModel {
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<usize> {
-        let pts = points(vertices, "vertices")?;
-        let b = match faces {
-            Some(f) => voussoir::RigidBlock::from_faces(name, &pts, &f, density),
-            None => voussoir::RigidBlock::from_vertices(name, &pts, density),
-        }
-        .py()?
-        .with_material(MaterialId(material))
-        .with_fixity(fixity(fixed)?)
-        .with_velocity(
-            vec3_or_zero(velocity, "velocity")?,
-            vec3_or_zero(angular_velocity, "angular_velocity")?,
-        );
+        let b = crate::blocks::PyBlock::from_vertices(
+            name,
+            vertices,
+            density,
+            faces,
+            material,
+            fixed,
+            velocity,
+            angular_velocity,
+        )?
+        .inner;
         Ok(self.model.add_block(b).py()?.index())
     }
 
