@@ -275,13 +275,20 @@ def test_gil_released_during_run():
 
 
 def test_ctrl_c_stops_a_run_cleanly():
+    # A process started in the background by a non-interactive shell (as CI may run pytest)
+    # inherits SIGINT ignored, and Python then installs no handler for it: install Python's
+    # own, as an interactive session has it, for the duration of the test.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     m = vs.scenes.benchmark_wall(200)
     timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
     start = time.perf_counter()
-    with pytest.raises(KeyboardInterrupt):
-        m.run_steps(10**9)
-    timer.join()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            m.run_steps(10**9)
+    finally:
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
     assert time.perf_counter() - start < 5.0
     # Stopped between steps: the model is still usable.
     n = m.step_count
