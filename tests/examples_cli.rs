@@ -6,6 +6,10 @@
 #[path = "../examples/common/args.rs"]
 mod args;
 
+#[path = "support/example_binary.rs"]
+mod example_binary;
+
+use example_binary::example;
 use std::ops::Bound::{Excluded, Included, Unbounded};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -86,23 +90,6 @@ fn the_output_folder_is_probed() {
     args::prepare_output_dir(&dir.join("new/deeper"), &["paraview"], &summary).expect("fresh");
     assert!(dir.join("new/deeper/paraview").is_dir());
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// The built example `name` (beside this test's `deps/` folder).
-fn example(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().expect("test executable");
-    let path = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>")
-        .join("examples")
-        .join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        path.exists(),
-        "{} is not built: run `cargo build --release --examples` (cargo test builds it)",
-        path.display()
-    );
-    path
 }
 
 /// Runs an example in `cwd`: exit code, stdout, stderr, wall time.

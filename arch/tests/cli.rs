@@ -3,6 +3,10 @@
 //! I/O errors naming the path. Parser-level tests, and two runs of the built examples that must
 //! fail at once (they need `cargo build --release --examples`, which `cargo test --release` does).
 
+#[path = "../../tests/support/example_binary.rs"]
+mod example_binary;
+
+use example_binary::example;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -195,23 +199,6 @@ fn the_output_folder_is_prepared_before_the_run() {
     let e = args::write_text(&out.join("paraview").join("x.csv"), "x").expect_err("under a file");
     assert!(e.to_string().contains("paraview"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// The built example `name` (beside this test's `deps/` folder).
-fn example(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().expect("test executable");
-    let path = exe
-        .parent()
-        .and_then(Path::parent)
-        .expect("target/<profile>")
-        .join("examples")
-        .join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        path.exists(),
-        "{} is not built: run `cargo build --release --examples` (cargo test builds it)",
-        path.display()
-    );
-    path
 }
 
 /// Runs an example; its exit code, its stderr and its wall time.
