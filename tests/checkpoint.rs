@@ -147,7 +147,34 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 10"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 11"),
+        "{err}"
+    );
+    // The tested pairs: in order, with finite unit poses and slacks, one for every contact.
+    let tested = |edit: &dyn Fn(&mut serde_json::Value)| -> Result<String> {
+        let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+        edit(&mut json);
+        Ok(Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?)
+            .expect_err("a bad tested pair")
+            .to_string())
+    };
+    let err = tested(&|j| j["tested"].as_array_mut().expect("a list").swap(0, 1))?;
+    assert!(err.contains("tested[1].blocks"), "{err}");
+    let err = tested(&|j| j["tested"][0]["blocks"] = serde_json::json!([3, 2]))?;
+    assert!(err.contains("tested[0].blocks"), "{err}");
+    let err = tested(&|j| j["tested"][2]["relative"]["rotation"] = serde_json::json!([0.0, 0.0, 0.0, 2.0]))?;
+    assert!(err.contains("tested[2].relative"), "{err}");
+    let err = tested(&|j| j["tested"][2]["slack"] = serde_json::json!(-1e-3))?;
+    assert!(err.contains("tested[2].slack"), "{err}");
+    let err = tested(&|j| {
+        let first = j["contacts"][0]["blocks"].clone();
+        j["tested"]
+            .as_array_mut()
+            .expect("a list")
+            .retain(|t| t["blocks"] != first);
+    })?;
+    assert!(
+        err.contains("contacts[0].blocks") && err.contains("did not test"),
         "{err}"
     );
     // Every contact has its wrench.
@@ -202,7 +229,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 10);
+    assert_eq!(json["version"], 11);
     assert_eq!(json["law_type"], "CoulombSlip");
     assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
@@ -230,11 +257,13 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
             "refining",
             "started",
             "step",
+            "tested",
             "time",
             "unbalanced_ratio",
             "version",
         ]
     );
+    assert_eq!(keys(&json["tested"][0]), ["blocks", "relative", "slack"]);
     let contact = &json["contacts"][0];
     assert_eq!(
         keys(contact),

@@ -112,9 +112,23 @@ impl BroadPhase {
         out: &mut Vec<(u32, u32)>,
     ) -> usize {
         self.collect_aabbs(shapes, margin);
-        let n = self.aabbs.len();
+        let boxes = std::mem::take(&mut self.aabbs);
+        let reinserted = self.pairs_of_boxes(&boxes, margin, out);
+        self.aabbs = boxes;
+        reinserted
+    }
+
+    /// All pairs `(i, j)`, `i < j`, of overlapping `boxes`, sorted, from the BVH of
+    /// [`BroadPhase::pairs_incremental`] (leaves: the boxes loosened by `margin`), for a caller
+    /// that keeps the blocks' boxes itself and updates only those of the blocks that moved.
+    ///
+    /// Returns how many leaves were (re)inserted (all of them on a fresh build).
+    pub fn pairs_of_boxes(&mut self, boxes: &[Aabb], margin: Real, out: &mut Vec<(u32, u32)>) -> usize {
+        let n = boxes.len();
         if n < 2 || margin <= 0.0 {
             self.incremental = None;
+            self.aabbs.clear();
+            self.aabbs.extend_from_slice(boxes);
             self.bvh_pairs(out);
             return n;
         }
@@ -126,12 +140,12 @@ impl BroadPhase {
                     && inc.bvh.leaf_count() as usize == n
                     && inc.reinserted <= REBUILD_AFTER_REINSERTIONS * n =>
             {
-                let count = inc.update(&self.aabbs, fat, ws);
+                let count = inc.update(boxes, fat, ws);
                 inc.reinserted += count;
                 count
             }
             _ => {
-                self.incremental = Some(Incremental::build(&self.aabbs, margin, fat, ws));
+                self.incremental = Some(Incremental::build(boxes, margin, fat, ws));
                 n
             }
         };
@@ -140,7 +154,7 @@ impl BroadPhase {
         out.extend(
             inc.fat_pairs
                 .iter()
-                .filter(|&&(i, j)| self.aabbs[i as usize].intersects(&self.aabbs[j as usize])),
+                .filter(|&&(i, j)| boxes[i as usize].intersects(&boxes[j as usize])),
         );
         reinserted
     }

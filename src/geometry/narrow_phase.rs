@@ -228,6 +228,16 @@ pub struct NarrowPhaseScratch {
     cell: Vec<DVec2>,
     tmp_cell: Vec<DVec2>,
     tmp: Vec<DVec2>,
+    separation: Real,
+}
+
+impl NarrowPhaseScratch {
+    /// The separation the last [`detect`] call found along its separating axis (m): when
+    /// positive, a lower bound on the distance between the two blocks (positive = apart,
+    /// negative = overlap depth along that axis).
+    pub fn separation(&self) -> Real {
+        self.separation
+    }
 }
 
 /// Everything the narrow phase needs to know about one block.
@@ -255,6 +265,7 @@ pub fn detect(
     seeds: &mut Vec<SubcontactSeed>,
 ) -> Option<DetectedContact> {
     let axis = separating_axis(a, b, scratch);
+    scratch.separation = axis.separation;
     if axis.separation > params.tolerance {
         return None;
     }

@@ -13,6 +13,7 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+use super::detection::TestedPair;
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::contact::{
@@ -31,7 +32,9 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// Version 9 stores joints through [`ContactEntry`], apart from the step's storage layout, so
 /// that a layout change no longer changes the format. Version 10 adds the checksum and the law
 /// type; version 9 files (which have neither, so that corruption could not be told) are refused.
-const VERSION: u32 = 10;
+/// Version 11 adds the pairs the narrow phase tested, with their relative poses, on which
+/// re-detection depends.
+const VERSION: u32 = 11;
 /// The checksum's field: `"crc32:"` and eight hexadecimal digits.
 const CHECKSUM: &str = "checksum";
 /// The largest step count (or detection count) a checkpoint may hold: 2⁵³, where `f64` stops
@@ -65,6 +68,8 @@ struct Snapshot<L: ConstitutiveLaw> {
     /// The contacts, sorted by block pair, each with its sub-contacts.
     contacts: Vec<ContactEntry<L::State>>,
     ref_poses: Vec<Pose>,
+    /// The pairs the narrow phase tested, sorted, with the relative pose of each at its test.
+    tested: Vec<TestedEntry>,
     dt: Real,
     critical: Option<CriticalStep>,
     step: u64,
@@ -94,6 +99,17 @@ struct Snapshot<L: ConstitutiveLaw> {
     /// Base motions ([`Model::set_base_motion`]), with the model time each started at.
     #[serde(default)]
     motions: Vec<super::excitation::AppliedMotion>,
+}
+
+/// A pair the narrow phase tested, as checkpoints store it.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TestedEntry {
+    blocks: (u32, u32),
+    /// The pose of the smaller block in the body frame of the other at the test.
+    relative: Pose,
+    /// The separation beyond the tolerance of a pair found apart (m).
+    slack: Real,
 }
 
 /// A joint as checkpoints store it: its geometry, law, the step's running sums and its
@@ -178,6 +194,42 @@ impl<L: ConstitutiveLaw> Model<L> {
                 .collect(),
         }
     }
+}
+
+/// The tested pairs of a checkpoint of `n` blocks, checked: pairs `a < b < n` in strictly
+/// increasing order, finite poses with unit rotations, finite slacks not below zero.
+fn tested_pairs(entries: &[TestedEntry], n: usize) -> Result<Vec<TestedPair>> {
+    let corrupt = |path: &str, message: &str| Error::Checkpoint {
+        path: path.into(),
+        message: message.into(),
+    };
+    let mut tested = Vec::with_capacity(entries.len());
+    for (k, e) in entries.iter().enumerate() {
+        let (a, b) = e.blocks;
+        let ordered = tested.last().is_none_or(|t: &TestedPair| (t.a, t.b) < (a, b));
+        if !(a < b && (b as usize) < n && ordered) {
+            return Err(corrupt(
+                &format!("tested[{k}].blocks"),
+                "block pairs a < b < block count, in increasing order, expected",
+            ));
+        }
+        if !pose_ok(&e.relative) {
+            return Err(corrupt(
+                &format!("tested[{k}].relative"),
+                "not a finite pose with a unit rotation",
+            ));
+        }
+        if !(e.slack.is_finite() && e.slack >= 0.0) {
+            return Err(corrupt(&format!("tested[{k}].slack"), "a finite length ≥ 0 expected"));
+        }
+        tested.push(TestedPair {
+            a,
+            b,
+            relative: e.relative,
+            slack: e.slack,
+        });
+    }
+    Ok(tested)
 }
 
 /// The step's storage rebuilt from checkpointed joints: contacts, their references and
@@ -284,6 +336,16 @@ where
             joints: self.state.laws.clone(),
             contacts: (0..self.state.pairs.len()).map(|k| self.contact_entry(k)).collect(),
             ref_poses: self.state.ref_poses.clone(),
+            tested: self
+                .state
+                .tested
+                .iter()
+                .map(|t| TestedEntry {
+                    blocks: (t.a, t.b),
+                    relative: t.relative,
+                    slack: t.slack,
+                })
+                .collect(),
             dt: self.state.dt,
             critical: self.state.critical,
             step: self.state.step,
@@ -454,11 +516,21 @@ where
                 "not a finite pose with a unit rotation",
             ));
         }
+        let tested = tested_pairs(&snap.tested, n)?;
         if snap.last_forces.len() != n {
             return Err(corrupt("last_forces", "one pair of wrenches per block expected"));
         }
         check_run_state(&snap)?;
         let (pairs, references, wrenches, subs, sub_records) = into_storage(snap.contacts);
+        if let Some(k) = pairs
+            .iter()
+            .position(|p| tested.binary_search_by_key(&(p.a, p.b), |t| (t.a, t.b)).is_err())
+        {
+            return Err(corrupt(
+                &format!("contacts[{k}].blocks"),
+                "a contact between blocks the narrow phase did not test",
+            ));
+        }
         if let Some(k) = wrenches
             .iter()
             .position(|w| !(is_finite_vector(w.force) && is_finite_vector(w.moment_a) && is_finite_vector(w.moment_b)))
@@ -594,6 +666,7 @@ where
             }
         }
         model.state.ref_poses = snap.ref_poses;
+        model.state.tested = tested;
         model.state.drift = if snap.drift > 0.0 && snap.started {
             snap.drift
         } else {

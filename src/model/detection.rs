@@ -1,5 +1,7 @@
 //! Contact re-detection with history transfer, the block → contact index, and the time step.
 
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
+use parry3d_f64::shape::Shape;
 use rayon::prelude::*;
 
 use super::changes::Changes;
@@ -11,9 +13,30 @@ use crate::contact::{
     SubContactRecord,
 };
 use crate::error::{Error, Result};
-use crate::geometry::{detect, BlockGeometry, BroadPhase, DetectedContact, NarrowPhaseScratch, SubcontactSeed};
+use crate::geometry::{
+    detect, BlockGeometry, BroadPhase, ContactParameters, DetectedContact, NarrowPhaseScratch, SubcontactSeed,
+};
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
-use crate::math::{Matrix, Real, Vector};
+use crate::math::{Matrix, Pose, Real, Vector};
+
+/// Planned pairs per task of the parallel narrow phase.
+const PLAN_CHUNK: usize = 256;
+
+/// A block pair the narrow phase tested, with the relative pose it was tested at: its verdict
+/// holds until the pair has moved relatively past the trigger (a contact) or past `slack` (a
+/// pair found apart), as looked at when one of its blocks moves past the trigger
+/// (`docs/theory.md` §2.3). Sorted by `(a, b)` in [`ModelState::tested`]; every contact has one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct TestedPair {
+    pub a: u32,
+    pub b: u32,
+    /// The pose of the pair's smaller block (by radius; `b` on a tie) in the body frame of the
+    /// other, at the test ([`relative_pose`]).
+    pub relative: Pose,
+    /// For a pair found apart, its separation beyond the contact tolerance (m), which it may
+    /// close before it can come within the tolerance; 0 otherwise.
+    pub slack: Real,
+}
 
 /// Buffers reused from one detection to the next.
 #[derive(Debug, Clone)]
@@ -22,11 +45,23 @@ pub(crate) struct DetectionScratch<S> {
     /// took their rotation matrices and movement check for the next step: whether any block
     /// moved beyond the re-detection trigger. Taken (reset) by the next step.
     pub prepared: Option<bool>,
+    /// Pairs the narrow phase tested since the model was built (a statistic, like the timings).
+    pub tests: u64,
     broad: BroadPhase,
-    narrow: NarrowPhaseScratch,
     candidates: Vec<(u32, u32)>,
-    seeds: Vec<SubcontactSeed>,
-    moved: Vec<bool>,
+    plan: Vec<Planned>,
+    outcomes: Vec<Outcome>,
+    chunks: Vec<ChunkScratch>,
+    /// Blocks that moved beyond the trigger since their reference poses, as the last block pass
+    /// (or [`ModelState::prepare_blocks`]) found them.
+    pub moved: Vec<bool>,
+    /// Each block's box at its reference pose, loosened to hold it at any pose within the
+    /// trigger ([`reference_box`]): the broad phase's boxes.
+    boxes: Vec<Aabb>,
+    /// Old contacts kept as they were (rebuild only).
+    kept: Vec<bool>,
+    /// Merge buffer of [`update_tested`].
+    tested: Vec<TestedPair>,
     pairs: Vec<ContactPair>,
     references: Vec<ContactReference>,
     wrenches: Vec<ContactWrench>,
@@ -38,11 +73,16 @@ impl<S> Default for DetectionScratch<S> {
     fn default() -> Self {
         Self {
             prepared: None,
+            tests: 0,
             broad: BroadPhase::default(),
-            narrow: NarrowPhaseScratch::default(),
             candidates: Vec::new(),
-            seeds: Vec::new(),
+            plan: Vec::new(),
+            outcomes: Vec::new(),
+            chunks: Vec::new(),
             moved: Vec::new(),
+            boxes: Vec::new(),
+            kept: Vec::new(),
+            tested: Vec::new(),
             pairs: Vec::new(),
             references: Vec::new(),
             wrenches: Vec::new(),
@@ -52,43 +92,427 @@ impl<S> Default for DetectionScratch<S> {
     }
 }
 
+/// A candidate pair of the broad phase (two blocks not both fixed), with its entries in the
+/// lists of the last detection.
+#[derive(Debug, Clone, Copy)]
+struct Planned {
+    a: u32,
+    b: u32,
+    /// Index in [`ModelState::tested`], or `u32::MAX`.
+    tested: u32,
+    /// Index of its contact, or `u32::MAX`.
+    contact: u32,
+}
+
+impl Planned {
+    fn old_tested(&self) -> Option<usize> {
+        (self.tested != u32::MAX).then_some(self.tested as usize)
+    }
+
+    fn old_contact(&self) -> Option<usize> {
+        (self.contact != u32::MAX).then_some(self.contact as usize)
+    }
+}
+
+/// What the narrow phase made of a planned pair.
+#[derive(Debug, Clone)]
+struct Outcome {
+    /// Tested afresh (else its last verdict holds).
+    tested: bool,
+    /// The test's entry for [`ModelState::tested`].
+    entry: TestedPair,
+    contact: Option<DetectedContact>,
+    /// The contact's seeds in its chunk's buffer.
+    first_seed: u32,
+    seed_count: u32,
+}
+
+impl Default for Outcome {
+    fn default() -> Self {
+        Self {
+            tested: false,
+            entry: TestedPair {
+                a: 0,
+                b: 0,
+                relative: Pose::IDENTITY,
+                slack: 0.0,
+            },
+            contact: None,
+            first_seed: 0,
+            seed_count: 0,
+        }
+    }
+}
+
+/// One task's buffers of the parallel narrow phase.
+#[derive(Debug, Clone, Default)]
+struct ChunkScratch {
+    narrow: NarrowPhaseScratch,
+    seeds: Vec<SubcontactSeed>,
+}
+
+impl ChunkScratch {
+    fn seeds(&self, o: &Outcome) -> &[SubcontactSeed] {
+        &self.seeds[o.first_seed as usize..(o.first_seed + o.seed_count) as usize]
+    }
+}
+
+/// What the parallel narrow phase reads.
+struct PairTest<'a> {
+    blocks: &'a [RigidBlock],
+    tested: &'a [TestedPair],
+    pairs: &'a [ContactPair],
+    params: &'a ContactParameters,
+    /// The trigger within which a contact keeps its verdict; `None` tests every pair.
+    keep_within: Option<Real>,
+}
+
+impl PairTest<'_> {
+    /// Decides and, where needed, tests one chunk of planned pairs.
+    fn run(&self, plan: &[Planned], outcomes: &mut [Outcome], scratch: &mut ChunkScratch) {
+        scratch.seeds.clear();
+        for (p, o) in plan.iter().zip(outcomes) {
+            o.tested = false;
+            let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
+            let (relative, radius) = relative_pose(bi, bj);
+            if let (Some(trigger), Some(t)) = (self.keep_within, p.old_tested()) {
+                let last = &self.tested[t];
+                let within = if p.old_contact().is_some() { trigger } else { last.slack };
+                if relative_motion(&relative, &last.relative, radius) <= within {
+                    continue;
+                }
+            }
+            let first = scratch.seeds.len();
+            let previous = p.old_contact().map(|c| (self.pairs[c].kind, self.pairs[c].host_is_a));
+            let found = detect(
+                BlockGeometry {
+                    shape: bi.shape(),
+                    pose: &bi.state.pose,
+                },
+                BlockGeometry {
+                    shape: bj.shape(),
+                    pose: &bj.state.pose,
+                },
+                previous,
+                self.params,
+                &mut scratch.narrow,
+                &mut scratch.seeds,
+            );
+            let separation = scratch.narrow.separation();
+            *o = Outcome {
+                tested: true,
+                entry: TestedPair {
+                    a: p.a,
+                    b: p.b,
+                    relative,
+                    slack: if found.is_none() && separation > self.params.tolerance {
+                        separation - self.params.tolerance
+                    } else {
+                        0.0
+                    },
+                },
+                first_seed: first as u32,
+                seed_count: (scratch.seeds.len() - first) as u32,
+                contact: found,
+            };
+        }
+    }
+}
+
+/// The candidate pairs with a block that moved, not between two fixed blocks, each with its
+/// entries in the sorted `tested` and `pairs` of the last detection (a merge of sorted lists).
+fn plan(
+    candidates: &[(u32, u32)],
+    blocks: &[RigidBlock],
+    moved: &[bool],
+    tested: &[TestedPair],
+    pairs: &[ContactPair],
+    out: &mut Vec<Planned>,
+) {
+    out.clear();
+    let (mut t, mut c) = (0, 0);
+    for &(a, b) in candidates {
+        if !moved[a as usize] && !moved[b as usize] {
+            continue;
+        }
+        if blocks[a as usize].fixity().is_fixed() && blocks[b as usize].fixity().is_fixed() {
+            continue;
+        }
+        while t < tested.len() && (tested[t].a, tested[t].b) < (a, b) {
+            t += 1;
+        }
+        while c < pairs.len() && (pairs[c].a, pairs[c].b) < (a, b) {
+            c += 1;
+        }
+        let found_t = t < tested.len() && (tested[t].a, tested[t].b) == (a, b);
+        let found_c = c < pairs.len() && (pairs[c].a, pairs[c].b) == (a, b);
+        out.push(Planned {
+            a,
+            b,
+            tested: if found_t { t as u32 } else { u32::MAX },
+            contact: if found_c { c as u32 } else { u32::MAX },
+        });
+    }
+}
+
+/// Brings `tested` up to date with the detection's outcomes: in place when the planned pairs
+/// are those with a moved block tested before, else merged afresh through `buffer` (the pairs of
+/// two blocks that did not move keep their entries; those with a moved block that are no longer
+/// candidates lose them).
+fn update_tested(
+    tested: &mut Vec<TestedPair>,
+    plan: &[Planned],
+    outcomes: &[Outcome],
+    moved: &[bool],
+    buffer: &mut Vec<TestedPair>,
+) {
+    let moved_pair = |t: &TestedPair| moved[t.a as usize] || moved[t.b as usize];
+    if plan.iter().all(|p| p.tested != u32::MAX) && tested.iter().filter(|t| moved_pair(t)).count() == plan.len() {
+        for (p, o) in plan.iter().zip(outcomes) {
+            if o.tested {
+                tested[p.tested as usize] = o.entry;
+            }
+        }
+        return;
+    }
+    buffer.clear();
+    let mut t = 0;
+    for (p, o) in plan.iter().zip(outcomes) {
+        while t < tested.len() && (tested[t].a, tested[t].b) < (p.a, p.b) {
+            if !moved_pair(&tested[t]) {
+                buffer.push(tested[t]);
+            }
+            t += 1;
+        }
+        buffer.push(match p.old_tested() {
+            Some(k) if !o.tested => tested[k],
+            _ => o.entry,
+        });
+    }
+    buffer.extend(tested[t..].iter().filter(|t| !moved_pair(t)));
+    std::mem::swap(tested, buffer);
+}
+
+/// The pose of the smaller of two blocks (by radius; `b` on a tie) in the body frame of the
+/// other, and the smaller radius: what the contact geometry of the pair depends on.
+#[inline]
+pub(crate) fn relative_pose(a: &RigidBlock, b: &RigidBlock) -> (Pose, Real) {
+    let (frame, moving) = if b.radius > a.radius { (b, a) } else { (a, b) };
+    let (f, m) = (&frame.state.pose, &moving.state.pose);
+    let to_frame = f.rotation.inverse();
+    (
+        Pose::from_parts(to_frame * (m.translation - f.translation), to_frame * m.rotation),
+        moving.radius,
+    )
+}
+
+/// The largest displacement of a point of a block of `radius` between relative poses `then` and
+/// `now`: the translation plus the chord `2 r sin(θ/2)` of the rotation angle `θ` between them.
+#[inline]
+fn relative_motion(now: &Pose, then: &Pose, radius: Real) -> Real {
+    let translation = (now.translation - then.translation).length();
+    let half_sine = (now.rotation * then.rotation.inverse()).xyz().length().min(1.0);
+    translation + 2.0 * radius * half_sine
+}
+
 impl<L: ConstitutiveLaw> ModelState<L> {
     /// The step's first pass over the blocks: their rotation matrices, which the contact pass
-    /// reads instead of turning every contact's normals by quaternions, and (`check`) whether
-    /// any material point of a block moved more than the re-detection trigger since the block's
-    /// last detection. (After a step of a blockwise integrator the block pass has done this
-    /// already, see [`DetectionScratch::prepared`].)
+    /// reads instead of turning every contact's normals by quaternions, and (`check`) which
+    /// blocks moved more than the re-detection trigger since their reference poses (the flags in
+    /// [`DetectionScratch::moved`]; whether any did is returned). (After a step of a blockwise
+    /// integrator the block pass has done this already, see [`DetectionScratch::prepared`].)
     pub(super) fn prepare_blocks(&mut self, pipeline: &mut Pipeline<L::State>, check: bool) -> bool {
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
-        pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        let n = self.blocks.len();
+        pipeline.rotations.resize(n, Matrix::IDENTITY);
+        pipeline.detection.moved.resize(n, false);
         pipeline
             .rotations
             .par_chunks_mut(BLOCK_CHUNK)
+            .zip(pipeline.detection.moved.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.blocks.par_chunks(BLOCK_CHUNK))
             .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
-            .map(|((rotations, blocks), refs)| prepare_chunk(rotations, blocks, refs, check.then_some(trigger)))
+            .map(|(((rotations, moved), blocks), refs)| {
+                prepare_chunk(rotations, moved, blocks, refs, check.then_some(trigger))
+            })
             .reduce(|| false, |a, b| a || b)
     }
 
-    /// Re-detects contacts: pairs where a block moved beyond the trigger get a fresh narrow phase
-    /// with sub-contact history carried over by key; other pairs are kept as they are.
+    /// Re-detects contacts (`docs/theory.md` §2.3).
+    ///
+    /// Only pairs with a block that moved beyond the trigger since its reference pose are looked
+    /// at (the flags the last block pass left in [`DetectionScratch::moved`]; a full detection
+    /// looks at every pair). Of those, a pair the narrow phase tested before keeps its verdict
+    /// while the relative pose of its two blocks stays within the trigger (a contact) or within
+    /// its separation beyond the tolerance (a pair found apart) of the one it was tested at; the
+    /// others are tested afresh, in parallel, and their sub-contacts take the history of the old
+    /// ones by key. Where the contacts keep their pairs and sub-contact counts (the usual case),
+    /// the re-tested contacts are rewritten in place; otherwise the lists are rebuilt in pair
+    /// order. Either way the result does not depend on the number of threads.
     pub(super) fn detect(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
         let params = self.params.contact;
         let full = self.changes.need_full_detection() || self.params.mode == DisplacementMode::Small;
         let trigger = params.redetect_fraction * params.tolerance;
+        let n = self.blocks.len();
         let sc = &mut pipeline.detection;
-        sc.moved.clear();
-        sc.moved.extend(
-            self.blocks
-                .iter()
-                .zip(&self.ref_poses)
-                .map(|(b, r)| full || moved_beyond(b, r, trigger)),
+        if full || sc.moved.len() != n {
+            sc.moved.clear();
+            sc.moved.resize(n, true);
+        }
+        // The moved blocks take their current poses as reference poses, and their boxes.
+        let reach = 0.5 * params.tolerance + trigger;
+        let fresh_boxes = sc.boxes.len() != n;
+        if fresh_boxes {
+            sc.boxes.clear();
+            sc.boxes.extend(
+                self.blocks
+                    .iter()
+                    .zip(&self.ref_poses)
+                    .map(|(b, r)| reference_box(b, r, reach)),
+            );
+        }
+        for (i, b) in self.blocks.iter().enumerate() {
+            if sc.moved[i] {
+                self.ref_poses[i] = b.state.pose;
+                sc.boxes[i] = reference_box(b, &b.state.pose, reach);
+            }
+        }
+        sc.broad.pairs_of_boxes(&sc.boxes, params.tolerance, &mut sc.candidates);
+        plan(
+            &sc.candidates,
+            &self.blocks,
+            &sc.moved,
+            &self.tested,
+            &self.pairs,
+            &mut sc.plan,
         );
-        sc.broad.pairs_incremental(
-            self.blocks.iter().map(|b| (b.shape(), &b.state.pose)),
-            params.tolerance,
-            &mut sc.candidates,
-        );
+        sc.outcomes.clear();
+        sc.outcomes.resize(sc.plan.len(), Outcome::default());
+        let chunks = sc.plan.len().div_ceil(PLAN_CHUNK);
+        if sc.chunks.len() < chunks {
+            sc.chunks.resize_with(chunks, ChunkScratch::default);
+        }
+        let test = PairTest {
+            blocks: &self.blocks,
+            tested: &self.tested,
+            params: &params,
+            keep_within: (!full).then_some(trigger),
+            pairs: &self.pairs,
+        };
+        sc.outcomes
+            .par_chunks_mut(PLAN_CHUNK)
+            .zip(sc.plan.par_chunks(PLAN_CHUNK))
+            .zip(sc.chunks.par_iter_mut())
+            .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
+
+        // A full detection (a change of laws, parameters or fixity) always rebuilds.
+        let rewrite = !full && self.rewrite_in_place(&sc.plan, &sc.outcomes, &sc.moved);
+        let (work, dashpot) = if rewrite {
+            self.rewrite_contacts(sc)?
+        } else {
+            self.rebuild_contacts(sc)?
+        };
+        self.energy.joint_work += work;
+        self.energy.damping += dashpot;
+        update_tested(&mut self.tested, &sc.plan, &sc.outcomes, &sc.moved, &mut sc.tested);
+        sc.tests += sc.outcomes.iter().filter(|o| o.tested).count() as u64;
+        self.detections += 1;
+        if !rewrite {
+            self.rebuild_block_index(pipeline);
+        }
+        // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
+        // since the last evaluation (lost contacts only make the step safer). A forced full
+        // detection follows a change of laws, parameters or fixity: the step is re-evaluated
+        // then too. The flag is set (or stays set) if that fails, so the error repeats rather
+        // than the run going on with an unstable step.
+        let stiffer = self.references.iter().any(|r| r.area > 1.05 * r.bound_area);
+        if stiffer || full || self.critical.is_none() {
+            self.changes.insert(Changes::DETECTION);
+            self.refresh_time_step(pipeline)?;
+        }
+        self.changes.clear();
+        Ok(())
+    }
+
+    /// Whether the outcome of the narrow phase leaves every contact in place: no contact
+    /// appears or disappears, and every re-tested contact keeps its number of sub-contacts.
+    /// (Contacts between two blocks that did not move are kept as they are.)
+    fn rewrite_in_place(&self, plan: &[Planned], outcomes: &[Outcome], moved: &[bool]) -> bool {
+        let mut planned_contacts = 0;
+        for (p, o) in plan.iter().zip(outcomes) {
+            let found = o.tested && o.contact.is_some() && o.seed_count > 0;
+            match p.old_contact() {
+                Some(c) => {
+                    if o.tested && (!found || o.seed_count != self.pairs[c].count) {
+                        return false;
+                    }
+                    planned_contacts += 1;
+                }
+                None if found => return false,
+                None => {}
+            }
+        }
+        let moved_contacts = self
+            .pairs
+            .iter()
+            .filter(|p| moved[p.a as usize] || moved[p.b as usize])
+            .count();
+        planned_contacts == moved_contacts
+    }
+
+    /// Rewrites the re-tested contacts in their slots (see [`ModelState::rewrite_in_place`]).
+    /// Returns the work of the dropped sub-contacts, as [`dropped_work`].
+    fn rewrite_contacts(&mut self, sc: &mut DetectionScratch<L::State>) -> Result<(Real, Real)> {
+        let mut owed = (0.0, 0.0);
+        let dt = if self.drift > 0.0 { self.drift } else { self.dt };
+        for (k, (p, o)) in sc.plan.iter().zip(&sc.outcomes).enumerate() {
+            let (Some(c), true) = (p.old_contact(), o.tested) else {
+                continue;
+            };
+            let dc = o.contact.as_ref().expect("checked by rewrite_in_place");
+            let seeds = sc.chunks[k / PLAN_CHUNK].seeds(o);
+            let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
+            let law = self.law_index(p.a, p.b)?;
+            let mut one = NewContacts {
+                pairs: &mut sc.pairs,
+                references: &mut sc.references,
+                wrenches: &mut sc.wrenches,
+                subs: &mut sc.subs,
+                records: &mut sc.records,
+            };
+            one.clear();
+            let old = OldContacts {
+                pairs: &self.pairs,
+                references: &self.references,
+                subs: &self.subs,
+                records: &self.sub_records,
+            };
+            one.add_detected(&old, Some(c), (p.a, bi), (p.b, bj), dc, law, seeds);
+            add_dropped_work(
+                &old,
+                c,
+                Some((&sc.pairs[0], &sc.records[..])),
+                &self.blocks,
+                self.params.mode,
+                dt,
+                &mut owed,
+            );
+            let range = self.pairs[c].range();
+            self.subs[range.clone()].clone_from_slice(&sc.subs);
+            self.sub_records[range.clone()].clone_from_slice(&sc.records);
+            let mut pair = sc.pairs[0].clone();
+            pair.first = range.start as u32;
+            self.pairs[c] = pair;
+            self.references[c] = sc.references[0].clone();
+            self.wrenches[c] = sc.wrenches[0];
+        }
+        Ok(owed)
+    }
+
+    /// Builds the contact lists afresh in pair order: kept contacts copied (those of two blocks
+    /// that did not move, and those whose pair kept its verdict), re-tested ones from their
+    /// seeds. Returns the work of the dropped sub-contacts ([`dropped_work`]).
+    fn rebuild_contacts(&mut self, sc: &mut DetectionScratch<L::State>) -> Result<(Real, Real)> {
         let mut new = NewContacts {
             pairs: &mut sc.pairs,
             references: &mut sc.references,
@@ -103,83 +527,68 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             subs: &self.subs,
             records: &self.sub_records,
         };
-        for &(i, j) in &sc.candidates {
-            let k_old = old.pairs.binary_search_by_key(&(i, j), |p| (p.a, p.b)).ok();
-            let (bi, bj) = (&self.blocks[i as usize], &self.blocks[j as usize]);
-            if bi.fixity().is_fixed() && bj.fixity().is_fixed() {
-                continue;
+        sc.kept.clear();
+        sc.kept.resize(self.pairs.len(), false);
+        let moved = &sc.moved;
+        let mut c = 0;
+        for (k, (p, o)) in sc.plan.iter().zip(&sc.outcomes).enumerate() {
+            // The contacts of two blocks that did not move, up to this pair.
+            while c < old.pairs.len() && (old.pairs[c].a, old.pairs[c].b) < (p.a, p.b) {
+                if !moved[old.pairs[c].a as usize] && !moved[old.pairs[c].b as usize] {
+                    new.keep(&old, c, self.wrenches[c]);
+                    sc.kept[c] = true;
+                }
+                c += 1;
             }
-            if !sc.moved[i as usize] && !sc.moved[j as usize] {
-                if let Some(k) = k_old {
-                    new.keep(&old, k, self.wrenches.get(k).copied().unwrap_or_default());
+            if !o.tested {
+                if let Some(c) = p.old_contact() {
+                    new.keep(&old, c, self.wrenches[c]);
+                    sc.kept[c] = true;
                 }
                 continue;
             }
-            sc.seeds.clear();
-            let found = detect(
-                BlockGeometry {
-                    shape: bi.shape(),
-                    pose: &bi.state.pose,
-                },
-                BlockGeometry {
-                    shape: bj.shape(),
-                    pose: &bj.state.pose,
-                },
-                k_old.map(|k| (old.pairs[k].kind, old.pairs[k].host_is_a)),
-                &params,
-                &mut sc.narrow,
-                &mut sc.seeds,
-            );
-            let Some(dc) = found else { continue };
-            if sc.seeds.is_empty() {
+            let Some(dc) = &o.contact else { continue };
+            if o.seed_count == 0 {
                 continue;
             }
-            let law = self
-                .laws
-                .index_of(bi.material(), bj.material())
-                .ok_or(Error::MissingJointLaw {
-                    a: bi.material(),
-                    b: bj.material(),
-                    block_a: BlockId(i),
-                    block_b: BlockId(j),
-                })?;
-            new.add_detected(&old, k_old, (i, bi), (j, bj), &dc, law, &sc.seeds);
+            let seeds = sc.chunks[k / PLAN_CHUNK].seeds(o);
+            let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
+            let law = self.law_index(p.a, p.b)?;
+            new.add_detected(&old, p.old_contact(), (p.a, bi), (p.b, bj), dc, law, seeds);
         }
-        // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
-        // since the last evaluation (lost contacts only make the step safer).
-        let stiffer = sc.references.iter().any(|r| r.area > 1.05 * r.bound_area);
-        let (work, dashpot) = dropped_work(
-            old,
+        for c in c..old.pairs.len() {
+            if !moved[old.pairs[c].a as usize] && !moved[old.pairs[c].b as usize] {
+                new.keep(&old, c, self.wrenches[c]);
+                sc.kept[c] = true;
+            }
+        }
+        let dropped = dropped_work(
+            &old,
             (&sc.pairs, &sc.records),
-            &sc.moved,
+            &sc.kept,
             &self.blocks,
             self.params.mode,
             if self.drift > 0.0 { self.drift } else { self.dt },
         );
-        self.energy.joint_work += work;
-        self.energy.damping += dashpot;
         std::mem::swap(&mut self.pairs, &mut sc.pairs);
         std::mem::swap(&mut self.references, &mut sc.references);
         std::mem::swap(&mut self.wrenches, &mut sc.wrenches);
         std::mem::swap(&mut self.subs, &mut sc.subs);
         std::mem::swap(&mut self.sub_records, &mut sc.records);
-        for (i, moved) in sc.moved.iter().enumerate() {
-            if *moved {
-                self.ref_poses[i] = self.blocks[i].state.pose;
-            }
-        }
-        self.detections += 1;
-        self.rebuild_block_index(pipeline);
-        // A forced full detection follows a change of laws, parameters or fixity: the step is
-        // re-evaluated then too, as after a re-detection that found stiffer contacts. The flag
-        // is set (or stays set) if that fails, so the error repeats rather than the run going on
-        // with an unstable step.
-        if stiffer || full || self.critical.is_none() {
-            self.changes.insert(Changes::DETECTION);
-            self.refresh_time_step(pipeline)?;
-        }
-        self.changes.clear();
-        Ok(())
+        Ok(dropped)
+    }
+
+    /// The index of the joint law between blocks `i` and `j`.
+    fn law_index(&self, i: u32, j: u32) -> Result<u32> {
+        let (bi, bj) = (&self.blocks[i as usize], &self.blocks[j as usize]);
+        self.laws
+            .index_of(bi.material(), bj.material())
+            .ok_or(Error::MissingJointLaw {
+                a: bi.material(),
+                b: bj.material(),
+                block_a: BlockId(i),
+                block_b: BlockId(j),
+            })
     }
 
     pub(super) fn rebuild_block_index(&mut self, pipeline: &mut Pipeline<L::State>) {
@@ -206,23 +615,31 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     }
 }
 
-/// The rotation matrices of a chunk of blocks and, given the re-detection `trigger`, whether
-/// any of them moved beyond it since its reference pose in `refs`.
+/// The rotation matrices of a chunk of blocks and, given the re-detection `trigger`, which of
+/// them moved beyond it since their reference poses in `refs` (`moved`, all `false` without a
+/// trigger); returns whether any did.
 #[inline]
 pub(super) fn prepare_chunk(
     rotations: &mut [Matrix],
-    blocks: &[crate::block::RigidBlock],
-    refs: &[crate::math::Pose],
+    moved: &mut [bool],
+    blocks: &[RigidBlock],
+    refs: &[Pose],
     trigger: Option<Real>,
 ) -> bool {
-    let mut moved = false;
-    for ((rotation, b), r) in rotations.iter_mut().zip(blocks).zip(refs) {
+    let mut any = false;
+    for (((rotation, moved), b), r) in rotations.iter_mut().zip(moved).zip(blocks).zip(refs) {
         *rotation = Matrix::from_quat(b.state.pose.rotation);
-        if let Some(trigger) = trigger {
-            moved |= moved_beyond(b, r, trigger);
-        }
+        *moved = trigger.is_some_and(|trigger| moved_beyond(b, r, trigger));
+        any |= *moved;
     }
-    moved
+    any
+}
+
+/// The box of a block at its reference pose `r` loosened by `reach`: half the contact
+/// tolerance plus the trigger, so that it holds the block's box loosened by half the tolerance
+/// at any pose within the trigger of `r`.
+fn reference_box(b: &RigidBlock, r: &Pose, reach: Real) -> Aabb {
+    b.shape().parry().compute_aabb(r).loosened(reach)
 }
 
 /// Whether the largest displacement of a point of the block since pose `r`, bounded by the
@@ -378,46 +795,61 @@ impl<S: Clone + Default> NewContacts<'_, S> {
 /// that produced the current poses); the stored energy that vanishes with the sub-contact is
 /// not dissipation and shows in [`crate::Energies::balance_error`].
 fn dropped_work<S>(
-    old: OldContacts<'_, S>,
+    old: &OldContacts<'_, S>,
     new: (&[ContactPair], &[SubContactRecord]),
-    moved: &[bool],
-    blocks: &[crate::block::RigidBlock],
+    kept: &[bool],
+    blocks: &[RigidBlock],
     mode: DisplacementMode,
     dt: Real,
 ) -> (Real, Real) {
-    let (mut work, mut dashpot) = (0.0, 0.0);
-    for (p, reference) in old.pairs.iter().zip(old.references) {
+    let mut owed = (0.0, 0.0);
+    for (k, p) in old.pairs.iter().enumerate() {
+        // A contact whose pair kept its verdict is kept as it was, with all its sub-contacts.
+        if kept[k] {
+            continue;
+        }
         let successor = new
             .0
             .binary_search_by_key(&(p.a, p.b), |q| (q.a, q.b))
             .ok()
-            .map(|k| &new.0[k]);
-        let carried = successor
-            .filter(|q| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
-            .map(|q| &new.1[q.range()]);
-        // A contact between two blocks that did not move is kept as it was, with all its
-        // sub-contacts.
-        if carried.is_some() && !moved[p.a as usize] && !moved[p.b as usize] {
+            .map(|s| (&new.0[s], new.1));
+        add_dropped_work(old, k, successor, blocks, mode, dt, &mut owed);
+    }
+    owed
+}
+
+/// Adds to `owed` the work ([`dropped_work`]) of the sub-contacts of old contact `k` that its
+/// `successor` (the new contact of the same pair, with the new sub-contact records it indexes)
+/// does not carry on.
+fn add_dropped_work<S>(
+    old: &OldContacts<'_, S>,
+    k: usize,
+    successor: Option<(&ContactPair, &[SubContactRecord])>,
+    blocks: &[RigidBlock],
+    mode: DisplacementMode,
+    dt: Real,
+    owed: &mut (Real, Real),
+) {
+    let (p, reference) = (&old.pairs[k], &old.references[k]);
+    let carried = successor
+        .filter(|(q, _)| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
+        .map(|(q, records)| &records[q.range()]);
+    let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
+    let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
+    let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
+    for (s, r) in old.subs[p.range()].iter().zip(&old.records[p.range()]) {
+        let spring = p.axes().force(&s.force);
+        if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
             continue;
         }
-        let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
-        let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
-        let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
-        for (s, r) in old.subs[p.range()].iter().zip(&old.records[p.range()]) {
-            let spring = p.axes().force(&s.force);
-            if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
-                continue;
-            }
-            if carried.is_some_and(|records| records.binary_search_by_key(&r.key, |t| t.key).is_ok()) {
-                continue;
-            }
-            let pt = frame.transform_point(p.anchor(s));
-            let v_rel =
-                (sb.velocity + sb.angular_velocity.cross(pt - xb)) - (sa.velocity + sa.angular_velocity.cross(pt - xa));
-            let du = v_rel * dt;
-            work -= 0.5 * spring.dot(du);
-            dashpot -= 0.5 * r.dashpot.dot(du);
+        if carried.is_some_and(|records| records.binary_search_by_key(&r.key, |t| t.key).is_ok()) {
+            continue;
         }
+        let pt = frame.transform_point(p.anchor(s));
+        let v_rel =
+            (sb.velocity + sb.angular_velocity.cross(pt - xb)) - (sa.velocity + sa.angular_velocity.cross(pt - xa));
+        let du = v_rel * dt;
+        owed.0 -= 0.5 * spring.dot(du);
+        owed.1 -= 0.5 * r.dashpot.dot(du);
     }
-    (work, dashpot)
 }

@@ -141,7 +141,12 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     /// whose stream they would lengthen by 72 bytes per contact). Detection carries a kept
     /// contact's wrench and starts a new one at zero; checkpointed.
     pub wrenches: Vec<ContactWrench>,
+    /// Each block's pose at the last detection: the next one runs once a block has moved the
+    /// re-detection trigger from it.
     pub ref_poses: Vec<Pose>,
+    /// The pairs the narrow phase tested and the relative poses it tested them at, sorted by
+    /// pair (every contact has one): a pair keeps its verdict until it moves relatively.
+    pub tested: Vec<detection::TestedPair>,
     /// The step: `safety × critical` (or the fixed one), as set at the last evaluation.
     pub dt: Real,
     /// The step that brought the blocks to their poses (`Δt_{n−½}`): `dt`, or shorter around
@@ -265,6 +270,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 records: Vec::new(),
                 wrenches: Vec::new(),
                 ref_poses: Vec::new(),
+                tested: Vec::new(),
                 dt: 0.0,
                 drift: 0.0,
                 refine_until: 0.0,

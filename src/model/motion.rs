@@ -160,21 +160,25 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // Also the next step's first stage, while the blocks are in cache: their rotation
         // matrices and movement check (`prepare_blocks`).
         pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        pipeline.detection.moved.resize(self.blocks.len(), false);
         self.blocks
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(pipeline.forces.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.records.par_chunks_mut(BLOCK_CHUNK))
             .zip(pipeline.rotations.par_chunks_mut(BLOCK_CHUNK))
+            .zip(pipeline.detection.moved.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
             .zip(pipeline.block_sums.par_iter_mut())
             .enumerate()
-            .for_each(|(k, (((((blocks, forces), records), rotations), refs), sums))| {
-                let first_block = k * BLOCK_CHUNK;
-                pass.gather(first_block, blocks, forces, records, sums);
-                integrator.advance_chunk(blocks, forces, step, records);
-                pass.settle(first_block, blocks, records, sums);
-                sums.moved = prepare_chunk(rotations, blocks, refs, pass.trigger);
-            });
+            .for_each(
+                |(k, ((((((blocks, forces), records), rotations), moved), refs), sums))| {
+                    let first_block = k * BLOCK_CHUNK;
+                    pass.gather(first_block, blocks, forces, records, sums);
+                    integrator.advance_chunk(blocks, forces, step, records);
+                    pass.settle(first_block, blocks, records, sums);
+                    sums.moved = prepare_chunk(rotations, moved, blocks, refs, pass.trigger);
+                },
+            );
         pipeline.detection.prepared = Some(pipeline.block_sums.iter().any(|s| s.moved));
         self.gather_block_sums(pipeline)
     }
