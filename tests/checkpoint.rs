@@ -236,6 +236,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         keys(&json),
         [
             "blocks",
+            "bounds",
             "checksum",
             "contacts",
             "critical",
@@ -500,13 +501,30 @@ fn edited_time_step_and_counters_are_refused() -> Result<()> {
         assert_eq!(p, path, "{field} = {value}: {err}");
     }
     // dt and the critical step edited together (dt still safety × critical): the critical step
-    // re-evaluated from the blocks and contacts gives it away.
+    // the stored bounds give gives it away.
     let mut json = original.clone();
     json["critical"]["dt"] = serde_json::json!(10.0 * critical);
     json["dt"] = serde_json::json!(10.0 * dt);
     let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("critical");
     assert!(
         matches!(&err, Error::Checkpoint { path, .. } if path == "critical.dt"),
+        "{err}"
+    );
+    // The bounds, the critical step and dt edited together: the bounds the blocks and contacts
+    // give now give it away.
+    let mut json = original.clone();
+    let bounds: Vec<f64> = json["bounds"]
+        .as_array()
+        .expect("bounds")
+        .iter()
+        .map(|w| w.as_f64().expect("a number") / 100.0)
+        .collect();
+    json["bounds"] = serde_json::json!(bounds);
+    json["critical"]["dt"] = serde_json::json!(10.0 * critical);
+    json["dt"] = serde_json::json!(10.0 * dt);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("bounds");
+    assert!(
+        matches!(&err, Error::Checkpoint { path, .. } if path.starts_with("bounds[")),
         "{err}"
     );
     // A step count far beyond any run but short of 2^53 loads and steps.

@@ -20,61 +20,64 @@ pub(crate) struct ContactStiffness {
     pub moments: AreaMoments,
 }
 
-/// Fills `bounds` (one per block): for a block in contact, the block Gershgorin bound
+/// The bound of block `i`, given its contacts in contact order: for a block in contact, the block Gershgorin bound
 /// `λ ≤ λ_max(A_bb) + Σ_c √(λ_b λ_c)` of its mass-normalised contact stiffness; for a block
 /// in free flight, that of a contact of stiffness `k_max` (`kn + 2 ks`, the stiffest law's) over
 /// its largest face, so that its step is sensible when it lands (the landing contact is detected
 /// before it loads, and the step is then re-evaluated from the real contacts); zero for a block
 /// whose every degree of freedom is prescribed.
-pub(crate) fn block_bounds(
+///
+/// A block's bound depends only on its own contacts, so that the bounds of the blocks whose
+/// contacts changed can be re-evaluated without the others, and all of them in parallel.
+pub(crate) fn block_bound(
     blocks: &[RigidBlock],
-    contacts: &[ContactStiffness],
+    i: usize,
+    contacts: impl Iterator<Item = ContactStiffness>,
     k_max: Real,
-    bounds: &mut [StiffnessBound],
-) {
-    // Mass scaling of each movable block, restricted to its free degrees of freedom.
-    let scaling: Vec<Option<Normalisation>> = blocks
-        .iter()
-        .map(|b| (!all_constrained(b)).then(|| Normalisation::of(b)))
-        .collect();
-    let n = blocks.len();
-    let mut own = vec![Stiffness6::default(); n];
-    let mut coupling = vec![0.0; n];
-    let mut in_contact = vec![false; n];
+) -> StiffnessBound {
+    let b = &blocks[i];
+    if all_constrained(b) {
+        return StiffnessBound { omega_squared: 0.0 };
+    }
+    let mut own = Stiffness6::default();
+    let mut coupling = 0.0;
+    let mut in_contact = false;
     for c in contacts {
         let k = c.stiffness;
-        let side = |i: usize| -> Option<Stiffness6> {
-            let scaling = scaling[i].as_ref()?;
-            let centre = blocks[i].state.pose.translation - c.origin;
-            Some(c.moments.stiffness(centre, c.normal, k.normal, k.shear, scaling))
+        let side = |j: usize| -> Option<Stiffness6> {
+            let block = &blocks[j];
+            if all_constrained(block) {
+                return None;
+            }
+            let centre = block.state.pose.translation - c.origin;
+            Some(
+                c.moments
+                    .stiffness(centre, c.normal, k.normal, k.shear, &Normalisation::of(block)),
+            )
         };
-        let (a, b) = (c.a, c.b);
-        let (ka, kb) = (side(a), side(b));
+        let (ka, kb) = (side(c.a), side(c.b));
         let la = ka.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
         let lb = kb.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
-        if let Some(m) = ka {
-            own[a].add(&m);
+        if let Some(m) = if c.a == i { ka } else { kb } {
+            own.add(&m);
         }
-        if let Some(m) = kb {
-            own[b].add(&m);
-        }
-        coupling[a] += (la * lb).sqrt();
-        coupling[b] += (la * lb).sqrt();
-        in_contact[a] = true;
-        in_contact[b] = true;
+        coupling += (la * lb).sqrt();
+        in_contact = true;
     }
-    for (i, b) in blocks.iter().enumerate() {
-        bounds[i].omega_squared = if all_constrained(b) {
-            0.0
-        } else if in_contact[i] {
-            // Block Gershgorin: λ ≤ λ_max(A_bb) + Σ_c ‖A_bc‖, ‖A_bc‖ ≤ √(λ_b λ_c) per contact.
-            own[i].max_eigenvalue() + coupling[i]
+    StiffnessBound {
+        omega_squared: if in_contact {
+            own.max_eigenvalue() + coupling
         } else {
-            let mp = b.mass_properties();
-            let face = b.shape().faces().iter().map(|f| f.area).fold(0.0, Real::max);
-            k_max * face * (1.0 / mp.mass + b.shape().radius().powi(2) / mp.principal_inertia.min_element())
-        };
+            free_flight_bound(b, k_max)
+        },
     }
+}
+
+/// The bound of a block in free flight: a contact of stiffness `k_max` over its largest face.
+fn free_flight_bound(b: &RigidBlock, k_max: Real) -> Real {
+    let mp = b.mass_properties();
+    let face = b.shape().faces().iter().map(|f| f.area).fold(0.0, Real::max);
+    k_max * face * (1.0 / mp.mass + b.shape().radius().powi(2) / mp.principal_inertia.min_element())
 }
 
 /// The mass normalisation of one block's stiffness, `K ↦ T K Tᵀ`, restricted to its free
@@ -298,10 +301,9 @@ mod tests {
                 ..Fixity::FREE
             };
             let blocks = [base.clone(), cube.clone().with_fixity(fixity)];
-            let mut bounds = [StiffnessBound::default(); 2];
-            block_bounds(&blocks, &[contact], kn + 2.0 * ks, &mut bounds);
-            assert_eq!(bounds[0].omega_squared, 0.0);
-            bounds[1].omega_squared
+            let k_max = kn + 2.0 * ks;
+            assert_eq!(block_bound(&blocks, 0, [contact].into_iter(), k_max).omega_squared, 0.0);
+            block_bound(&blocks, 1, [contact].into_iter(), k_max).omega_squared
         };
         let translations_only = bound([Dof::Fixed; 3]);
         let expected = kn * 0.04 / mass;

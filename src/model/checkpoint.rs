@@ -33,7 +33,7 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// that a layout change no longer changes the format. Version 10 adds the checksum and the law
 /// type; version 9 files (which have neither, so that corruption could not be told) are refused.
 /// Version 11 adds the pairs the narrow phase tested, with their relative poses, on which
-/// re-detection depends.
+/// re-detection depends, and the blocks' stability bounds, which are re-evaluated block by block.
 const VERSION: u32 = 11;
 /// The checksum's field: `"crc32:"` and eight hexadecimal digits.
 const CHECKSUM: &str = "checksum";
@@ -41,6 +41,9 @@ const CHECKSUM: &str = "checksum";
 /// counting exactly; far beyond any run (years at a microsecond a step), far below where the
 /// counter would overflow.
 const MAX_COUNT: u64 = 1 << 53;
+/// A stored stability bound below this fraction of the one the blocks and contacts give on
+/// load is refused: it would allow a step the contacts cannot take.
+const MIN_STORED_BOUND: Real = 0.8;
 
 /// The fields every version has, read before the rest (other fields are skipped).
 #[derive(Deserialize)]
@@ -72,6 +75,9 @@ struct Snapshot<L: ConstitutiveLaw> {
     tested: Vec<TestedEntry>,
     dt: Real,
     critical: Option<CriticalStep>,
+    /// Each block's bound of its squared natural frequency (1/s²) as last evaluated: the
+    /// critical step and the impact probe read them.
+    bounds: Vec<Real>,
     step: u64,
     time: Real,
     energy: Energies,
@@ -348,6 +354,7 @@ where
                 .collect(),
             dt: self.state.dt,
             critical: self.state.critical,
+            bounds: self.pipeline.bounds.iter().map(|b| b.omega_squared).collect(),
             step: self.state.step,
             time: self.state.time,
             energy: self.energies(),
@@ -709,19 +716,40 @@ where
             model.state.changes.insert(super::changes::Changes::DETECTION);
         }
         model.state.rebuild_block_index(&mut model.pipeline);
-        // The time step: re-evaluated from the blocks and contacts as detection does, and
-        // compared with the stored one, which is kept (re-evaluated poses differ from those at
-        // the last detection in the last digits). A step due for re-evaluation is re-evaluated
-        // by the next step anyway.
+        // The time step: the stored bounds must give the stored critical step, and none may
+        // be far below the bound the blocks and contacts give now (the stored ones are as of
+        // their last evaluation: contacts that shrank since leave them higher, a contact grows
+        // by up to 5 % before they are re-evaluated). A step due for re-evaluation is
+        // re-evaluated by the next step anyway.
         if !redetect {
+            if snap.bounds.len() != n {
+                return Err(corrupt("bounds", "one bound per block expected"));
+            }
+            if let Some(i) = snap.bounds.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
+                return Err(corrupt(&format!("bounds[{i}]"), "a finite value ≥ 0 expected"));
+            }
             let bound_areas: Vec<Real> = model.state.references.iter().map(|r| r.bound_area).collect();
-            // An error here is a fixed step above the re-evaluated limit: compared below.
+            // An error here is a fixed step above the re-evaluated limit: checked below.
             let _ = model.state.refresh_time_step(&mut model.pipeline);
-            let fresh = model.state.critical;
             for (r, area) in model.state.references.iter_mut().zip(bound_areas) {
                 r.bound_area = area;
             }
-            check_time_step(&snap.params, snap.dt, snap.critical, fresh)?;
+            for (i, (stored, fresh)) in snap.bounds.iter().zip(&model.pipeline.bounds).enumerate() {
+                if *stored < MIN_STORED_BOUND * fresh.omega_squared {
+                    return Err(corrupt(
+                        &format!("bounds[{i}]"),
+                        &format!(
+                            "{stored} 1/s² in the file, the blocks and contacts give {} 1/s²",
+                            fresh.omega_squared
+                        ),
+                    ));
+                }
+            }
+            for (bound, stored) in model.pipeline.bounds.iter_mut().zip(&snap.bounds) {
+                bound.omega_squared = *stored;
+            }
+            let from_bounds = model.state.integrator.critical_step(&model.pipeline.bounds);
+            check_time_step(&snap.params, snap.dt, snap.critical, from_bounds)?;
         }
         model.state.dt = snap.dt;
         model.state.critical = snap.critical;
@@ -805,9 +833,9 @@ fn check_run_state<L: ConstitutiveLaw>(snap: &Snapshot<L>) -> Result<()> {
     Ok(())
 }
 
-/// The stored step against the parameters and the critical step re-evaluated on load (`fresh`):
-/// the stored critical step within 10 % of it (the poses moved a little since the last
-/// detection), the step what the parameters make of the stored critical step, bit for bit.
+/// The stored step against the parameters and the critical step the stored bounds give
+/// (`fresh`): the stored critical step equal to it, the step what the parameters make of the
+/// stored critical step, bit for bit.
 fn check_time_step(
     params: &ModelParameters,
     dt: Real,
@@ -822,11 +850,10 @@ fn check_time_step(
     };
     let expected = match (critical, fresh) {
         (Some(c), Some(f)) => {
-            let close = (c.dt - f.dt).abs() <= 0.1 * f.dt;
-            if !close {
+            if c != f {
                 return bad(
                     "critical.dt",
-                    format!("{} s in the file, the blocks and contacts give {} s", c.dt, f.dt),
+                    format!("{} s in the file, the stored bounds give {} s", c.dt, f.dt),
                 );
             }
             match params.time_step {

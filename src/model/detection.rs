@@ -19,6 +19,11 @@ use crate::geometry::{
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Pose, Real, Vector};
 
+/// The staging lists are freed after a detection when they hold more than this share of the
+/// sub-contacts' room (`1/STAGING_FRACTION`): a full re-detection must not leave a second copy
+/// of the contacts behind.
+const STAGING_FRACTION: usize = 8;
+
 /// Planned pairs per task of the parallel narrow phase.
 const PLAN_CHUNK: usize = 256;
 
@@ -58,8 +63,13 @@ pub(crate) struct DetectionScratch<S> {
     /// Each block's box at its reference pose, loosened to hold it at any pose within the
     /// trigger ([`reference_box`]): the broad phase's boxes.
     boxes: Vec<Aabb>,
-    /// Old contacts kept as they were (rebuild only).
+    /// Old contacts kept as they were.
     kept: Vec<bool>,
+    /// The contacts after detection, in order, and where each one's sub-contacts start.
+    layout: Vec<Slot>,
+    firsts: Vec<u32>,
+    /// Whether contacts changed places (the block → contact index is rebuilt).
+    reindex: bool,
     /// Merge buffer of [`update_tested`].
     tested: Vec<TestedPair>,
     pairs: Vec<ContactPair>,
@@ -67,6 +77,17 @@ pub(crate) struct DetectionScratch<S> {
     wrenches: Vec<ContactWrench>,
     subs: Vec<SubContact<S>>,
     records: Vec<SubContactRecord>,
+}
+
+impl<S> DetectionScratch<S> {
+    /// Frees the staging lists (after they held a large share of the contacts).
+    fn release_staging(&mut self) {
+        self.pairs = Vec::new();
+        self.references = Vec::new();
+        self.wrenches = Vec::new();
+        self.subs = Vec::new();
+        self.records = Vec::new();
+    }
 }
 
 impl<S> Default for DetectionScratch<S> {
@@ -82,12 +103,82 @@ impl<S> Default for DetectionScratch<S> {
             moved: Vec::new(),
             boxes: Vec::new(),
             kept: Vec::new(),
+            layout: Vec::new(),
+            firsts: Vec::new(),
+            reindex: false,
             tested: Vec::new(),
             pairs: Vec::new(),
             references: Vec::new(),
             wrenches: Vec::new(),
             subs: Vec::new(),
             records: Vec::new(),
+        }
+    }
+}
+
+/// A contact after detection: an old one kept (its index), or one detected afresh (its index
+/// in the staging lists).
+#[derive(Debug, Clone, Copy)]
+enum Slot {
+    Kept(u32),
+    Staged(u32),
+}
+
+/// Which kept contacts [`ContactLists::move_contact`] moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Direction {
+    /// Those that move towards the front (or stay), element by element from the first.
+    Front,
+    /// Those that move towards the back, element by element from the last.
+    Back,
+}
+
+/// The model's contact lists, as detection rearranges them.
+struct ContactLists<'a, S> {
+    pairs: &'a mut Vec<ContactPair>,
+    references: &'a mut Vec<ContactReference>,
+    wrenches: &'a mut Vec<ContactWrench>,
+    subs: &'a mut Vec<SubContact<S>>,
+    records: &'a mut Vec<SubContactRecord>,
+}
+
+impl<S> ContactLists<'_, S> {
+    /// Moves old contact `c` to index `k` and its sub-contacts to start at `first`, each of the
+    /// two if it moves in `direction` (by swaps: what it leaves behind is dead). The `Back` pass
+    /// comes second, and sets the contact's `first`.
+    fn move_contact(&mut self, c: usize, k: usize, first: u32, direction: Direction) {
+        // Where the contact is now: at `k` once the `Front` pass moved it there.
+        let at = if direction == Direction::Back && k <= c { k } else { c };
+        let range = self.pairs[at].range();
+        let to = first as usize;
+        let pair_moves = match direction {
+            Direction::Front => k < c,
+            Direction::Back => k > c,
+        };
+        if pair_moves {
+            self.pairs.swap(c, k);
+            self.references.swap(c, k);
+            self.wrenches.swap(c, k);
+        }
+        let start = range.start;
+        let shift = |i: usize| to + (i - start);
+        match direction {
+            Direction::Front if to < range.start => {
+                for i in range {
+                    self.subs.swap(i, shift(i));
+                    self.records.swap(i, shift(i));
+                }
+            }
+            Direction::Back if to > range.start => {
+                for i in range.rev() {
+                    self.subs.swap(i, shift(i));
+                    self.records.swap(i, shift(i));
+                }
+            }
+            _ => {}
+        }
+        if direction == Direction::Back {
+            self.pairs[k].first = first;
         }
     }
 }
@@ -405,122 +496,48 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .zip(sc.chunks.par_iter_mut())
             .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
 
-        // A full detection (a change of laws, parameters or fixity) always rebuilds.
-        let rewrite = !full && self.rewrite_in_place(&sc.plan, &sc.outcomes, &sc.moved);
-        let (work, dashpot) = if rewrite {
-            self.rewrite_contacts(sc)?
-        } else {
-            self.rebuild_contacts(sc)?
-        };
+        let (work, dashpot) = self.splice_contacts(sc)?;
         self.energy.joint_work += work;
         self.energy.damping += dashpot;
         update_tested(&mut self.tested, &sc.plan, &sc.outcomes, &sc.moved, &mut sc.tested);
         sc.tests += sc.outcomes.iter().filter(|o| o.tested).count() as u64;
         self.detections += 1;
-        if !rewrite {
+        if sc.reindex {
             self.rebuild_block_index(pipeline);
         }
         // The critical step is re-evaluated when a contact appeared or one grew by more than 5 %
-        // since the last evaluation (lost contacts only make the step safer). A forced full
-        // detection follows a change of laws, parameters or fixity: the step is re-evaluated
-        // then too. The flag is set (or stays set) if that fails, so the error repeats rather
-        // than the run going on with an unstable step.
-        let stiffer = self.references.iter().any(|r| r.area > 1.05 * r.bound_area);
-        if stiffer || full || self.critical.is_none() {
+        // since the last evaluation (lost contacts only make the step safer): the bounds of
+        // those contacts' blocks. A forced full detection follows a change of laws, parameters
+        // or fixity: every block's bound is re-evaluated then. The flag is set (or stays set) if
+        // that fails, so the error repeats rather than the run going on with an unstable step.
+        if full || self.critical.is_none() {
             self.changes.insert(Changes::DETECTION);
             self.refresh_time_step(pipeline)?;
+        } else if self.contacts_grew() {
+            self.changes.insert(Changes::DETECTION);
+            self.refresh_time_step_of_grown(pipeline)?;
         }
         self.changes.clear();
         Ok(())
     }
 
-    /// Whether the outcome of the narrow phase leaves every contact in place: no contact
-    /// appears or disappears, and every re-tested contact keeps its number of sub-contacts.
-    /// (Contacts between two blocks that did not move are kept as they are.)
-    fn rewrite_in_place(&self, plan: &[Planned], outcomes: &[Outcome], moved: &[bool]) -> bool {
-        let mut planned_contacts = 0;
-        for (p, o) in plan.iter().zip(outcomes) {
-            let found = o.tested && o.contact.is_some() && o.seed_count > 0;
-            match p.old_contact() {
-                Some(c) => {
-                    if o.tested && (!found || o.seed_count != self.pairs[c].count) {
-                        return false;
-                    }
-                    planned_contacts += 1;
-                }
-                None if found => return false,
-                None => {}
-            }
-        }
-        let moved_contacts = self
-            .pairs
-            .iter()
-            .filter(|p| moved[p.a as usize] || moved[p.b as usize])
-            .count();
-        planned_contacts == moved_contacts
-    }
-
-    /// Rewrites the re-tested contacts in their slots (see [`ModelState::rewrite_in_place`]).
-    /// Returns the work of the dropped sub-contacts, as [`dropped_work`].
-    fn rewrite_contacts(&mut self, sc: &mut DetectionScratch<L::State>) -> Result<(Real, Real)> {
-        let mut owed = (0.0, 0.0);
-        let dt = if self.drift > 0.0 { self.drift } else { self.dt };
-        for (k, (p, o)) in sc.plan.iter().zip(&sc.outcomes).enumerate() {
-            let (Some(c), true) = (p.old_contact(), o.tested) else {
-                continue;
-            };
-            let dc = o.contact.as_ref().expect("checked by rewrite_in_place");
-            let seeds = sc.chunks[k / PLAN_CHUNK].seeds(o);
-            let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
-            let law = self.law_index(p.a, p.b)?;
-            let mut one = NewContacts {
-                pairs: &mut sc.pairs,
-                references: &mut sc.references,
-                wrenches: &mut sc.wrenches,
-                subs: &mut sc.subs,
-                records: &mut sc.records,
-            };
-            one.clear();
-            let old = OldContacts {
-                pairs: &self.pairs,
-                references: &self.references,
-                subs: &self.subs,
-                records: &self.sub_records,
-            };
-            one.add_detected(&old, Some(c), (p.a, bi), (p.b, bj), dc, law, seeds);
-            add_dropped_work(
-                &old,
-                c,
-                Some((&sc.pairs[0], &sc.records[..])),
-                &self.blocks,
-                self.params.mode,
-                dt,
-                &mut owed,
-            );
-            let range = self.pairs[c].range();
-            self.subs[range.clone()].clone_from_slice(&sc.subs);
-            self.sub_records[range.clone()].clone_from_slice(&sc.records);
-            let mut pair = sc.pairs[0].clone();
-            pair.first = range.start as u32;
-            self.pairs[c] = pair;
-            self.references[c] = sc.references[0].clone();
-            self.wrenches[c] = sc.wrenches[0];
-        }
-        Ok(owed)
-    }
-
-    /// Builds the contact lists afresh in pair order: kept contacts copied (those of two blocks
-    /// that did not move, and those whose pair kept its verdict), re-tested ones from their
-    /// seeds. Returns the work of the dropped sub-contacts ([`dropped_work`]).
-    fn rebuild_contacts(&mut self, sc: &mut DetectionScratch<L::State>) -> Result<(Real, Real)> {
-        let mut new = NewContacts {
+    /// Brings the contact lists up to date with the narrow phase's outcomes, in place: the
+    /// contacts of two blocks that did not move and those whose pair kept its verdict keep their
+    /// data, moved to their new positions (`docs/performance.md`, "Contact storage"); the
+    /// re-tested ones are built in `sc`'s staging lists first, with the history of the old
+    /// ones, then written to theirs. Nothing of the model changes before every law is found.
+    /// Returns the work of the dropped sub-contacts ([`dropped_work`]) and sets `sc.reindex`
+    /// when contacts changed places.
+    fn splice_contacts(&mut self, sc: &mut DetectionScratch<L::State>) -> Result<(Real, Real)> {
+        // The new order: kept old contacts and staged new ones, by pair.
+        let mut staged = NewContacts {
             pairs: &mut sc.pairs,
             references: &mut sc.references,
             wrenches: &mut sc.wrenches,
             subs: &mut sc.subs,
             records: &mut sc.records,
         };
-        new.clear();
+        staged.clear();
         let old = OldContacts {
             pairs: &self.pairs,
             references: &self.references,
@@ -528,21 +545,22 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             records: &self.sub_records,
         };
         sc.kept.clear();
-        sc.kept.resize(self.pairs.len(), false);
+        sc.kept.resize(old.pairs.len(), false);
+        sc.layout.clear();
         let moved = &sc.moved;
+        let unmoved = |c: usize| !moved[old.pairs[c].a as usize] && !moved[old.pairs[c].b as usize];
         let mut c = 0;
         for (k, (p, o)) in sc.plan.iter().zip(&sc.outcomes).enumerate() {
-            // The contacts of two blocks that did not move, up to this pair.
             while c < old.pairs.len() && (old.pairs[c].a, old.pairs[c].b) < (p.a, p.b) {
-                if !moved[old.pairs[c].a as usize] && !moved[old.pairs[c].b as usize] {
-                    new.keep(&old, c, self.wrenches[c]);
+                if unmoved(c) {
+                    sc.layout.push(Slot::Kept(c as u32));
                     sc.kept[c] = true;
                 }
                 c += 1;
             }
             if !o.tested {
                 if let Some(c) = p.old_contact() {
-                    new.keep(&old, c, self.wrenches[c]);
+                    sc.layout.push(Slot::Kept(c as u32));
                     sc.kept[c] = true;
                 }
                 continue;
@@ -554,15 +572,16 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             let seeds = sc.chunks[k / PLAN_CHUNK].seeds(o);
             let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let law = self.law_index(p.a, p.b)?;
-            new.add_detected(&old, p.old_contact(), (p.a, bi), (p.b, bj), dc, law, seeds);
+            sc.layout.push(Slot::Staged(staged.pairs.len() as u32));
+            staged.add_detected(&old, p.old_contact(), (p.a, bi), (p.b, bj), dc, law, seeds);
         }
         for c in c..old.pairs.len() {
-            if !moved[old.pairs[c].a as usize] && !moved[old.pairs[c].b as usize] {
-                new.keep(&old, c, self.wrenches[c]);
+            if unmoved(c) {
+                sc.layout.push(Slot::Kept(c as u32));
                 sc.kept[c] = true;
             }
         }
-        let dropped = dropped_work(
+        let owed = dropped_work(
             &old,
             (&sc.pairs, &sc.records),
             &sc.kept,
@@ -570,12 +589,87 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.params.mode,
             if self.drift > 0.0 { self.drift } else { self.dt },
         );
-        std::mem::swap(&mut self.pairs, &mut sc.pairs);
-        std::mem::swap(&mut self.references, &mut sc.references);
-        std::mem::swap(&mut self.wrenches, &mut sc.wrenches);
-        std::mem::swap(&mut self.subs, &mut sc.subs);
-        std::mem::swap(&mut self.sub_records, &mut sc.records);
-        Ok(dropped)
+        // Where each contact goes: its index in `layout`, its sub-contacts from `first`.
+        sc.firsts.clear();
+        let mut total = 0u32;
+        for slot in &sc.layout {
+            sc.firsts.push(total);
+            total += match *slot {
+                Slot::Kept(c) => self.pairs[c as usize].count,
+                Slot::Staged(s) => sc.pairs[s as usize].count,
+            };
+        }
+        sc.reindex = sc.layout.len() != self.pairs.len()
+            || sc.layout.iter().enumerate().any(|(k, slot)| match *slot {
+                Slot::Kept(c) => c as usize != k,
+                Slot::Staged(s) => {
+                    let q = &sc.pairs[s as usize];
+                    self.pairs.get(k).is_none_or(|p| (p.a, p.b) != (q.a, q.b))
+                }
+            });
+        let (contacts, subs) = (sc.layout.len(), total as usize);
+        if sc.layout.iter().all(|slot| matches!(slot, Slot::Staged(_))) {
+            // Every contact detected afresh (the first detection, a full one): the staging lists
+            // are the new lists, and the old ones are released rather than kept as staging.
+            std::mem::swap(&mut self.pairs, &mut sc.pairs);
+            std::mem::swap(&mut self.references, &mut sc.references);
+            std::mem::swap(&mut self.wrenches, &mut sc.wrenches);
+            std::mem::swap(&mut self.subs, &mut sc.subs);
+            std::mem::swap(&mut self.sub_records, &mut sc.records);
+            sc.release_staging();
+            return Ok(owed);
+        }
+        if contacts > self.pairs.len() {
+            // Room for the new contacts (the fillers are overwritten below).
+            let filler = (sc.pairs[0].clone(), sc.references[0].clone());
+            self.pairs.resize(contacts, filler.0);
+            self.references.resize(contacts, filler.1);
+            self.wrenches.resize(contacts, ContactWrench::default());
+        }
+        if subs > self.subs.len() {
+            self.subs.resize(subs, sc.subs[0].clone());
+            self.sub_records.resize(subs, sc.records[0].clone());
+        }
+        // Kept contacts move towards the front left to right, then towards the back right to
+        // left: neither overwrites data still to be moved (`docs/performance.md`).
+        let mut lists = ContactLists {
+            pairs: &mut self.pairs,
+            references: &mut self.references,
+            wrenches: &mut self.wrenches,
+            subs: &mut self.subs,
+            records: &mut self.sub_records,
+        };
+        for (k, slot) in sc.layout.iter().enumerate() {
+            if let Slot::Kept(c) = *slot {
+                lists.move_contact(c as usize, k, sc.firsts[k], Direction::Front);
+            }
+        }
+        for (k, slot) in sc.layout.iter().enumerate().rev() {
+            if let Slot::Kept(c) = *slot {
+                lists.move_contact(c as usize, k, sc.firsts[k], Direction::Back);
+            }
+        }
+        for (k, slot) in sc.layout.iter().enumerate() {
+            if let Slot::Staged(s) = *slot {
+                let q = &sc.pairs[s as usize];
+                let (from, to) = (q.range(), sc.firsts[k] as usize..(sc.firsts[k] + q.count) as usize);
+                lists.subs[to.clone()].clone_from_slice(&sc.subs[from.clone()]);
+                lists.records[to].clone_from_slice(&sc.records[from]);
+                lists.pairs[k] = q.clone();
+                lists.pairs[k].first = sc.firsts[k];
+                lists.references[k] = sc.references[s as usize].clone();
+                lists.wrenches[k] = sc.wrenches[s as usize];
+            }
+        }
+        self.pairs.truncate(contacts);
+        self.references.truncate(contacts);
+        self.wrenches.truncate(contacts);
+        self.subs.truncate(subs);
+        self.sub_records.truncate(subs);
+        if STAGING_FRACTION * sc.subs.capacity() > self.subs.len().max(1) {
+            sc.release_staging();
+        }
+        Ok(owed)
     }
 
     /// The index of the joint law between blocks `i` and `j`.
@@ -686,18 +780,6 @@ impl<S: Clone + Default> NewContacts<'_, S> {
         self.wrenches.clear();
         self.subs.clear();
         self.records.clear();
-    }
-
-    /// Keeps old contact `k` as it is (neither block moved beyond the trigger), with its wrench.
-    fn keep(&mut self, old: &OldContacts<'_, S>, k: usize, wrench: ContactWrench) {
-        let p = &old.pairs[k];
-        let mut kept = p.clone();
-        kept.first = self.subs.len() as u32;
-        self.subs.extend_from_slice(&old.subs[p.range()]);
-        self.records.extend_from_slice(&old.records[p.range()]);
-        self.pairs.push(kept);
-        self.references.push(old.references[k].clone());
-        self.wrenches.push(wrench);
     }
 
     /// Adds the contact the narrow phase found between blocks `i < j` (`seeds` its sub-contacts,

@@ -26,6 +26,9 @@ pub(super) struct Pipeline<S> {
     /// The blocks' squared frequency bounds of the last step evaluation (critical step and
     /// impact probe).
     pub bounds: Vec<StiffnessBound>,
+    /// The blocks whose bounds a partial re-evaluation takes, and their new bounds.
+    pub refresh_blocks: Vec<u32>,
+    pub refresh_bounds: Vec<StiffnessBound>,
     /// Detection's buffers, and what the block pass prepared for the next step.
     pub detection: DetectionScratch<S>,
     /// Wall-clock time per stage.
@@ -42,6 +45,8 @@ impl<S> Default for Pipeline<S> {
             block_sums: Vec::new(),
             rotations: Vec::new(),
             bounds: Vec::new(),
+            refresh_blocks: Vec::new(),
+            refresh_bounds: Vec::new(),
             detection: DetectionScratch::default(),
             timings: Timings::default(),
         }

@@ -4,7 +4,9 @@
 use super::pipeline::Pipeline;
 use super::ModelState;
 use crate::error::{Error, Result};
-use crate::integrate::{AreaMoments, ContactStiffness, TimeStep};
+use rayon::prelude::*;
+
+use crate::integrate::{block_bound, AreaMoments, ContactStiffness, StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Real, Vector};
 
@@ -15,38 +17,78 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if self.blocks.is_empty() {
             return Ok(());
         }
-        let laws = self.laws.laws();
-        let mut contacts = Vec::with_capacity(self.pairs.len());
-        for (p, reference) in self.pairs.iter().zip(self.references.iter_mut()) {
-            let subs = &self.subs[p.range()];
-            reference.bound_area = reference.area;
-            // Area moments of the sub-contact points about the first one (for digits).
-            let (sa, sb) = (&self.blocks[p.a as usize].state, &self.blocks[p.b as usize].state);
-            let frame = p.frame(reference, &sa.pose, &sb.pose, self.params.mode);
-            let origin = subs
-                .first()
-                .map_or(Vector::ZERO, |s| frame.transform_point(p.anchor(s)));
-            let mut moments = AreaMoments::default();
-            for s in subs {
-                moments.add(frame.transform_point(p.anchor(s)) - origin, s.area);
-            }
-            contacts.push(ContactStiffness {
-                a: p.a as usize,
-                b: p.b as usize,
-                normal: p.normal,
-                stiffness: laws[p.law as usize].stiffness(),
-                origin,
-                moments,
-            });
+        // Blocks added since the last detection (a setter may ask before the first step).
+        let n = self.blocks.len();
+        if pipeline.block_offsets.len() != n + 1 || pipeline.block_offsets[n] as usize != 2 * self.pairs.len() {
+            self.rebuild_block_index(pipeline);
         }
-        let k_max = laws
-            .iter()
-            .map(|l| {
-                let k = l.stiffness();
-                k.normal + 2.0 * k.shear
-            })
-            .fold(0.0, Real::max);
-        crate::integrate::block_bounds(&self.blocks, &contacts, k_max, &mut pipeline.bounds);
+        for reference in &mut self.references {
+            reference.bound_area = reference.area;
+        }
+        pipeline.bounds.resize(n, StiffnessBound::default());
+        let sources = self.bound_sources(&pipeline.block_offsets, &pipeline.block_contacts);
+        pipeline
+            .bounds
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(i, bound)| *bound = sources.bound(i));
+        self.set_time_step(pipeline)
+    }
+
+    /// Re-evaluates the bounds of the blocks of the contacts whose area grew by more than 5 %
+    /// since their last evaluation (or that are new), then the critical step from all the
+    /// bounds: a block's bound depends only on its own contacts. Needs the block → contact
+    /// index.
+    pub(super) fn refresh_time_step_of_grown(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
+        let mut blocks = std::mem::take(&mut pipeline.refresh_blocks);
+        blocks.clear();
+        for (p, reference) in self.pairs.iter().zip(&mut self.references) {
+            if reference.area > GROWTH * reference.bound_area {
+                reference.bound_area = reference.area;
+                blocks.extend([p.a, p.b]);
+            }
+        }
+        blocks.sort_unstable();
+        blocks.dedup();
+        let mut fresh = std::mem::take(&mut pipeline.refresh_bounds);
+        {
+            let sources = self.bound_sources(&pipeline.block_offsets, &pipeline.block_contacts);
+            fresh.clear();
+            fresh.par_extend(blocks.par_iter().map(|&i| sources.bound(i as usize)));
+        }
+        for (&i, bound) in blocks.iter().zip(&fresh) {
+            pipeline.bounds[i as usize] = *bound;
+        }
+        pipeline.refresh_blocks = blocks;
+        pipeline.refresh_bounds = fresh;
+        self.set_time_step(pipeline)
+    }
+
+    /// Whether a contact grew enough since its last evaluation for the step to be re-evaluated.
+    pub(super) fn contacts_grew(&self) -> bool {
+        self.references.iter().any(|r| r.area > GROWTH * r.bound_area)
+    }
+
+    /// What a block's stability bound is computed from.
+    fn bound_sources<'a>(&'a self, offsets: &'a [u32], contacts: &'a [u32]) -> BoundSources<'a, L> {
+        BoundSources {
+            state: self,
+            offsets,
+            contacts,
+            k_max: self
+                .laws
+                .laws()
+                .iter()
+                .map(|l| {
+                    let k = l.stiffness();
+                    k.normal + 2.0 * k.shear
+                })
+                .fold(0.0, Real::max),
+        }
+    }
+
+    /// The critical step from the blocks' bounds, then `dt`.
+    fn set_time_step(&mut self, pipeline: &Pipeline<L::State>) -> Result<()> {
         self.critical = self.integrator.critical_step(&pipeline.bounds);
         let Some(crit) = self.critical else {
             // No stiffness anywhere: free flight; keep a previous step or a small default.
@@ -72,5 +114,53 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             }
         };
         Ok(())
+    }
+}
+
+/// A contact whose area grew by more than this factor since the critical step was last
+/// evaluated for it has its blocks' bounds re-evaluated (lost or shrinking contacts only make
+/// the step safer).
+const GROWTH: Real = 1.05;
+
+/// The model's blocks and contacts, and the block → contact index, as the stability bounds
+/// read them.
+struct BoundSources<'a, L: ConstitutiveLaw> {
+    state: &'a ModelState<L>,
+    offsets: &'a [u32],
+    contacts: &'a [u32],
+    k_max: Real,
+}
+
+impl<L: ConstitutiveLaw> BoundSources<'_, L> {
+    /// Block `i`'s bound, from its contacts in contact order.
+    fn bound(&self, i: usize) -> StiffnessBound {
+        let entries = &self.contacts[self.offsets[i] as usize..self.offsets[i + 1] as usize];
+        let contacts = entries.iter().map(|&e| self.contact((e / 2) as usize));
+        block_bound(&self.state.blocks, i, contacts, self.k_max)
+    }
+
+    /// What the bound needs of contact `k`: the area moments of its sub-contact points about the
+    /// first one (for digits), its normal and stiffness.
+    fn contact(&self, k: usize) -> ContactStiffness {
+        let s = self.state;
+        let (p, reference) = (&s.pairs[k], &s.references[k]);
+        let subs = &s.subs[p.range()];
+        let (sa, sb) = (&s.blocks[p.a as usize].state, &s.blocks[p.b as usize].state);
+        let frame = p.frame(reference, &sa.pose, &sb.pose, s.params.mode);
+        let origin = subs
+            .first()
+            .map_or(Vector::ZERO, |s| frame.transform_point(p.anchor(s)));
+        let mut moments = AreaMoments::default();
+        for sub in subs {
+            moments.add(frame.transform_point(p.anchor(sub)) - origin, sub.area);
+        }
+        ContactStiffness {
+            a: p.a as usize,
+            b: p.b as usize,
+            normal: p.normal,
+            stiffness: s.laws.laws()[p.law as usize].stiffness(),
+            origin,
+            moments,
+        }
     }
 }
