@@ -97,6 +97,9 @@ struct Run {
     detection_share: f64,
     /// Contact detections during the timed steps (the first, full one is in the warm-up), per step.
     redetections_per_step: f64,
+    /// Block pairs the narrow phase tested during the timed steps, per step
+    /// (`Model::pair_tests`).
+    pair_tests_per_step: f64,
     /// Share of the stepping time in the contact pass (kinematics, laws, resultants, gather).
     contact_share: f64,
     /// Share in the integrator and energy bookkeeping.
@@ -155,7 +158,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         }
     );
     println!(
-        "{:>8} {:>9} {:>11} {:>11} {:>14} {:>10} {:>10} {:>9} {:>11} {:>12} {:>9}",
+        "{:>8} {:>9} {:>11} {:>11} {:>14} {:>10} {:>10} {:>10} {:>9} {:>11} {:>12} {:>9}",
         "blocks",
         "contacts",
         "subcontacts",
@@ -163,6 +166,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         "updates/s",
         "detection",
         "redet/step",
+        "tests/step",
         "contacts",
         "integration",
         "bytes/block",
@@ -179,6 +183,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
         let setup = started.elapsed().as_secs_f64();
         model.reset_timings();
         let detections = model.detection_count();
+        let tests = model.pair_tests();
         // Sub-contacts change with re-detection: count the updates step by step (`step` is what
         // `run_steps` calls; the count is a length).
         let mut updates = 0_usize;
@@ -205,6 +210,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             subcontact_updates_per_s: updates as f64 / elapsed,
             detection_share: share(t.detection, t.total()),
             redetections_per_step: (model.detection_count() - detections) as f64 / steps as f64,
+            pair_tests_per_step: (model.pair_tests() - tests) as f64 / steps as f64,
             contact_share: share(t.contacts, t.total()),
             integration_share: share(t.integration, t.total()),
             peak_rss_bytes: peak_rss_bytes(),
@@ -212,7 +218,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             build_and_first_detection_s: setup,
         };
         println!(
-            "{:>8} {:>9} {:>11} {:>11.3} {:>14.3e} {:>9.1}% {:>10.3} {:>8.1}% {:>10.1}% {:>12.0} {:>9.0}",
+            "{:>8} {:>9} {:>11} {:>11.3} {:>14.3e} {:>9.1}% {:>10.3} {:>10.1} {:>8.1}% {:>10.1}% {:>12.0} {:>9.0}",
             run.blocks,
             run.contacts,
             run.subcontacts,
@@ -220,6 +226,7 @@ fn try_main() -> Result<(), Box<dyn std::error::Error>> {
             run.subcontact_updates_per_s,
             run.detection_share * 100.0,
             run.redetections_per_step,
+            run.pair_tests_per_step,
             run.contact_share * 100.0,
             run.integration_share * 100.0,
             run.peak_rss_bytes_per_block,

@@ -24,6 +24,13 @@ use crate::math::{Matrix, Pose, Real, Vector};
 /// of the contacts behind.
 const STAGING_FRACTION: usize = 8;
 
+/// A contact keeps its geometry at a detection while its blocks moved less than this fraction
+/// of the trigger relative to each other since its test. Until the next look, at the next
+/// detection where one of its blocks moved the trigger, the pair moves relatively by up to three
+/// more triggers (`docs/theory.md` §2.3): its geometry lags its relative motion by at most 3.5
+/// triggers, 0.875 of the tolerance at the defaults, as a block clipped afresh lags by up to 3.
+const KEEP_FRACTION: Real = 0.5;
+
 /// Planned pairs per task of the parallel narrow phase.
 const PLAN_CHUNK: usize = 256;
 
@@ -254,7 +261,7 @@ struct PairTest<'a> {
     tested: &'a [TestedPair],
     pairs: &'a [ContactPair],
     params: &'a ContactParameters,
-    /// The trigger within which a contact keeps its verdict; `None` tests every pair.
+    /// The relative motion within which a contact keeps its verdict; `None` tests every pair.
     keep_within: Option<Real>,
 }
 
@@ -487,7 +494,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             blocks: &self.blocks,
             tested: &self.tested,
             params: &params,
-            keep_within: (!full).then_some(trigger),
+            keep_within: (!full).then_some(KEEP_FRACTION * trigger),
             pairs: &self.pairs,
         };
         sc.outcomes

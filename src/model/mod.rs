@@ -608,6 +608,14 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.state.detections
     }
 
+    /// Number of block pairs the narrow phase tested since the model was built or restored: at
+    /// a detection, only the pairs with a block that moved beyond the re-detection trigger whose
+    /// relative pose changed beyond it since their last test (`docs/theory.md` §2.3). A
+    /// statistic, like [`Model::timings`]; a checkpoint does not store it.
+    pub fn pair_tests(&self) -> u64 {
+        self.pipeline.detection.tests
+    }
+
     /// Unbalanced-force ratio of the last step: the largest out-of-balance force on a free block
     /// divided by the mean contact force (infinite before the first step or without contacts).
     pub fn unbalanced_force_ratio(&self) -> Real {
