@@ -51,8 +51,10 @@ pub struct ContactParameters {
     /// Blocks closer than this (m) are in contact; contacts whose gap grows beyond it are dropped.
     /// Default `1e-3` m.
     pub tolerance: Real,
-    /// Contacts are re-detected once some block has moved more than this fraction of
-    /// `tolerance` since its last detection. Default `0.25`.
+    /// The re-detection trigger, as a fraction of `tolerance`: contacts are re-detected once
+    /// some block has moved more than this since it last did, and then a pair is tested afresh
+    /// only if its two blocks moved relative to each other (a contact: by more than half the
+    /// trigger since its test; `docs/theory.md` §2.3). Default `0.25`.
     pub redetect_fraction: Real,
     /// The two faces most aligned with the contact normal form a face-to-face joint (a grid of
     /// sub-contacts on one of the faces, gaps measured to the other face's plane) while their

@@ -31,6 +31,9 @@ const STAGING_FRACTION: usize = 8;
 /// triggers, 0.875 of the tolerance at the defaults, as a block clipped afresh lags by up to 3.
 const KEEP_FRACTION: Real = 0.5;
 
+/// Planned pairs per batch of the narrow phase (`PLAN_CHUNK` per task).
+const BATCH: usize = 64 * PLAN_CHUNK;
+
 /// Planned pairs per task of the parallel narrow phase.
 const PLAN_CHUNK: usize = 256;
 
@@ -75,6 +78,7 @@ pub(crate) struct DetectionScratch<S> {
     /// The contacts after detection, in order, and where each one's sub-contacts start.
     layout: Vec<Slot>,
     firsts: Vec<u32>,
+    runs: Vec<Run>,
     /// Whether contacts changed places (the block → contact index is rebuilt).
     reindex: bool,
     /// Merge buffer of [`update_tested`].
@@ -112,6 +116,7 @@ impl<S> Default for DetectionScratch<S> {
             kept: Vec::new(),
             layout: Vec::new(),
             firsts: Vec::new(),
+            runs: Vec::new(),
             reindex: false,
             tested: Vec::new(),
             pairs: Vec::new(),
@@ -131,7 +136,7 @@ enum Slot {
     Staged(u32),
 }
 
-/// Which kept contacts [`ContactLists::move_contact`] moves.
+/// Which runs of kept contacts [`ContactLists::move_run`] moves.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Direction {
     /// Those that move towards the front (or stay), element by element from the first.
@@ -150,44 +155,60 @@ struct ContactLists<'a, S> {
 }
 
 impl<S> ContactLists<'_, S> {
-    /// Moves old contact `c` to index `k` and its sub-contacts to start at `first`, each of the
-    /// two if it moves in `direction` (by swaps: what it leaves behind is dead). The `Back` pass
-    /// comes second, and sets the contact's `first`.
-    fn move_contact(&mut self, c: usize, k: usize, first: u32, direction: Direction) {
-        // Where the contact is now: at `k` once the `Front` pass moved it there.
+    /// Moves a run of old contacts to its new indices and their sub-contacts to start at
+    /// `first`, each of the two if it moves in `direction`, by rotating the run with the dead
+    /// room it moves into. The `Back` pass comes second, and sets the contacts' `first`.
+    fn move_run(&mut self, run: &Run, first: u32, direction: Direction) {
+        let (c, k, len) = (run.old as usize, run.new as usize, run.len as usize);
+        // Where the run is now: at `k` once the `Front` pass moved it there.
         let at = if direction == Direction::Back && k <= c { k } else { c };
-        let range = self.pairs[at].range();
-        let to = first as usize;
-        let pair_moves = match direction {
-            Direction::Front => k < c,
-            Direction::Back => k > c,
+        let start = self.pairs[at].first as usize;
+        let end = {
+            let last = &self.pairs[at + len - 1];
+            (last.first + last.count) as usize
         };
-        if pair_moves {
-            self.pairs.swap(c, k);
-            self.references.swap(c, k);
-            self.wrenches.swap(c, k);
-        }
-        let start = range.start;
-        let shift = |i: usize| to + (i - start);
+        let to = first as usize;
         match direction {
-            Direction::Front if to < range.start => {
-                for i in range {
-                    self.subs.swap(i, shift(i));
-                    self.records.swap(i, shift(i));
-                }
+            Direction::Front if k < c => {
+                self.pairs[k..c + len].rotate_left(c - k);
+                self.references[k..c + len].rotate_left(c - k);
+                self.wrenches[k..c + len].rotate_left(c - k);
             }
-            Direction::Back if to > range.start => {
-                for i in range.rev() {
-                    self.subs.swap(i, shift(i));
-                    self.records.swap(i, shift(i));
-                }
+            Direction::Back if k > c => {
+                self.pairs[c..k + len].rotate_right(k - c);
+                self.references[c..k + len].rotate_right(k - c);
+                self.wrenches[c..k + len].rotate_right(k - c);
+            }
+            _ => {}
+        }
+        match direction {
+            Direction::Front if to < start => {
+                self.subs[to..end].rotate_left(start - to);
+                self.records[to..end].rotate_left(start - to);
+            }
+            Direction::Back if to > start => {
+                let new_end = to + (end - start);
+                self.subs[start..new_end].rotate_right(to - start);
+                self.records[start..new_end].rotate_right(to - start);
             }
             _ => {}
         }
         if direction == Direction::Back {
-            self.pairs[k].first = first;
+            let mut next = first;
+            for pair in &mut self.pairs[k..k + len] {
+                pair.first = next;
+                next += pair.count;
+            }
         }
     }
+}
+
+/// Consecutive old contacts `old..old + len` that go to `new..new + len`.
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    old: u32,
+    new: u32,
+    len: u32,
 }
 
 /// A candidate pair of the broad phase (two blocks not both fixed), with its entries in the
@@ -223,6 +244,8 @@ struct Outcome {
     /// The contact's seeds in its chunk's buffer.
     first_seed: u32,
     seed_count: u32,
+    /// Its index in the staging lists, once staged (else `u32::MAX`).
+    staged: u32,
 }
 
 impl Default for Outcome {
@@ -238,6 +261,7 @@ impl Default for Outcome {
             contact: None,
             first_seed: 0,
             seed_count: 0,
+            staged: u32::MAX,
         }
     }
 }
@@ -311,6 +335,7 @@ impl PairTest<'_> {
                 },
                 first_seed: first as u32,
                 seed_count: (scratch.seeds.len() - first) as u32,
+                staged: u32::MAX,
                 contact: found,
             };
         }
@@ -486,7 +511,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         );
         sc.outcomes.clear();
         sc.outcomes.resize(sc.plan.len(), Outcome::default());
-        let chunks = sc.plan.len().div_ceil(PLAN_CHUNK);
+        let chunks = sc.plan.len().min(BATCH).div_ceil(PLAN_CHUNK);
         if sc.chunks.len() < chunks {
             sc.chunks.resize_with(chunks, ChunkScratch::default);
         }
@@ -497,12 +522,18 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             keep_within: (!full).then_some(KEEP_FRACTION * trigger),
             pairs: &self.pairs,
         };
-        sc.outcomes
-            .par_chunks_mut(PLAN_CHUNK)
-            .zip(sc.plan.par_chunks(PLAN_CHUNK))
-            .zip(sc.chunks.par_iter_mut())
-            .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
-
+        // In batches, so that the seeds of a full detection are not all held at once: the tests
+        // of a batch in parallel, then its contacts staged in order.
+        NewContacts::of(sc).clear();
+        for start in (0..sc.plan.len()).step_by(BATCH) {
+            let batch = start..(start + BATCH).min(sc.plan.len());
+            sc.outcomes[batch.clone()]
+                .par_chunks_mut(PLAN_CHUNK)
+                .zip(sc.plan[batch.clone()].par_chunks(PLAN_CHUNK))
+                .zip(sc.chunks.par_iter_mut())
+                .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
+            self.stage(sc, batch)?;
+        }
         let (work, dashpot) = self.splice_contacts(sc)?;
         self.energy.joint_work += work;
         self.energy.damping += dashpot;
@@ -528,6 +559,38 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         Ok(())
     }
 
+    /// Stages the contacts the narrow phase found in the planned pairs `batch` (in order), with
+    /// the history of the old ones, and notes where in their outcomes.
+    fn stage(&self, sc: &mut DetectionScratch<L::State>, batch: std::ops::Range<usize>) -> Result<()> {
+        let old = OldContacts {
+            pairs: &self.pairs,
+            references: &self.references,
+            subs: &self.subs,
+            records: &self.sub_records,
+        };
+        let first = batch.start;
+        for k in batch {
+            let (p, o) = (&sc.plan[k], &mut sc.outcomes[k]);
+            let Some(dc) = o.contact.take() else { continue };
+            if o.seed_count == 0 {
+                continue;
+            }
+            let seeds = sc.chunks[(k - first) / PLAN_CHUNK].seeds(o);
+            let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
+            let law = self.law_index(p.a, p.b)?;
+            o.staged = sc.pairs.len() as u32;
+            let mut staged = NewContacts {
+                pairs: &mut sc.pairs,
+                references: &mut sc.references,
+                wrenches: &mut sc.wrenches,
+                subs: &mut sc.subs,
+                records: &mut sc.records,
+            };
+            staged.add_detected(&old, p.old_contact(), (p.a, bi), (p.b, bj), &dc, law, seeds);
+        }
+        Ok(())
+    }
+
     /// Brings the contact lists up to date with the narrow phase's outcomes, in place: the
     /// contacts of two blocks that did not move and those whose pair kept its verdict keep their
     /// data, moved to their new positions (`docs/performance.md`, "Contact storage"); the
@@ -537,14 +600,6 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// when contacts changed places.
     fn splice_contacts(&mut self, sc: &mut DetectionScratch<L::State>) -> Result<(Real, Real)> {
         // The new order: kept old contacts and staged new ones, by pair.
-        let mut staged = NewContacts {
-            pairs: &mut sc.pairs,
-            references: &mut sc.references,
-            wrenches: &mut sc.wrenches,
-            subs: &mut sc.subs,
-            records: &mut sc.records,
-        };
-        staged.clear();
         let old = OldContacts {
             pairs: &self.pairs,
             references: &self.references,
@@ -557,7 +612,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let moved = &sc.moved;
         let unmoved = |c: usize| !moved[old.pairs[c].a as usize] && !moved[old.pairs[c].b as usize];
         let mut c = 0;
-        for (k, (p, o)) in sc.plan.iter().zip(&sc.outcomes).enumerate() {
+        for (p, o) in sc.plan.iter().zip(&sc.outcomes) {
             while c < old.pairs.len() && (old.pairs[c].a, old.pairs[c].b) < (p.a, p.b) {
                 if unmoved(c) {
                     sc.layout.push(Slot::Kept(c as u32));
@@ -570,17 +625,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     sc.layout.push(Slot::Kept(c as u32));
                     sc.kept[c] = true;
                 }
-                continue;
+            } else if o.staged != u32::MAX {
+                sc.layout.push(Slot::Staged(o.staged));
             }
-            let Some(dc) = &o.contact else { continue };
-            if o.seed_count == 0 {
-                continue;
-            }
-            let seeds = sc.chunks[k / PLAN_CHUNK].seeds(o);
-            let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
-            let law = self.law_index(p.a, p.b)?;
-            sc.layout.push(Slot::Staged(staged.pairs.len() as u32));
-            staged.add_detected(&old, p.old_contact(), (p.a, bi), (p.b, bj), dc, law, seeds);
         }
         for c in c..old.pairs.len() {
             if unmoved(c) {
@@ -646,15 +693,24 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             subs: &mut self.subs,
             records: &mut self.sub_records,
         };
+        // Runs of kept contacts that were neighbours and stay neighbours move as one.
+        sc.runs.clear();
         for (k, slot) in sc.layout.iter().enumerate() {
-            if let Slot::Kept(c) = *slot {
-                lists.move_contact(c as usize, k, sc.firsts[k], Direction::Front);
+            let Slot::Kept(c) = *slot else { continue };
+            match sc.runs.last_mut() {
+                Some(run) if run.old + run.len == c && run.new + run.len == k as u32 => run.len += 1,
+                _ => sc.runs.push(Run {
+                    old: c,
+                    new: k as u32,
+                    len: 1,
+                }),
             }
         }
-        for (k, slot) in sc.layout.iter().enumerate().rev() {
-            if let Slot::Kept(c) = *slot {
-                lists.move_contact(c as usize, k, sc.firsts[k], Direction::Back);
-            }
+        for run in &sc.runs {
+            lists.move_run(run, sc.firsts[run.new as usize], Direction::Front);
+        }
+        for run in sc.runs.iter().rev() {
+            lists.move_run(run, sc.firsts[run.new as usize], Direction::Back);
         }
         for (k, slot) in sc.layout.iter().enumerate() {
             if let Slot::Staged(s) = *slot {
@@ -778,6 +834,19 @@ struct NewContacts<'a, S> {
     wrenches: &'a mut Vec<ContactWrench>,
     subs: &'a mut Vec<SubContact<S>>,
     records: &'a mut Vec<SubContactRecord>,
+}
+
+impl<'a, S> NewContacts<'a, S> {
+    /// The staging lists of `sc`.
+    fn of(sc: &'a mut DetectionScratch<S>) -> Self {
+        Self {
+            pairs: &mut sc.pairs,
+            references: &mut sc.references,
+            wrenches: &mut sc.wrenches,
+            subs: &mut sc.subs,
+            records: &mut sc.records,
+        }
+    }
 }
 
 impl<S: Clone + Default> NewContacts<'_, S> {
