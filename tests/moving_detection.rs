@@ -124,3 +124,34 @@ fn a_sliding_block_is_tested_again_as_it_slides() {
         );
     }
 }
+
+/// The shaking wall, run into its rocking (pairs re-tested, contacts spliced, bounds
+/// re-evaluated block by block), ends in the same bits on one thread and on four.
+#[test]
+fn a_shaking_wall_gives_the_same_bits_on_any_number_of_threads() {
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool");
+        pool.install(|| {
+            let mut model = voussoir::scenes::shaking_wall(600, voussoir::scenes::BENCHMARK_SPACING).expect("wall");
+            let tests = model.pair_tests();
+            model.run_steps(900).expect("run");
+            assert!(model.pair_tests() > tests, "the courses moved relative to each other");
+            let mut bits: Vec<u64> = Vec::new();
+            for b in model.blocks() {
+                let p = &b.state().pose;
+                bits.extend(p.translation.to_array().map(f64::to_bits));
+                bits.extend(p.rotation.to_array().map(f64::to_bits));
+            }
+            for c in model.contacts() {
+                bits.push(c.normal_force().to_bits());
+                bits.push(c.subcontacts().count() as u64);
+            }
+            bits.push(model.dt().to_bits());
+            bits
+        })
+    };
+    assert!(run(1) == run(4), "one thread and four differ");
+}
