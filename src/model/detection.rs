@@ -145,15 +145,6 @@ enum Direction {
     Back,
 }
 
-/// The model's contact lists, as detection rearranges them.
-struct ContactLists<'a, S> {
-    pairs: &'a mut Vec<ContactPair>,
-    references: &'a mut Vec<ContactReference>,
-    wrenches: &'a mut Vec<ContactWrench>,
-    subs: &'a mut Vec<SubContact<S>>,
-    records: &'a mut Vec<SubContactRecord>,
-}
-
 impl<S> ContactLists<'_, S> {
     /// Moves a run of old contacts to its new indices and their sub-contacts to start at
     /// `first`, each of the two if it moves in `direction`, by rotating the run with the dead
@@ -524,7 +515,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         };
         // In batches, so that the seeds of a full detection are not all held at once: the tests
         // of a batch in parallel, then its contacts staged in order.
-        NewContacts::of(sc).clear();
+        ContactLists::of(sc).clear();
         for start in (0..sc.plan.len()).step_by(BATCH) {
             let batch = start..(start + BATCH).min(sc.plan.len());
             sc.outcomes[batch.clone()]
@@ -579,7 +570,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let law = self.law_index(p.a, p.b)?;
             o.staged = sc.pairs.len() as u32;
-            let mut staged = NewContacts {
+            let mut staged = ContactLists {
                 pairs: &mut sc.pairs,
                 references: &mut sc.references,
                 wrenches: &mut sc.wrenches,
@@ -827,8 +818,9 @@ struct OldContacts<'a, S> {
     records: &'a [SubContactRecord],
 }
 
-/// The contact lists detection builds, swapped in for the model's at its end.
-struct NewContacts<'a, S> {
+/// Contact lists as detection writes them: the staging lists, or the model's as they are
+/// rearranged.
+struct ContactLists<'a, S> {
     pairs: &'a mut Vec<ContactPair>,
     references: &'a mut Vec<ContactReference>,
     wrenches: &'a mut Vec<ContactWrench>,
@@ -836,7 +828,7 @@ struct NewContacts<'a, S> {
     records: &'a mut Vec<SubContactRecord>,
 }
 
-impl<'a, S> NewContacts<'a, S> {
+impl<'a, S> ContactLists<'a, S> {
     /// The staging lists of `sc`.
     fn of(sc: &'a mut DetectionScratch<S>) -> Self {
         Self {
@@ -849,7 +841,7 @@ impl<'a, S> NewContacts<'a, S> {
     }
 }
 
-impl<S: Clone + Default> NewContacts<'_, S> {
+impl<S: Clone + Default> ContactLists<'_, S> {
     fn clear(&mut self) {
         self.pairs.clear();
         self.references.clear();
