@@ -139,9 +139,9 @@ enum Slot {
 /// Which runs of kept contacts [`ContactLists::move_run`] moves.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Direction {
-    /// Those that move towards the front (or stay), element by element from the first.
+    /// Those that move towards the front (or stay), run by run from the first.
     Front,
-    /// Those that move towards the back, element by element from the last.
+    /// Those that move towards the back, run by run from the last.
     Back,
 }
 
@@ -584,7 +584,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
 
     /// Brings the contact lists up to date with the narrow phase's outcomes, in place: the
     /// contacts of two blocks that did not move and those whose pair kept its verdict keep their
-    /// data, moved to their new positions (`docs/performance.md`, "Contact storage"); the
+    /// data, moved to their new positions (`docs/theory.md` §2.3, "Parallel, in place"); the
     /// re-tested ones are built in `sc`'s staging lists first, with the history of the old
     /// ones, then written to theirs. Nothing of the model changes before every law is found.
     /// Returns the work of the dropped sub-contacts ([`dropped_work`]) and sets `sc.reindex`
