@@ -124,12 +124,60 @@ impl BroadPhase {
     ///
     /// Returns how many leaves were (re)inserted (all of them on a fresh build).
     pub fn pairs_of_boxes(&mut self, boxes: &[Aabb], margin: Real, out: &mut Vec<(u32, u32)>) -> usize {
+        self.pairs_of_boxes_where(boxes, None, margin, out)
+    }
+
+    /// The pairs of [`BroadPhase::pairs_of_boxes`] with at least one block `i` for which
+    /// `moved[i]`, given that the boxes of the other blocks have not changed since the last
+    /// call (on the same tree): only the moved blocks' leaves are looked at, and the kept pairs
+    /// are filtered by the flags before their boxes are compared. The first call (or a change of
+    /// `margin` or of the number of boxes) builds the tree from every box.
+    ///
+    /// ```
+    /// use parry3d_f64::bounding_volume::Aabb;
+    /// use voussoir::geometry::BroadPhase;
+    /// use voussoir::math::Vector;
+    ///
+    /// let cube = |x: f64| Aabb::new(Vector::new(x, 0.0, 0.0), Vector::new(x + 1.0, 1.0, 1.0));
+    /// let mut boxes = vec![cube(0.0), cube(1.0), cube(2.0), cube(5.0)];
+    /// let mut bp = BroadPhase::default();
+    /// let mut pairs = Vec::new();
+    /// bp.pairs_of_boxes(&boxes, 1e-3, &mut pairs);
+    /// assert_eq!(pairs, [(0, 1), (1, 2)]);
+    /// // Block 3 moves next to block 2: only its pairs are asked for.
+    /// boxes[3] = cube(3.0);
+    /// bp.pairs_of_moved_boxes(&boxes, &[false, false, false, true], 1e-3, &mut pairs);
+    /// assert_eq!(pairs, [(2, 3)]);
+    /// ```
+    ///
+    /// # Panics
+    /// If `moved` is shorter than `boxes`.
+    pub fn pairs_of_moved_boxes(
+        &mut self,
+        boxes: &[Aabb],
+        moved: &[bool],
+        margin: Real,
+        out: &mut Vec<(u32, u32)>,
+    ) -> usize {
+        assert!(moved.len() >= boxes.len(), "a flag per box");
+        self.pairs_of_boxes_where(boxes, Some(moved), margin, out)
+    }
+
+    fn pairs_of_boxes_where(
+        &mut self,
+        boxes: &[Aabb],
+        moved: Option<&[bool]>,
+        margin: Real,
+        out: &mut Vec<(u32, u32)>,
+    ) -> usize {
         let n = boxes.len();
+        let touches = |i: u32, j: u32| moved.is_none_or(|m| m[i as usize] || m[j as usize]);
         if n < 2 || margin <= 0.0 {
             self.incremental = None;
             self.aabbs.clear();
             self.aabbs.extend_from_slice(boxes);
             self.bvh_pairs(out);
+            out.retain(|&(i, j)| touches(i, j));
             return n;
         }
         let fat = FAT_FACTOR * margin;
@@ -140,7 +188,7 @@ impl BroadPhase {
                     && inc.bvh.leaf_count() as usize == n
                     && inc.reinserted <= REBUILD_AFTER_REINSERTIONS * n =>
             {
-                let count = inc.update(boxes, fat, ws);
+                let count = inc.update(boxes, moved, fat, ws);
                 inc.reinserted += count;
                 count
             }
@@ -154,7 +202,7 @@ impl BroadPhase {
         out.extend(
             inc.fat_pairs
                 .iter()
-                .filter(|&&(i, j)| boxes[i as usize].intersects(&boxes[j as usize])),
+                .filter(|&&(i, j)| touches(i, j) && boxes[i as usize].intersects(&boxes[j as usize])),
         );
         reinserted
     }
@@ -250,10 +298,13 @@ impl Incremental {
     /// Re-inserts the leaves whose box left its fat leaf, refits, and brings `fat_pairs` up to
     /// date: pairs of two untouched leaves are kept, pairs with an updated leaf come from the
     /// changed-only traversal. Returns how many leaves were re-inserted.
-    fn update(&mut self, aabbs: &[Aabb], fat: Real, ws: &mut BvhWorkspace) -> usize {
+    ///
+    /// Only the leaves flagged in `moved` (when given) are looked at: the others' boxes have not
+    /// changed.
+    fn update(&mut self, aabbs: &[Aabb], moved: Option<&[bool]>, fat: Real, ws: &mut BvhWorkspace) -> usize {
         self.updated.clear();
         for (i, (a, leaf)) in aabbs.iter().zip(&mut self.fat_leaves).enumerate() {
-            if leaf.contains(a) {
+            if moved.is_some_and(|m| !m[i]) || leaf.contains(a) {
                 continue;
             }
             // The tight box goes in: parry stores it enlarged by `fat`, as `loosened` does.

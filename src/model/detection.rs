@@ -31,11 +31,19 @@ const STAGING_FRACTION: usize = 8;
 /// triggers, 0.875 of the tolerance at the defaults, as a block clipped afresh lags by up to 3.
 const KEEP_FRACTION: Real = 0.5;
 
-/// Planned pairs per batch of the narrow phase (`PLAN_CHUNK` per task).
-const BATCH: usize = 64 * PLAN_CHUNK;
+/// Planned pairs per batch of the narrow phase (`MAX_PLAN_CHUNK` per task).
+const BATCH: usize = 64 * MAX_PLAN_CHUNK;
 
-/// Planned pairs per task of the parallel narrow phase.
-const PLAN_CHUNK: usize = 256;
+/// Planned pairs per task of the parallel narrow phase, at most: a batch is split in 64 tasks,
+/// of at least `MIN_PLAN_CHUNK` pairs (the few pairs of a local re-detection still run in
+/// parallel). Each pair's outcome depends on that pair alone, so the split does not change it.
+const MAX_PLAN_CHUNK: usize = 256;
+const MIN_PLAN_CHUNK: usize = 4;
+
+/// The pairs per task of the narrow phase over `pairs` planned pairs.
+fn plan_chunk(pairs: usize) -> usize {
+    pairs.min(BATCH).div_ceil(64).clamp(MIN_PLAN_CHUNK, MAX_PLAN_CHUNK)
+}
 
 /// A block pair the narrow phase tested, with the relative pose it was tested at: its verdict
 /// holds until the pair has moved relatively past the trigger (a contact) or past `slack` (a
@@ -79,6 +87,18 @@ pub(crate) struct DetectionScratch<S> {
     layout: Vec<Slot>,
     firsts: Vec<u32>,
     runs: Vec<Run>,
+    sub_runs: Vec<SubRun>,
+    /// The in-place splice's re-tested contacts, and the kept ones it pushes back.
+    replaced: Vec<Replaced>,
+    pushed: Vec<Pushed>,
+    /// The room (sub-contacts, dead or alive) the in-place splice may use before a full splice
+    /// compacts the lists: set by the full splice.
+    room_limit: usize,
+    /// How the splices went (statistics).
+    pub splices: SpliceCounts,
+    /// Which splices may run (tests compare them).
+    #[cfg(test)]
+    pub splice_mode: SpliceMode,
     /// Whether contacts changed places (the block → contact index is rebuilt).
     reindex: bool,
     /// Merge buffer of [`update_tested`].
@@ -91,6 +111,17 @@ pub(crate) struct DetectionScratch<S> {
 }
 
 impl<S> DetectionScratch<S> {
+    /// Whether a test asks for a fresh layout at every full splice.
+    #[cfg(test)]
+    fn fresh_forced(&self) -> bool {
+        self.splice_mode == SpliceMode::Fresh
+    }
+
+    #[cfg(not(test))]
+    fn fresh_forced(&self) -> bool {
+        false
+    }
+
     /// Frees the staging lists (after they held a large share of the contacts).
     fn release_staging(&mut self) {
         self.pairs = Vec::new();
@@ -117,6 +148,13 @@ impl<S> Default for DetectionScratch<S> {
             layout: Vec::new(),
             firsts: Vec::new(),
             runs: Vec::new(),
+            sub_runs: Vec::new(),
+            replaced: Vec::new(),
+            pushed: Vec::new(),
+            room_limit: 0,
+            splices: SpliceCounts::default(),
+            #[cfg(test)]
+            splice_mode: SpliceMode::Any,
             reindex: false,
             tested: Vec::new(),
             pairs: Vec::new(),
@@ -129,11 +167,111 @@ impl<S> Default for DetectionScratch<S> {
 }
 
 /// A contact after detection: an old one kept (its index), or one detected afresh (its index
-/// in the staging lists).
+/// in the staging lists, and the old contact of the same pair it replaces or `u32::MAX`).
 #[derive(Debug, Clone, Copy)]
 enum Slot {
     Kept(u32),
-    Staged(u32),
+    Staged { staged: u32, replaces: u32 },
+}
+
+impl Slot {
+    /// Where the contact's sub-contacts were before the detection: those of the old contact
+    /// it keeps or replaces.
+    fn home(self, old: &[ContactPair]) -> Option<u32> {
+        match self {
+            Slot::Kept(c) => Some(old[c as usize].first),
+            Slot::Staged { replaces, .. } => old.get(replaces as usize).map(|p| p.first),
+        }
+    }
+
+    fn count(self, old: &[ContactPair], staged: &[ContactPair]) -> u32 {
+        match self {
+            Slot::Kept(c) => old[c as usize].count,
+            Slot::Staged { staged: s, .. } => staged[s as usize].count,
+        }
+    }
+}
+
+/// The room a re-tested contact is given beyond its sub-contacts when it outgrows the room it
+/// had (or a new one has none), so that it can grow again without moving its neighbours
+/// (`docs/theory.md` §2.3, "Parallel, in place").
+fn headroom(count: u32) -> u32 {
+    count / 8 + 2
+}
+
+/// The room the sub-contact lists may take with `live` sub-contacts.
+fn room_limit(live: usize) -> usize {
+    live + live / COMPACT_FRACTION as usize
+}
+
+/// The sub-contact list is compacted when the room between contacts exceeds this share of the
+/// sub-contacts (`1/COMPACT_FRACTION`).
+const COMPACT_FRACTION: u32 = 4;
+
+/// Contacts per segment of a fresh layout, after each of which [`segment_slack`] is left
+/// empty: a contact that outgrows its room pushes at most the rest of its segment.
+const SEGMENT: usize = 64;
+
+/// The dead room left after a segment of `subs` sub-contacts in a fresh layout: a sixteenth.
+fn segment_slack(subs: u32) -> u32 {
+    subs / 16 + 4
+}
+
+/// Where each contact of `layout` puts its sub-contacts (`firsts`, increasing with the contact):
+/// at its home ([`Slot::home`]) unless the contacts before it reach past it, a new contact right
+/// after the one before; a re-tested contact that reaches past the next contact's home gets
+/// [`headroom`]. A fresh layout (every contact right after the one before, with
+/// [`segment_slack`] after every [`SEGMENT`] contacts) when that would leave more than
+/// `1/COMPACT_FRACTION` of the room empty, or when `fresh`. Returns the end of the room used,
+/// the room the lists may take before they are laid out afresh again, and whether they were.
+fn place_subcontacts(
+    layout: &[Slot],
+    old: &[ContactPair],
+    staged: &[ContactPair],
+    old_end: u32,
+    fresh: bool,
+    firsts: &mut Vec<u32>,
+) -> (u32, usize, bool) {
+    let live: u32 = layout.iter().map(|s| s.count(old, staged)).sum();
+    firsts.clear();
+    firsts.resize(layout.len(), 0);
+    for packed in [false, true] {
+        if fresh && !packed {
+            continue;
+        }
+        // The next contact's home, from the back: how far a contact may reach in place.
+        let mut next = old_end;
+        for (k, slot) in layout.iter().enumerate().rev() {
+            firsts[k] = next;
+            if let Some(home) = slot.home(old) {
+                next = home;
+            }
+        }
+        let (mut cursor, mut segment) = (0, 0);
+        for (k, slot) in layout.iter().enumerate() {
+            let limit = firsts[k];
+            let first = match slot.home(old) {
+                Some(home) if !packed => home.max(cursor),
+                _ => cursor,
+            };
+            let count = slot.count(old, staged);
+            cursor = first + count;
+            if packed {
+                segment += count;
+                if (k + 1) % SEGMENT == 0 {
+                    cursor += segment_slack(segment);
+                    segment = 0;
+                }
+            } else if matches!(slot, Slot::Staged { .. }) && cursor > limit {
+                cursor += headroom(count);
+            }
+            firsts[k] = first;
+        }
+        if packed || cursor - live <= live / COMPACT_FRACTION {
+            return (cursor, room_limit(live as usize), packed);
+        }
+    }
+    unreachable!("the packed layout is returned")
 }
 
 /// Which runs of kept contacts [`ContactLists::move_run`] moves.
@@ -146,19 +284,10 @@ enum Direction {
 }
 
 impl<S> ContactLists<'_, S> {
-    /// Moves a run of old contacts to its new indices and their sub-contacts to start at
-    /// `first`, each of the two if it moves in `direction`, by rotating the run with the dead
-    /// room it moves into. The `Back` pass comes second, and sets the contacts' `first`.
-    fn move_run(&mut self, run: &Run, first: u32, direction: Direction) {
+    /// Moves a run of old contacts to their new indices, if they move in `direction`, by
+    /// rotating the run with the dead room it moves into (their sub-contacts stay).
+    fn move_contacts(&mut self, run: &Run, direction: Direction) {
         let (c, k, len) = (run.old as usize, run.new as usize, run.len as usize);
-        // Where the run is now: at `k` once the `Front` pass moved it there.
-        let at = if direction == Direction::Back && k <= c { k } else { c };
-        let start = self.pairs[at].first as usize;
-        let end = {
-            let last = &self.pairs[at + len - 1];
-            (last.first + last.count) as usize
-        };
-        let to = first as usize;
         match direction {
             Direction::Front if k < c => {
                 self.pairs[k..c + len].rotate_left(c - k);
@@ -172,26 +301,69 @@ impl<S> ContactLists<'_, S> {
             }
             _ => {}
         }
+    }
+
+    /// Moves the sub-contacts `range` by `shift`, if they move in `direction`, by rotating them
+    /// with the dead room they move into.
+    fn move_subcontacts(&mut self, range: std::ops::Range<usize>, shift: i64, direction: Direction) {
+        let by = shift.unsigned_abs() as usize;
         match direction {
-            Direction::Front if to < start => {
-                self.subs[to..end].rotate_left(start - to);
-                self.records[to..end].rotate_left(start - to);
+            Direction::Front if shift < 0 => {
+                self.subs[range.start - by..range.end].rotate_left(by);
+                self.records[range.start - by..range.end].rotate_left(by);
             }
-            Direction::Back if to > start => {
-                let new_end = to + (end - start);
-                self.subs[start..new_end].rotate_right(to - start);
-                self.records[start..new_end].rotate_right(to - start);
+            Direction::Back if shift > 0 => {
+                self.subs[range.start..range.end + by].rotate_right(by);
+                self.records[range.start..range.end + by].rotate_right(by);
             }
             _ => {}
         }
-        if direction == Direction::Back {
-            let mut next = first;
-            for pair in &mut self.pairs[k..k + len] {
-                pair.first = next;
-                next += pair.count;
-            }
-        }
     }
+}
+
+/// Sub-contacts `start..end` of consecutive kept contacts (and the dead room between them) that
+/// move by `shift`.
+#[derive(Debug, Clone, Copy)]
+struct SubRun {
+    start: u32,
+    end: u32,
+    shift: i64,
+}
+
+/// How many detections spliced the contacts in place (and how many of those pushed contacts
+/// back), through the full splice, and of those how many laid the lists out afresh.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct SpliceCounts {
+    pub in_place: u64,
+    pub pushed: u64,
+    pub full: u64,
+    pub fresh: u64,
+}
+
+/// Which splices a detection may use: any, the full one only, or the full one with a fresh
+/// layout every time. The results are the same bits (`tests`).
+#[cfg(test)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum SpliceMode {
+    Any,
+    Full,
+    Fresh,
+}
+
+/// A re-tested contact that replaces old contact `contact` (same index) with staged contact
+/// `staged`, its sub-contacts from `first`.
+#[derive(Debug, Clone, Copy)]
+struct Replaced {
+    contact: u32,
+    staged: u32,
+    first: u32,
+}
+
+/// Neighbouring kept contacts whose sub-contacts the in-place splice pushes back by `shift`.
+#[derive(Debug, Clone)]
+struct Pushed {
+    contacts: std::ops::Range<u32>,
+    shift: u32,
 }
 
 /// Consecutive old contacts `old..old + len` that go to `new..new + len`.
@@ -334,7 +506,9 @@ impl PairTest<'_> {
 }
 
 /// The candidate pairs with a block that moved, not between two fixed blocks, each with its
-/// entries in the sorted `tested` and `pairs` of the last detection (a merge of sorted lists).
+/// entries in the sorted `tested` and `pairs` of the last detection (a merge of sorted lists
+/// that gallops over the entries between two candidates: the candidates of a local
+/// re-detection are few).
 fn plan(
     candidates: &[(u32, u32)],
     blocks: &[RigidBlock],
@@ -352,12 +526,8 @@ fn plan(
         if blocks[a as usize].fixity().is_fixed() && blocks[b as usize].fixity().is_fixed() {
             continue;
         }
-        while t < tested.len() && (tested[t].a, tested[t].b) < (a, b) {
-            t += 1;
-        }
-        while c < pairs.len() && (pairs[c].a, pairs[c].b) < (a, b) {
-            c += 1;
-        }
+        t = gallop(tested, t, |e| (e.a, e.b) < (a, b));
+        c = gallop(pairs, c, |p| (p.a, p.b) < (a, b));
         let found_t = t < tested.len() && (tested[t].a, tested[t].b) == (a, b);
         let found_c = c < pairs.len() && (pairs[c].a, pairs[c].b) == (a, b);
         out.push(Planned {
@@ -369,19 +539,36 @@ fn plan(
     }
 }
 
-/// Brings `tested` up to date with the detection's outcomes: in place when the planned pairs
-/// are those with a moved block tested before, else merged afresh through `buffer` (the pairs of
-/// two blocks that did not move keep their entries; those with a moved block that are no longer
-/// candidates lose them).
+/// The first index from `start` on at which `before` is false (`before` true on a prefix of
+/// `list[start..]`): doubling steps, then a binary search, O(log distance).
+fn gallop<T>(list: &[T], start: usize, before: impl Fn(&T) -> bool) -> usize {
+    let mut step = 1;
+    let mut low = start;
+    while low + step <= list.len() && before(&list[low + step - 1]) {
+        low += step;
+        step *= 2;
+    }
+    let high = (low + step).min(list.len());
+    low + list[low..high].partition_point(before)
+}
+
+/// Brings `tested` up to date with the detection's outcomes: in place when every planned pair
+/// was tested before and the contacts were spliced in place, else merged afresh through
+/// `buffer` (the pairs of two blocks that did not move keep their entries; those with a moved
+/// block that are no longer candidates lose them).
 fn update_tested(
     tested: &mut Vec<TestedPair>,
     plan: &[Planned],
     outcomes: &[Outcome],
     moved: &[bool],
+    in_place: bool,
     buffer: &mut Vec<TestedPair>,
 ) {
     let moved_pair = |t: &TestedPair| moved[t.a as usize] || moved[t.b as usize];
-    if plan.iter().all(|p| p.tested != u32::MAX) && tested.iter().filter(|t| moved_pair(t)).count() == plan.len() {
+    // After an in-place splice no contact was lost, so the entries of pairs with a moved block
+    // that are no longer candidates are those of pairs found apart: their verdicts still hold
+    // (they depend on the relative pose alone), and they may stay until the next merge.
+    if in_place && plan.iter().all(|p| p.tested != u32::MAX) {
         for (p, o) in plan.iter().zip(outcomes) {
             if o.tested {
                 tested[p.tested as usize] = o.entry;
@@ -491,7 +678,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 sc.boxes[i] = reference_box(b, &b.state.pose, reach);
             }
         }
-        sc.broad.pairs_of_boxes(&sc.boxes, params.tolerance, &mut sc.candidates);
+        sc.broad
+            .pairs_of_moved_boxes(&sc.boxes, &sc.moved, params.tolerance, &mut sc.candidates);
         plan(
             &sc.candidates,
             &self.blocks,
@@ -502,7 +690,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         );
         sc.outcomes.clear();
         sc.outcomes.resize(sc.plan.len(), Outcome::default());
-        let chunks = sc.plan.len().min(BATCH).div_ceil(PLAN_CHUNK);
+        let chunk = plan_chunk(sc.plan.len());
+        let chunks = sc.plan.len().min(BATCH).div_ceil(chunk);
         if sc.chunks.len() < chunks {
             sc.chunks.resize_with(chunks, ChunkScratch::default);
         }
@@ -519,16 +708,34 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         for start in (0..sc.plan.len()).step_by(BATCH) {
             let batch = start..(start + BATCH).min(sc.plan.len());
             sc.outcomes[batch.clone()]
-                .par_chunks_mut(PLAN_CHUNK)
-                .zip(sc.plan[batch.clone()].par_chunks(PLAN_CHUNK))
+                .par_chunks_mut(chunk)
+                .zip(sc.plan[batch.clone()].par_chunks(chunk))
                 .zip(sc.chunks.par_iter_mut())
                 .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
             self.stage(sc, batch)?;
         }
-        let (work, dashpot) = self.splice_contacts(sc)?;
+        let index = BlockIndex {
+            offsets: &pipeline.block_offsets,
+            contacts: &pipeline.block_contacts,
+        };
+        #[cfg(test)]
+        let index = Some(index).filter(|_| sc.splice_mode == SpliceMode::Any);
+        #[cfg(not(test))]
+        let index = Some(index);
+        let (in_place, (work, dashpot)) = match index.and_then(|index| self.splice_in_place(sc, index)) {
+            Some(owed) => (true, owed),
+            None => (false, self.splice_contacts(sc)?),
+        };
         self.energy.joint_work += work;
         self.energy.damping += dashpot;
-        update_tested(&mut self.tested, &sc.plan, &sc.outcomes, &sc.moved, &mut sc.tested);
+        update_tested(
+            &mut self.tested,
+            &sc.plan,
+            &sc.outcomes,
+            &sc.moved,
+            in_place,
+            &mut sc.tested,
+        );
         sc.tests += sc.outcomes.iter().filter(|o| o.tested).count() as u64;
         self.detections += 1;
         if sc.reindex {
@@ -542,9 +749,21 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if full || self.critical.is_none() {
             self.changes.insert(Changes::DETECTION);
             self.refresh_time_step(pipeline)?;
-        } else if self.contacts_grew() {
-            self.changes.insert(Changes::DETECTION);
-            self.refresh_time_step_of_grown(pipeline)?;
+        } else {
+            let mut blocks = std::mem::take(&mut pipeline.refresh_blocks);
+            blocks.clear();
+            if in_place {
+                let replaced = &pipeline.detection.replaced;
+                self.take_grown(replaced.iter().map(|r| r.contact as usize), &mut blocks);
+            } else {
+                self.take_grown(0..self.pairs.len(), &mut blocks);
+            }
+            let grew = !blocks.is_empty();
+            pipeline.refresh_blocks = blocks;
+            if grew {
+                self.changes.insert(Changes::DETECTION);
+                self.refresh_time_step_of_grown(pipeline)?;
+            }
         }
         self.changes.clear();
         Ok(())
@@ -566,7 +785,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             if o.seed_count == 0 {
                 continue;
             }
-            let seeds = sc.chunks[(k - first) / PLAN_CHUNK].seeds(o);
+            let seeds = sc.chunks[(k - first) / plan_chunk(sc.plan.len())].seeds(o);
             let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let law = self.law_index(p.a, p.b)?;
             o.staged = sc.pairs.len() as u32;
@@ -580,6 +799,163 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             staged.add_detected(&old, p.old_contact(), (p.a, bi), (p.b, bj), &dc, law, seeds);
         }
         Ok(())
+    }
+
+    /// The usual splice, whose cost follows the re-tested contacts alone: when no contact
+    /// appeared or was lost, the re-tested contacts are written over the old ones, each in the
+    /// room of the one it replaces (its sub-contacts and the dead room after them). One that
+    /// outgrows its room takes [`headroom`] besides and pushes the contacts after it towards the
+    /// back, as far as the dead room between them absorbs the push (`docs/theory.md` §2.3).
+    /// Returns the work of the dropped sub-contacts, as [`ModelState::splice_contacts`] would,
+    /// or `None`, with nothing changed, when it does not apply: a contact appeared or was lost,
+    /// or the room would pass the limit the last compaction set.
+    fn splice_in_place(&mut self, sc: &mut DetectionScratch<L::State>, index: BlockIndex<'_>) -> Option<(Real, Real)> {
+        let n = self.blocks.len();
+        if index.offsets.len() != n + 1 || index.offsets[n] as usize != 2 * self.pairs.len() {
+            return None;
+        }
+        sc.replaced.clear();
+        let mut planned_contacts = 0;
+        for (p, o) in sc.plan.iter().zip(&sc.outcomes) {
+            match (p.old_contact(), o.staged != u32::MAX) {
+                (None, false) => {}
+                (None, true) => return None, // a new contact
+                (Some(_), _) if !o.tested => planned_contacts += 1,
+                (Some(_), false) => return None, // a contact lost
+                (Some(k), true) => {
+                    planned_contacts += 1;
+                    sc.replaced.push(Replaced {
+                        contact: k as u32,
+                        staged: o.staged,
+                        first: self.pairs[k].first,
+                    });
+                }
+            }
+        }
+        // Every old contact with a moved block was planned: none lost its candidate pair.
+        let moved = &sc.moved;
+        let mut moved_contacts = 0;
+        for i in (0..n).filter(|&i| moved[i]) {
+            for &e in &index.contacts[index.offsets[i] as usize..index.offsets[i + 1] as usize] {
+                // Counted once: at `a`, or at `b` when `a` did not move.
+                if e % 2 == 0 || !moved[self.pairs[(e / 2) as usize].a as usize] {
+                    moved_contacts += 1;
+                }
+            }
+        }
+        if moved_contacts != planned_contacts {
+            return None;
+        }
+        // Where the re-tested contacts go, and the kept ones they push.
+        sc.pushed.clear();
+        let contacts = self.pairs.len();
+        let room = self.subs.len() as u32;
+        let mut needed = room;
+        let mut window_end = 0;
+        let count = |staged: u32| sc.pairs[staged as usize].count;
+        for r in 0..sc.replaced.len() {
+            let Replaced { contact: k, staged, .. } = sc.replaced[r];
+            let k = k as usize;
+            if k < window_end {
+                continue; // placed by the push of a contact before it
+            }
+            let end = self.pairs.get(k + 1).map_or(room, |q| q.first);
+            let (first, m) = (self.pairs[k].first, count(staged));
+            if first + m <= end {
+                continue;
+            }
+            // It outgrew its room: the contacts after it go right after the one before them
+            // until one's home is far enough back.
+            let mut cursor = first + m + headroom(m);
+            let (mut j, mut next) = (k + 1, r + 1);
+            while j < contacts && cursor > self.pairs[j].first {
+                match sc.replaced.get(next).copied() {
+                    Some(q) if q.contact as usize == j => {
+                        sc.replaced[next].first = cursor;
+                        cursor += count(q.staged);
+                        next += 1;
+                    }
+                    _ => {
+                        // Neighbours pushed by as much move as one run.
+                        let (p, shift) = (&self.pairs[j], cursor - self.pairs[j].first);
+                        match sc.pushed.last_mut() {
+                            Some(run) if run.contacts.end as usize == j && run.shift == shift => run.contacts.end += 1,
+                            _ => sc.pushed.push(Pushed {
+                                contacts: j as u32..j as u32 + 1,
+                                shift,
+                            }),
+                        }
+                        cursor += p.count;
+                    }
+                }
+                j += 1;
+            }
+            needed = needed.max(cursor);
+            window_end = j;
+        }
+        if needed as usize > sc.room_limit {
+            return None;
+        }
+        // The work of the dropped sub-contacts, in contact order as `dropped_work` sums it,
+        // before anything moves.
+        let old = OldContacts {
+            pairs: &self.pairs,
+            references: &self.references,
+            subs: &self.subs,
+            records: &self.sub_records,
+        };
+        let dt = if self.drift > 0.0 { self.drift } else { self.dt };
+        let mut owed = (0.0, 0.0);
+        for r in &sc.replaced {
+            let successor = (&sc.pairs[r.staged as usize], sc.records.as_slice());
+            add_dropped_work(
+                &old,
+                r.contact as usize,
+                Some(successor),
+                &self.blocks,
+                self.params.mode,
+                dt,
+                &mut owed,
+            );
+        }
+        if needed > room {
+            // Dead room (sub-contacts not in any contact's range are never read).
+            self.subs.resize(needed as usize, sc.subs[0].clone());
+            self.sub_records.resize(needed as usize, sc.records[0].clone());
+        }
+        // Pushed contacts move from the last: each moves into room that is dead by then (the
+        // old room of the ones after it, which moved further back, or of re-tested ones).
+        for run in sc.pushed.iter().rev() {
+            let contacts = &mut self.pairs[run.contacts.start as usize..run.contacts.end as usize];
+            let last = &contacts[contacts.len() - 1];
+            let (start, end) = (
+                contacts[0].first as usize,
+                (last.first + last.count + run.shift) as usize,
+            );
+            self.subs[start..end].rotate_right(run.shift as usize);
+            self.sub_records[start..end].rotate_right(run.shift as usize);
+            for p in contacts {
+                p.first += run.shift;
+            }
+        }
+        for r in &sc.replaced {
+            let (k, s) = (r.contact as usize, r.staged as usize);
+            let q = &sc.pairs[s];
+            let to = r.first as usize..(r.first + q.count) as usize;
+            self.subs[to.clone()].clone_from_slice(&sc.subs[q.range()]);
+            self.sub_records[to].clone_from_slice(&sc.records[q.range()]);
+            self.pairs[k] = q.clone();
+            self.pairs[k].first = r.first;
+            self.references[k] = sc.references[s].clone();
+            self.wrenches[k] = sc.wrenches[s];
+        }
+        sc.reindex = false;
+        sc.splices.in_place += 1;
+        sc.splices.pushed += u64::from(!sc.pushed.is_empty() || needed > room);
+        if STAGING_FRACTION * sc.subs.capacity() > self.subs.len().max(1) {
+            sc.release_staging();
+        }
+        Some(owed)
     }
 
     /// Brings the contact lists up to date with the narrow phase's outcomes, in place: the
@@ -617,7 +993,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     sc.kept[c] = true;
                 }
             } else if o.staged != u32::MAX {
-                sc.layout.push(Slot::Staged(o.staged));
+                sc.layout.push(Slot::Staged {
+                    staged: o.staged,
+                    replaces: p.contact,
+                });
             }
         }
         for c in c..old.pairs.len() {
@@ -634,26 +1013,15 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.params.mode,
             if self.drift > 0.0 { self.drift } else { self.dt },
         );
-        // Where each contact goes: its index in `layout`, its sub-contacts from `first`.
-        sc.firsts.clear();
-        let mut total = 0u32;
-        for slot in &sc.layout {
-            sc.firsts.push(total);
-            total += match *slot {
-                Slot::Kept(c) => self.pairs[c as usize].count,
-                Slot::Staged(s) => sc.pairs[s as usize].count,
-            };
-        }
         sc.reindex = sc.layout.len() != self.pairs.len()
             || sc.layout.iter().enumerate().any(|(k, slot)| match *slot {
                 Slot::Kept(c) => c as usize != k,
-                Slot::Staged(s) => {
-                    let q = &sc.pairs[s as usize];
+                Slot::Staged { staged, .. } => {
+                    let q = &sc.pairs[staged as usize];
                     self.pairs.get(k).is_none_or(|p| (p.a, p.b) != (q.a, q.b))
                 }
             });
-        let (contacts, subs) = (sc.layout.len(), total as usize);
-        if sc.layout.iter().all(|slot| matches!(slot, Slot::Staged(_))) {
+        if sc.layout.iter().all(|slot| matches!(slot, Slot::Staged { .. })) {
             // Every contact detected afresh (the first detection, a full one): the staging lists
             // are the new lists, and the old ones are released rather than kept as staging.
             std::mem::swap(&mut self.pairs, &mut sc.pairs);
@@ -662,8 +1030,26 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             std::mem::swap(&mut self.subs, &mut sc.subs);
             std::mem::swap(&mut self.sub_records, &mut sc.records);
             sc.release_staging();
+            sc.room_limit = room_limit(self.subs.len());
+            sc.splices.full += 1;
+            sc.splices.fresh += 1;
+            self.spread_segments();
             return Ok(owed);
         }
+        // Where each contact goes: its index in `layout`, its sub-contacts from `firsts`, with
+        // room between contacts (`place_subcontacts`).
+        let (end, limit, fresh) = place_subcontacts(
+            &sc.layout,
+            &self.pairs,
+            &sc.pairs,
+            self.subs.len() as u32,
+            sc.room_limit == 0 || sc.fresh_forced(),
+            &mut sc.firsts,
+        );
+        sc.room_limit = limit;
+        sc.splices.full += 1;
+        sc.splices.fresh += u64::from(fresh);
+        let (contacts, room) = (sc.layout.len(), end as usize);
         if contacts > self.pairs.len() {
             // Room for the new contacts (the fillers are overwritten below).
             let filler = (sc.pairs[0].clone(), sc.references[0].clone());
@@ -671,23 +1057,30 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.references.resize(contacts, filler.1);
             self.wrenches.resize(contacts, ContactWrench::default());
         }
-        if subs > self.subs.len() {
-            self.subs.resize(subs, sc.subs[0].clone());
-            self.sub_records.resize(subs, sc.records[0].clone());
+        if room > self.subs.len() {
+            // Dead room (sub-contacts not in any contact's range are never read).
+            self.subs.resize(room, sc.subs[0].clone());
+            self.sub_records.resize(room, sc.records[0].clone());
         }
-        // Kept contacts move towards the front left to right, then towards the back right to
-        // left: neither overwrites data still to be moved (`docs/performance.md`).
-        let mut lists = ContactLists {
-            pairs: &mut self.pairs,
-            references: &mut self.references,
-            wrenches: &mut self.wrenches,
-            subs: &mut self.subs,
-            records: &mut self.sub_records,
-        };
-        // Runs of kept contacts that were neighbours and stay neighbours move as one.
+        // The kept contacts' sub-contacts move first, in runs of equal shift (while the contacts
+        // still hold their old ranges), then the contacts, in runs that were neighbours and stay
+        // neighbours. Each moves towards the front left to right, then towards the back right
+        // to left: neither overwrites data still to be moved (`docs/theory.md` §2.3).
+        sc.sub_runs.clear();
         sc.runs.clear();
+        let mut last_shift = 0;
         for (k, slot) in sc.layout.iter().enumerate() {
             let Slot::Kept(c) = *slot else { continue };
+            let p = &self.pairs[c as usize];
+            let (start, end) = (p.first, p.first + p.count);
+            let shift = i64::from(sc.firsts[k]) - i64::from(start);
+            // A run takes in the dead room between its contacts (that of re-tested ones).
+            match sc.sub_runs.last_mut() {
+                _ if shift == 0 => {}
+                Some(run) if last_shift == shift => run.end = end,
+                _ => sc.sub_runs.push(SubRun { start, end, shift }),
+            }
+            last_shift = shift;
             match sc.runs.last_mut() {
                 Some(run) if run.old + run.len == c && run.new + run.len == k as u32 => run.len += 1,
                 _ => sc.runs.push(Run {
@@ -697,33 +1090,78 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 }),
             }
         }
+        let mut lists = ContactLists {
+            pairs: &mut self.pairs,
+            references: &mut self.references,
+            wrenches: &mut self.wrenches,
+            subs: &mut self.subs,
+            records: &mut self.sub_records,
+        };
+        for run in &sc.sub_runs {
+            lists.move_subcontacts(run.start as usize..run.end as usize, run.shift, Direction::Front);
+        }
+        for run in sc.sub_runs.iter().rev() {
+            lists.move_subcontacts(run.start as usize..run.end as usize, run.shift, Direction::Back);
+        }
         for run in &sc.runs {
-            lists.move_run(run, sc.firsts[run.new as usize], Direction::Front);
+            lists.move_contacts(run, Direction::Front);
         }
         for run in sc.runs.iter().rev() {
-            lists.move_run(run, sc.firsts[run.new as usize], Direction::Back);
+            lists.move_contacts(run, Direction::Back);
         }
         for (k, slot) in sc.layout.iter().enumerate() {
-            if let Slot::Staged(s) = *slot {
-                let q = &sc.pairs[s as usize];
-                let (from, to) = (q.range(), sc.firsts[k] as usize..(sc.firsts[k] + q.count) as usize);
-                lists.subs[to.clone()].clone_from_slice(&sc.subs[from.clone()]);
-                lists.records[to].clone_from_slice(&sc.records[from]);
-                lists.pairs[k] = q.clone();
-                lists.pairs[k].first = sc.firsts[k];
-                lists.references[k] = sc.references[s as usize].clone();
-                lists.wrenches[k] = sc.wrenches[s as usize];
+            let first = sc.firsts[k];
+            match *slot {
+                Slot::Kept(_) => lists.pairs[k].first = first,
+                Slot::Staged { staged: s, .. } => {
+                    let q = &sc.pairs[s as usize];
+                    let (from, to) = (q.range(), first as usize..(first + q.count) as usize);
+                    lists.subs[to.clone()].clone_from_slice(&sc.subs[from.clone()]);
+                    lists.records[to].clone_from_slice(&sc.records[from]);
+                    lists.pairs[k] = q.clone();
+                    lists.pairs[k].first = first;
+                    lists.references[k] = sc.references[s as usize].clone();
+                    lists.wrenches[k] = sc.wrenches[s as usize];
+                }
             }
         }
         self.pairs.truncate(contacts);
         self.references.truncate(contacts);
         self.wrenches.truncate(contacts);
-        self.subs.truncate(subs);
-        self.sub_records.truncate(subs);
+        self.subs.truncate(room);
+        self.sub_records.truncate(room);
         if STAGING_FRACTION * sc.subs.capacity() > self.subs.len().max(1) {
             sc.release_staging();
         }
         Ok(owed)
+    }
+
+    /// Leaves [`segment_slack`] after every [`SEGMENT`] contacts of packed lists (as a full
+    /// detection stages them): the fresh layout of [`place_subcontacts`].
+    fn spread_segments(&mut self) {
+        let segments = self.pairs.len().div_ceil(SEGMENT);
+        let (Some(sub), Some(record)) = (self.subs.first().cloned(), self.sub_records.first().cloned()) else {
+            return;
+        };
+        let contacts = self.pairs.len();
+        let segment = |k: usize| k * SEGMENT..((k + 1) * SEGMENT).min(contacts);
+        let slack = |pairs: &[ContactPair], k: usize| segment_slack(pairs[segment(k)].iter().map(|p| p.count).sum());
+        // Segment `k` moves back by the slack of the segments before it, the last one first,
+        // into room that is dead by then.
+        let mut shift: u32 = (0..segments.saturating_sub(1)).map(|k| slack(&self.pairs, k)).sum();
+        self.subs.resize(self.subs.len() + shift as usize, sub);
+        self.sub_records.resize(self.sub_records.len() + shift as usize, record);
+        for k in (1..segments).rev() {
+            let contacts = &mut self.pairs[segment(k)];
+            let last = &contacts[contacts.len() - 1];
+            let (start, end) = (contacts[0].first as usize, (last.first + last.count) as usize);
+            self.subs[start..end + shift as usize].rotate_right(shift as usize);
+            self.sub_records[start..end + shift as usize].rotate_right(shift as usize);
+            for p in contacts.iter_mut() {
+                p.first += shift;
+            }
+            shift -= slack(&self.pairs, k - 1);
+        }
     }
 
     /// The index of the joint law between blocks `i` and `j`.
@@ -808,6 +1246,13 @@ fn moved_beyond(b: &crate::block::RigidBlock, r: &crate::math::Pose, trigger: Re
         return false;
     }
     translation + radius * 2.0 * s.asin() > trigger
+}
+
+/// The block → contact index of the pipeline (`Pipeline::block_contacts`).
+#[derive(Clone, Copy)]
+struct BlockIndex<'a> {
+    offsets: &'a [u32],
+    contacts: &'a [u32],
 }
 
 /// The contact lists before a re-detection, for [`dropped_work`].
@@ -1001,5 +1446,209 @@ fn add_dropped_work<S>(
         let du = v_rel * dt;
         owed.0 -= 0.5 * spring.dot(du);
         owed.1 -= 0.5 * r.dashpot.dot(du);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::block::BlockState;
+    use crate::law::CoulombSlip;
+    use crate::model::{Energies, Model};
+    use crate::scenes::{shaking_wall, BENCHMARK_SPACING};
+
+    /// The sub-contact ranges increase with the contacts, do not overlap, and lie in the lists,
+    /// which stay within the room the last fresh layout allowed.
+    fn check_layout<L: ConstitutiveLaw>(state: &ModelState<L>, room_limit: usize) {
+        let mut end = 0;
+        for (k, p) in state.pairs.iter().enumerate() {
+            assert!(p.first >= end, "contact {k} starts at {} before {end}", p.first);
+            end = p.first + p.count;
+        }
+        assert!(end as usize <= state.subs.len(), "sub-contacts past the lists");
+        assert_eq!(state.subs.len(), state.sub_records.len());
+        assert!(
+            state.subs.len() <= room_limit,
+            "{} sub-contacts' room past {room_limit}",
+            state.subs.len()
+        );
+    }
+
+    /// Eight bricks (0.2 × 0.1 × 0.05 m, 30 mm apart) sliding at 2 m/s, undamped, on 5° friction,
+    /// over a row of twelve fixed ones: their contacts with the row grow, shrink, appear
+    /// and vanish as they pass, while two bricks resting aside keep theirs.
+    fn conveyor() -> Model<CoulombSlip> {
+        use crate::block::Fixity;
+        use crate::ids::MaterialId;
+        use crate::integrate::Damping;
+        let mut model = Model::new(crate::model::ModelParameters::default()).expect("model");
+        model
+            .set_joint_law(
+                MaterialId(0),
+                MaterialId(0),
+                CoulombSlip::dry(1e9, 4e8, 5.0).expect("law"),
+            )
+            .expect("law");
+        model.set_damping(Damping::None).expect("undamped");
+        let brick = |x: Real, z: Real| {
+            RigidBlock::cuboid(
+                "brick",
+                Vector::new(x, 0.0, z),
+                Vector::new(x + 0.2, 0.1, z + 0.05),
+                2000.0,
+            )
+            .expect("brick")
+        };
+        // Bricks resting on fixed ones aside, first and last: contacts kept through every
+        // detection, before and after the others.
+        let aside = |model: &mut Model<CoulombSlip>, y: Real| {
+            let aside = |b: RigidBlock| b.transformed(Pose::from_translation(Vector::new(0.0, y, 0.0)));
+            model
+                .add_block(aside(brick(0.0, -0.05)).with_fixity(Fixity::FIXED))
+                .expect("aside");
+            model.add_block(aside(brick(0.0, 0.0))).expect("aside");
+        };
+        aside(&mut model, 0.5);
+        for k in 0..12 {
+            model
+                .add_block(brick(0.2 * k as Real, -0.05).with_fixity(Fixity::FIXED))
+                .expect("row");
+        }
+        for k in 0..8 {
+            let moving = brick(0.1 + 0.23 * k as Real, 0.0).with_velocity(Vector::new(2.0, 0.0, 0.0), Vector::ZERO);
+            model.add_block(moving).expect("brick");
+        }
+        aside(&mut model, -0.5);
+        model
+    }
+
+    /// Every contact with its sub-contacts and their records (its `first` left out).
+    type Contacts<S> = Vec<(ContactPair, Vec<SubContact<S>>, Vec<SubContactRecord>)>;
+
+    /// `model` run for `steps` steps with the splices `mode` allows: the blocks' states, the
+    /// energies, the splice counts and the contacts at the end.
+    fn run<L: ConstitutiveLaw>(
+        mut model: Model<L>,
+        mode: SpliceMode,
+        steps: usize,
+    ) -> (Vec<BlockState>, Energies, SpliceCounts, Contacts<L::State>) {
+        model.pipeline.detection.splice_mode = mode;
+        for _ in 0..steps {
+            model.step().expect("step");
+            check_layout(&model.state, model.pipeline.detection.room_limit);
+        }
+        let states = model.blocks().iter().map(|b| *b.state()).collect();
+        let s = &model.state;
+        let contacts = s
+            .pairs
+            .iter()
+            .map(|p| {
+                let pair = ContactPair { first: 0, ..p.clone() };
+                (pair, s.subs[p.range()].to_vec(), s.sub_records[p.range()].to_vec())
+            })
+            .collect();
+        (states, model.energies(), model.pipeline.detection.splices, contacts)
+    }
+
+    /// The in-place splice (re-tested contacts written over the old ones, pushing their
+    /// neighbours back when they outgrow their room), the full splice into the gapped layout,
+    /// and the full splice into a fresh layout every time give the same bits, through bricks
+    /// sliding over a row (contacts growing, shrinking, appearing and vanishing) and a shaking
+    /// wall's rocking: the sub-contact layout never shows in the results. Each path is taken.
+    #[test]
+    fn in_place_full_and_fresh_splices_give_the_same_bits() {
+        type Scene = fn() -> Model<CoulombSlip>;
+        let scenes: [(&str, Scene, usize); 2] = [
+            ("conveyor", conveyor, 4000),
+            (
+                "shaking wall",
+                || shaking_wall(300, BENCHMARK_SPACING).expect("wall"),
+                1500,
+            ),
+        ];
+        let mut counts = Vec::new();
+        for (name, scene, steps) in scenes {
+            let any = run(scene(), SpliceMode::Any, steps);
+            let full = run(scene(), SpliceMode::Full, steps);
+            let fresh = run(scene(), SpliceMode::Fresh, steps);
+            for other in [&full, &fresh] {
+                assert!(any.0 == other.0, "{name}: block states differ");
+                assert_eq!(any.1, other.1, "{name}: energies differ");
+                assert!(any.3 == other.3, "{name}: contacts differ");
+            }
+            let (f, r) = (full.2, fresh.2);
+            assert_eq!(f.in_place, 0, "{name}");
+            assert!(
+                r.fresh == r.full && r.full > 100,
+                "{name}: fresh layouts not exercised: {r:?}"
+            );
+            counts.push((any.2, f));
+        }
+        let ((conveyor, conveyor_full), (wall, _)) = (counts[0], counts[1]);
+        assert!(
+            conveyor.in_place > 100 && conveyor.pushed > 10 && conveyor.full > 5,
+            "in-place splices with pushes, and full ones, not exercised: {conveyor:?}"
+        );
+        assert!(
+            conveyor_full.fresh < conveyor_full.full,
+            "gapped full splices not exercised: {conveyor_full:?}"
+        );
+        assert!(wall.in_place > 100, "the shaking wall's splices are in place: {wall:?}");
+    }
+
+    /// Spreading packed lists into segments moves every contact's sub-contacts and records with
+    /// it, and leaves the slack between segments.
+    #[test]
+    fn spreading_segments_keeps_every_contacts_subcontacts() {
+        let mut model = shaking_wall(300, BENCHMARK_SPACING).expect("wall");
+        model.step().expect("first detection");
+        let state = &mut model.state;
+        let contacts = state.pairs.len();
+        assert!(contacts > 4 * SEGMENT, "{contacts} contacts");
+        let each: Vec<_> = state
+            .pairs
+            .iter()
+            .map(|p| (state.subs[p.range()].to_vec(), state.sub_records[p.range()].to_vec()))
+            .collect();
+        // Packed again, as a full detection stages them.
+        let (mut subs, mut records) = (Vec::new(), Vec::new());
+        for (p, (s, r)) in state.pairs.iter_mut().zip(&each) {
+            p.first = subs.len() as u32;
+            subs.extend_from_slice(s);
+            records.extend_from_slice(r);
+        }
+        let live = subs.len();
+        (state.subs, state.sub_records) = (subs, records);
+        state.spread_segments();
+        check_layout(state, room_limit(live));
+        for (k, (p, (s, r))) in state.pairs.iter().zip(&each).enumerate() {
+            assert!(state.subs[p.range()] == s[..], "contact {k}'s sub-contacts");
+            assert!(state.sub_records[p.range()] == r[..], "contact {k}'s records");
+        }
+        let gaps = contacts.div_ceil(SEGMENT) - 1;
+        assert!(
+            state.subs.len() >= live + 4 * gaps,
+            "{} for {live} live",
+            state.subs.len()
+        );
+        for k in 1..=gaps {
+            let (before, after) = (&state.pairs[k * SEGMENT - 1], &state.pairs[k * SEGMENT]);
+            assert!(
+                after.first >= before.first + before.count + 4,
+                "no slack before segment {k}"
+            );
+        }
+    }
+
+    /// Galloping finds the partition point from any start.
+    #[test]
+    fn gallop_finds_the_partition_point() {
+        let list: Vec<u32> = (0..200).map(|k| k / 3).collect();
+        for start in [0, 1, 17, 100, 199, 200] {
+            for x in [0, 1, 5, 33, 50, 66, 67, 80] {
+                let expected = start + list[start..].partition_point(|&v| v < x);
+                assert_eq!(gallop(&list, start, |&v| v < x), expected, "start {start}, x {x}");
+            }
+        }
     }
 }

@@ -201,7 +201,7 @@ impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
         f.debug_struct("Model")
             .field("blocks", &self.state.blocks.len())
             .field("contacts", &self.state.pairs.len())
-            .field("subcontacts", &self.state.subs.len())
+            .field("subcontacts", &self.subcontact_count())
             .field("step", &self.state.step)
             .field("time", &self.state.time)
             .field("dt", &self.state.dt)
@@ -530,7 +530,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// Total number of sub-contacts.
     pub fn subcontact_count(&self) -> usize {
-        self.state.subs.len()
+        self.state.pairs.iter().map(|p| p.count as usize).sum()
     }
 
     /// Steps taken.

@@ -35,19 +35,24 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         self.set_time_step(pipeline)
     }
 
-    /// Re-evaluates the bounds of the blocks of the contacts whose area grew by more than 5 %
-    /// since their last evaluation (or that are new), then the critical step from all the
-    /// bounds: a block's bound depends only on its own contacts. Needs the block → contact
-    /// index.
-    pub(super) fn refresh_time_step_of_grown(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
-        let mut blocks = std::mem::take(&mut pipeline.refresh_blocks);
-        blocks.clear();
-        for (p, reference) in self.pairs.iter().zip(&mut self.references) {
+    /// Of `contacts`, those whose area grew by more than 5 % since their last evaluation (or
+    /// that are new): their areas are taken as evaluated, and their blocks added to `blocks`.
+    /// Only a contact detected afresh can have grown: a caller may pass those alone.
+    pub(super) fn take_grown(&mut self, contacts: impl Iterator<Item = usize>, blocks: &mut Vec<u32>) {
+        for k in contacts {
+            let reference = &mut self.references[k];
             if reference.area > GROWTH * reference.bound_area {
                 reference.bound_area = reference.area;
-                blocks.extend([p.a, p.b]);
+                blocks.extend([self.pairs[k].a, self.pairs[k].b]);
             }
         }
+    }
+
+    /// Re-evaluates the bounds of the blocks in `pipeline.refresh_blocks` (those of the grown
+    /// contacts, [`ModelState::take_grown`]), then the critical step from all the bounds: a
+    /// block's bound depends only on its own contacts. Needs the block → contact index.
+    pub(super) fn refresh_time_step_of_grown(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
+        let mut blocks = std::mem::take(&mut pipeline.refresh_blocks);
         blocks.sort_unstable();
         blocks.dedup();
         let mut fresh = std::mem::take(&mut pipeline.refresh_bounds);
@@ -62,11 +67,6 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         pipeline.refresh_blocks = blocks;
         pipeline.refresh_bounds = fresh;
         self.set_time_step(pipeline)
-    }
-
-    /// Whether a contact grew enough since its last evaluation for the step to be re-evaluated.
-    pub(super) fn contacts_grew(&self) -> bool {
-        self.references.iter().any(|r| r.area > GROWTH * r.bound_area)
     }
 
     /// What a block's stability bound is computed from.
