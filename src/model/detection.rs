@@ -72,6 +72,12 @@ pub(crate) struct DetectionScratch<S> {
     pub tests: u64,
     broad: BroadPhase,
     candidates: Vec<(u32, u32)>,
+    /// Whether each block is fixed (as of the last detection).
+    fixed: Vec<bool>,
+    /// The pairs of the contacts and of [`ModelState::tested`], in order: what [`plan`] looks
+    /// up, packed. Taken afresh when the lists change other than in place.
+    contact_keys: Vec<(u32, u32)>,
+    tested_keys: Vec<(u32, u32)>,
     plan: Vec<Planned>,
     outcomes: Vec<Outcome>,
     chunks: Vec<ChunkScratch>,
@@ -139,6 +145,9 @@ impl<S> Default for DetectionScratch<S> {
             tests: 0,
             broad: BroadPhase::default(),
             candidates: Vec::new(),
+            fixed: Vec::new(),
+            contact_keys: Vec::new(),
+            tested_keys: Vec::new(),
             plan: Vec::new(),
             outcomes: Vec::new(),
             chunks: Vec::new(),
@@ -506,30 +515,28 @@ impl PairTest<'_> {
 }
 
 /// The candidate pairs with a block that moved, not between two fixed blocks, each with its
-/// entries in the sorted `tested` and `pairs` of the last detection (a merge of sorted lists
-/// that gallops over the entries between two candidates: the candidates of a local
-/// re-detection are few).
+/// entries in the sorted `tested` and contact lists of the last detection, given by their keys
+/// (a merge of sorted lists that gallops over the entries between two candidates: the
+/// candidates of a local re-detection are few).
 fn plan(
     candidates: &[(u32, u32)],
-    blocks: &[RigidBlock],
+    fixed: &[bool],
     moved: &[bool],
-    tested: &[TestedPair],
-    pairs: &[ContactPair],
+    tested: &[(u32, u32)],
+    contacts: &[(u32, u32)],
     out: &mut Vec<Planned>,
 ) {
     out.clear();
     let (mut t, mut c) = (0, 0);
     for &(a, b) in candidates {
-        if !moved[a as usize] && !moved[b as usize] {
+        let (a_, b_) = (a as usize, b as usize);
+        if !moved[a_] && !moved[b_] || fixed[a_] && fixed[b_] {
             continue;
         }
-        if blocks[a as usize].fixity().is_fixed() && blocks[b as usize].fixity().is_fixed() {
-            continue;
-        }
-        t = gallop(tested, t, |e| (e.a, e.b) < (a, b));
-        c = gallop(pairs, c, |p| (p.a, p.b) < (a, b));
-        let found_t = t < tested.len() && (tested[t].a, tested[t].b) == (a, b);
-        let found_c = c < pairs.len() && (pairs[c].a, pairs[c].b) == (a, b);
+        t = gallop(tested, t, |&key| key < (a, b));
+        c = gallop(contacts, c, |&key| key < (a, b));
+        let found_t = tested.get(t) == Some(&(a, b));
+        let found_c = contacts.get(c) == Some(&(a, b));
         out.push(Planned {
             a,
             b,
@@ -555,7 +562,7 @@ fn gallop<T>(list: &[T], start: usize, before: impl Fn(&T) -> bool) -> usize {
 /// Brings `tested` up to date with the detection's outcomes: in place when every planned pair
 /// was tested before and the contacts were spliced in place, else merged afresh through
 /// `buffer` (the pairs of two blocks that did not move keep their entries; those with a moved
-/// block that are no longer candidates lose them).
+/// block that are no longer candidates lose them). Returns whether it was in place.
 fn update_tested(
     tested: &mut Vec<TestedPair>,
     plan: &[Planned],
@@ -563,7 +570,7 @@ fn update_tested(
     moved: &[bool],
     in_place: bool,
     buffer: &mut Vec<TestedPair>,
-) {
+) -> bool {
     let moved_pair = |t: &TestedPair| moved[t.a as usize] || moved[t.b as usize];
     // After an in-place splice no contact was lost, so the entries of pairs with a moved block
     // that are no longer candidates are those of pairs found apart: their verdicts still hold
@@ -574,7 +581,7 @@ fn update_tested(
                 tested[p.tested as usize] = o.entry;
             }
         }
-        return;
+        return true;
     }
     buffer.clear();
     let mut t = 0;
@@ -592,6 +599,7 @@ fn update_tested(
     }
     buffer.extend(tested[t..].iter().filter(|t| !moved_pair(t)));
     std::mem::swap(tested, buffer);
+    false
 }
 
 /// The pose of the smaller of two blocks (by radius; `b` on a tie) in the body frame of the
@@ -672,20 +680,44 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     .map(|(b, r)| reference_box(b, r, reach)),
             );
         }
-        for (i, b) in self.blocks.iter().enumerate() {
-            if sc.moved[i] {
-                self.ref_poses[i] = b.state.pose;
-                sc.boxes[i] = reference_box(b, &b.state.pose, reach);
-            }
-        }
+        self.ref_poses
+            .par_chunks_mut(BLOCK_CHUNK)
+            .zip(sc.boxes.par_chunks_mut(BLOCK_CHUNK))
+            .zip(self.blocks.par_chunks(BLOCK_CHUNK))
+            .zip(sc.moved.par_chunks(BLOCK_CHUNK))
+            .for_each(|(((refs, boxes), blocks), moved)| {
+                let moved_blocks = refs.iter_mut().zip(boxes).zip(blocks).zip(moved).filter(|(_, m)| **m);
+                for (((r, bx), b), _) in moved_blocks {
+                    *r = b.state.pose;
+                    *bx = reference_box(b, r, reach);
+                }
+            });
         sc.broad
             .pairs_of_moved_boxes(&sc.boxes, &sc.moved, params.tolerance, &mut sc.candidates);
+        if full || sc.fixed.len() != n {
+            sc.fixed.clear();
+            sc.fixed.extend(self.blocks.iter().map(|b| b.fixity().is_fixed()));
+        } else {
+            // A change of fixity asks for a full detection, but a base motion prescribes the
+            // velocities of its block's axes at every step.
+            for m in &self.motions {
+                sc.fixed[m.block as usize] = self.blocks[m.block as usize].fixity().is_fixed();
+            }
+        }
+        if sc.contact_keys.len() != self.pairs.len() {
+            sc.contact_keys.clear();
+            sc.contact_keys.extend(self.pairs.iter().map(|p| (p.a, p.b)));
+        }
+        if sc.tested_keys.len() != self.tested.len() {
+            sc.tested_keys.clear();
+            sc.tested_keys.extend(self.tested.iter().map(|t| (t.a, t.b)));
+        }
         plan(
             &sc.candidates,
-            &self.blocks,
+            &sc.fixed,
             &sc.moved,
-            &self.tested,
-            &self.pairs,
+            &sc.tested_keys,
+            &sc.contact_keys,
             &mut sc.plan,
         );
         sc.outcomes.clear();
@@ -728,7 +760,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         };
         self.energy.joint_work += work;
         self.energy.damping += dashpot;
-        update_tested(
+        if !in_place {
+            sc.contact_keys.clear();
+            sc.contact_keys.extend(self.pairs.iter().map(|p| (p.a, p.b)));
+        }
+        let merged = !update_tested(
             &mut self.tested,
             &sc.plan,
             &sc.outcomes,
@@ -736,6 +772,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             in_place,
             &mut sc.tested,
         );
+        if merged {
+            sc.tested_keys.clear();
+            sc.tested_keys.extend(self.tested.iter().map(|t| (t.a, t.b)));
+        }
         sc.tests += sc.outcomes.iter().filter(|o| o.tested).count() as u64;
         self.detections += 1;
         if sc.reindex {
