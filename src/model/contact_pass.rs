@@ -2,7 +2,8 @@
 //! over fixed chunks of contacts.
 //!
 //! Each contact owns a contiguous range of the sub-contact list, and the ranges follow the
-//! contacts in order (detection builds them so; checkpoint load rebuilds them so). The pass
+//! contacts in order, possibly with dead room between them that nothing reads (detection
+//! builds them so, `docs/theory.md` §2.3; checkpoint load packs them). The pass
 //! therefore splits the contact list and the sub-contact list together, with `split_at_mut`, at
 //! chunk boundaries: every task owns its contacts' sub-contacts outright, and no `unsafe` is
 //! needed. Sums are kept per chunk of [`CONTACT_CHUNK`] contacts and added in chunk order
