@@ -155,3 +155,129 @@ fn a_shaking_wall_gives_the_same_bits_on_any_number_of_threads() {
     };
     assert!(run(1) == run(4), "one thread and four differ");
 }
+
+/// A 0.2 m cube from `x` along x (its base at height `z`), of stone.
+fn cube_at(x: f64, z: f64) -> RigidBlock {
+    RigidBlock::cuboid(
+        "cube",
+        Vector::new(x, 0.0, z),
+        Vector::new(x + 0.2, 0.2, z + 0.2),
+        common::STONE_DENSITY,
+    )
+    .expect("cube")
+}
+
+/// A model without gravity at a fixed step of 0.1 ms, one Coulomb law.
+fn weightless_model() -> Model<CoulombSlip> {
+    let params = ModelParameters {
+        gravity: Vector::ZERO,
+        time_step: TimeStep::Fixed(1e-4),
+        ..ModelParameters::default()
+    };
+    common::model_with(params, CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"))
+}
+
+/// A checkpoint holds the contact lists packed; the first detection after loading lays them out
+/// afresh, with room after every 64 contacts, even when it tests no pair and stages nothing
+/// (it used to take its filler from the empty staging lists and panic). The resumed run keeps
+/// the bits of the uninterrupted one.
+#[test]
+fn a_resumed_run_detects_without_retesting_and_keeps_the_bits() {
+    let build = || {
+        let mut wall = voussoir::scenes::benchmark_wall(100).expect("wall");
+        let mut params = *wall.parameters();
+        params.gravity = Vector::ZERO;
+        wall.set_parameters(params).expect("weightless");
+        // Far away and flying: the only block that moves past the trigger.
+        let flyer = cube_at(0.0, 10.0).with_velocity(Vector::new(0.0, 0.0, 1.0), Vector::ZERO);
+        wall.add_block(flyer).expect("flyer");
+        wall
+    };
+    let mut straight = build();
+    straight.run_steps(5).expect("run");
+    assert!(straight.contacts().len() > 128, "more than two segments of contacts");
+    let text = straight.to_checkpoint_string().expect("save");
+    let mut resumed: Model<CoulombSlip> = Model::from_checkpoint_str(&text).expect("load");
+    let detections = resumed.detection_count();
+    resumed.run_steps(100).expect("resumed run");
+    straight.run_steps(100).expect("straight run");
+    assert!(
+        resumed.detection_count() > detections,
+        "the flyer moved past the trigger"
+    );
+    assert_eq!(common::fingerprint(&resumed), common::fingerprint(&straight));
+}
+
+/// A table given a base motion for one step keeps its last velocity once the motion is removed
+/// (as documented) and runs into a fixed post: their contact is found. The table's fixity
+/// turned from fixed to prescribed without a full detection; the pair of two fixed blocks it
+/// was at the start must not stay skipped.
+#[test]
+fn a_block_released_from_a_base_motion_meets_a_fixed_one() {
+    use voussoir::loading::{BaseMotion, MotionKind, TimeHistory};
+    let mut model = weightless_model();
+    let table = model
+        .add_block(cube_at(0.0, 0.0).with_fixity(Fixity::FIXED))
+        .expect("table");
+    let post = model
+        .add_block(cube_at(0.22, 0.0).with_fixity(Fixity::FIXED))
+        .expect("post");
+    model.add_block(cube_at(5.0, 5.0)).expect("a free block far away");
+    model.run_steps(1).expect("first detection");
+    let velocity = TimeHistory::new(vec![0.0, 100.0], vec![0.5, 0.5]).expect("history");
+    let motion = BaseMotion::new(MotionKind::Velocity, [Some(velocity), None, None]).expect("motion");
+    model.set_base_motion(table, Some(motion)).expect("motion on");
+    model.step().expect("step");
+    model.set_base_motion(table, None).expect("motion off");
+    // 20 mm at 0.5 m/s, and 0.3 mm into the post (the table's centroid starts at x = 0.1 m).
+    while model.block(table).expect("table").state().pose.translation.x < 0.1203 {
+        model.step().expect("step");
+    }
+    let joint = model.contact_between(table, post).expect("the table meets the post");
+    assert!(joint.subcontacts().count() > 0);
+}
+
+/// A cube tested apart from a fixed one 1.2 mm away (0.2 mm beyond the 1 mm tolerance) drifts
+/// 10 mm off, the tolerance is raised to 5 mm, and the cube comes back to 1.2 mm in one step:
+/// the pair is in contact, as in a model built there. The verdict of a pair found apart holds
+/// only for the tolerance it was measured against; a change of parameters forgets it.
+#[test]
+fn raising_the_tolerance_forgets_the_verdicts_of_pairs_found_apart() {
+    let contact_subcontacts = |model: &Model<CoulombSlip>| {
+        model
+            .contact_between(BlockId(0), BlockId(1))
+            .map_or(0, |c| c.subcontacts().count())
+    };
+    let mut model = weightless_model();
+    model
+        .add_block(cube_at(0.0, 0.0).with_fixity(Fixity::FIXED))
+        .expect("fixed");
+    let cube = model.add_block(cube_at(0.2012, 0.0)).expect("cube");
+    model.run_steps(1).expect("first detection");
+    assert_eq!(contact_subcontacts(&model), 0, "1.2 mm apart at a 1 mm tolerance");
+    model
+        .set_velocity(cube, Vector::new(0.1, 0.0, 0.0), Vector::ZERO)
+        .expect("push");
+    model.run_steps(1000).expect("10 mm away");
+    model.set_velocity(cube, Vector::ZERO, Vector::ZERO).expect("stop");
+    let mut params = *model.parameters();
+    params.contact.tolerance = 5e-3;
+    model.set_parameters(params).expect("5 mm tolerance");
+    model.run_steps(2).expect("run");
+    let x = model.block(cube).expect("cube").state().pose.translation.x;
+    let back = x - (0.2012 + 0.1);
+    model
+        .set_velocity(cube, Vector::new(-back / 1e-4, 0.0, 0.0), Vector::ZERO)
+        .expect("back in one step");
+    model.step().expect("step");
+    model.set_velocity(cube, Vector::ZERO, Vector::ZERO).expect("stop");
+    model.run_steps(3).expect("run");
+    let mut fresh = common::model_with(params, CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
+    fresh
+        .add_block(cube_at(0.0, 0.0).with_fixity(Fixity::FIXED))
+        .expect("fixed");
+    fresh.add_block(cube_at(0.2012, 0.0)).expect("cube");
+    fresh.run_steps(1).expect("first detection");
+    assert!(contact_subcontacts(&fresh) > 0);
+    assert_eq!(contact_subcontacts(&model), contact_subcontacts(&fresh));
+}

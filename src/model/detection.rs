@@ -14,10 +14,10 @@ use crate::contact::{
 };
 use crate::error::{Error, Result};
 use crate::geometry::{
-    detect, BlockGeometry, BroadPhase, ContactParameters, DetectedContact, NarrowPhaseScratch, SubcontactSeed,
+    detect, BlockGeometry, BroadPhase, ContactParameters, DetectedContact, NarrowPhaseScratch, SubKey, SubcontactSeed,
 };
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
-use crate::math::{Matrix, Pose, Real, Vector};
+use crate::math::{Matrix, Pose, Real, Vector, Vector2};
 
 /// The staging lists are freed after a detection when they hold more than this share of the
 /// sub-contacts' room (`1/STAGING_FRACTION`): a full re-detection must not leave a second copy
@@ -699,7 +699,12 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             sc.fixed.extend(self.blocks.iter().map(|b| b.fixity().is_fixed()));
         } else {
             // A change of fixity asks for a full detection, but a base motion prescribes the
-            // velocities of its block's axes at every step.
+            // velocities of its block's axes (`Fixed` becomes `Velocity`) without one, and its
+            // block keeps them once the motion is removed: the flags of the moved blocks and of
+            // those under a motion are taken afresh (a planned pair has a moved block).
+            for i in (0..n).filter(|&i| sc.moved[i]) {
+                sc.fixed[i] = self.blocks[i].fixity().is_fixed();
+            }
             for m in &self.motions {
                 sc.fixed[m.block as usize] = self.blocks[m.block as usize].fixity().is_fixed();
             }
@@ -764,12 +769,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             sc.contact_keys.clear();
             sc.contact_keys.extend(self.pairs.iter().map(|p| (p.a, p.b)));
         }
+        // A full detection follows a change of parameters (the tolerance that the slack of a
+        // pair found apart was measured against): its entries are merged afresh.
         let merged = !update_tested(
             &mut self.tested,
             &sc.plan,
             &sc.outcomes,
             &sc.moved,
-            in_place,
+            in_place && !full,
             &mut sc.tested,
         );
         if merged {
@@ -960,8 +967,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         if needed > room {
             // Dead room (sub-contacts not in any contact's range are never read).
-            self.subs.resize(needed as usize, sc.subs[0].clone());
-            self.sub_records.resize(needed as usize, sc.records[0].clone());
+            let (sub, record) = dead_subcontact();
+            self.subs.resize(needed as usize, sub);
+            self.sub_records.resize(needed as usize, record);
         }
         // Pushed contacts move from the last: each moves into room that is dead by then (the
         // old room of the ones after it, which moved further back, or of re-tested ones).
@@ -1099,8 +1107,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         if room > self.subs.len() {
             // Dead room (sub-contacts not in any contact's range are never read).
-            self.subs.resize(room, sc.subs[0].clone());
-            self.sub_records.resize(room, sc.records[0].clone());
+            let (sub, record) = dead_subcontact();
+            self.subs.resize(room, sub);
+            self.sub_records.resize(room, record);
         }
         // The kept contacts' sub-contacts move first, in runs of equal shift (while the contacts
         // still hold their old ranges), then the contacts, in runs that were neighbours and stay
@@ -1293,6 +1302,20 @@ fn moved_beyond(b: &crate::block::RigidBlock, r: &crate::math::Pose, trigger: Re
 struct BlockIndex<'a> {
     offsets: &'a [u32],
     contacts: &'a [u32],
+}
+
+/// A sub-contact and a record to fill dead room with (never read).
+fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord) {
+    let sub = SubContact {
+        plane: Vector2::ZERO,
+        area: 0.0,
+        gap: 0.0,
+        force: JointForce::default(),
+        slip: 0.0,
+        status: JointStatus::Open,
+        state: S::default(),
+    };
+    (sub, SubContactRecord::new(SubKey(0)))
 }
 
 /// The contact lists before a re-detection, for [`dropped_work`].
