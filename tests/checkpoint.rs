@@ -123,6 +123,23 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     *force = serde_json::json!(fz * 1.5);
     let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("bad springs");
     assert!(err.to_string().contains("contacts[0].springs"), "{err}");
+    // A loaded sub-contact whose area is tiny (subnormal): its springs' elastic energy is
+    // infinite, and a model loaded with it would save a file that does not load (found by the
+    // fuzzer: the energy was written as `null`).
+    let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let sub = json["contacts"][0]["subcontacts"]
+        .as_array()
+        .expect("sub-contacts")
+        .iter()
+        .position(|s| s["force"]["normal"].as_f64().is_some_and(|f| f.abs() > 0.0))
+        .expect("a loaded sub-contact");
+    json["contacts"][0]["subcontacts"][sub]["area"] = serde_json::json!(1e-320);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("infinite energy");
+    assert!(
+        err.to_string().contains(&format!("contacts[0].subcontacts[{sub}]"))
+            && err.to_string().contains("elastic energy"),
+        "{err}"
+    );
     // Joint axes or anchor plane axes that are not orthonormal.
     for (field, path) in [("tangent", "contacts[0].tangent"), ("anchors", "contacts[0].anchors")] {
         let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");

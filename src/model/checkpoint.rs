@@ -672,6 +672,24 @@ where
                 ));
             }
         }
+        // The joints' elastic energy is saved with the model: it must be a number (a sub-contact
+        // of a tiny area, or a huge force, would make it infinite and the saved file unreadable).
+        for (k, p) in model.state.pairs.iter().enumerate() {
+            let law = &model.state.laws.laws()[p.law as usize];
+            let subs = &model.state.subs[p.range()];
+            if let Some(j) = subs
+                .iter()
+                .position(|s| !law.elastic_energy(s.area, &s.force, &s.state).is_finite())
+            {
+                return Err(corrupt(
+                    &format!("contacts[{k}].subcontacts[{j}]"),
+                    "forces and area whose elastic energy is not finite",
+                ));
+            }
+        }
+        if !model.elastic_energy().is_finite() {
+            return Err(corrupt("contacts", "the joints' elastic energy is not finite"));
+        }
         model.state.ref_poses = snap.ref_poses;
         model.state.tested = tested;
         model.state.drift = if snap.drift > 0.0 && snap.started {
