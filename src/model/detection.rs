@@ -825,14 +825,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             subs: &self.subs,
             records: &self.sub_records,
         };
-        let first = batch.start;
+        let (first, chunk) = (batch.start, plan_chunk(sc.plan.len()));
         for k in batch {
             let (p, o) = (&sc.plan[k], &mut sc.outcomes[k]);
             let Some(dc) = o.contact.take() else { continue };
             if o.seed_count == 0 {
                 continue;
             }
-            let seeds = sc.chunks[(k - first) / plan_chunk(sc.plan.len())].seeds(o);
+            let seeds = sc.chunks[(k - first) / chunk].seeds(o);
             let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let law = self.law_index(p.a, p.b)?;
             o.staged = sc.pairs.len() as u32;
@@ -1189,15 +1189,13 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// detection stages them): the fresh layout of [`place_subcontacts`].
     fn spread_segments(&mut self) {
         let segments = self.pairs.len().div_ceil(SEGMENT);
-        let (Some(sub), Some(record)) = (self.subs.first().cloned(), self.sub_records.first().cloned()) else {
-            return;
-        };
         let contacts = self.pairs.len();
         let segment = |k: usize| k * SEGMENT..((k + 1) * SEGMENT).min(contacts);
         let slack = |pairs: &[ContactPair], k: usize| segment_slack(pairs[segment(k)].iter().map(|p| p.count).sum());
         // Segment `k` moves back by the slack of the segments before it, the last one first,
         // into room that is dead by then.
         let mut shift: u32 = (0..segments.saturating_sub(1)).map(|k| slack(&self.pairs, k)).sum();
+        let (sub, record) = dead_subcontact();
         self.subs.resize(self.subs.len() + shift as usize, sub);
         self.sub_records.resize(self.sub_records.len() + shift as usize, record);
         for k in (1..segments).rev() {
