@@ -12,9 +12,6 @@ impl Changes {
     pub const LAWS: Self = Self(1 << 1);
     /// The global parameters were replaced.
     pub const PARAMETERS: Self = Self(1 << 2);
-    /// A block's fixity changed (a released block may touch blocks it had no contact with
-    /// while both were fixed).
-    pub const FIXITY: Self = Self(1 << 3);
     /// A full detection and step evaluation is owed for another reason: the first step, a
     /// checkpoint saved with one pending, or a step re-evaluation that failed (so that the
     /// error repeats rather than the run going on with an unstable step).

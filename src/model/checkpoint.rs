@@ -371,7 +371,7 @@ where
             refine_omega2: self.state.refine_omega2,
             refining: self.state.refining.clone(),
             motions: self.state.motions.clone(),
-            pending_detection: self.state.changes.need_full_detection(),
+            pending_detection: self.state.changes.need_full_detection() || !self.state.refixed.is_empty(),
         };
         let io = |e: serde_json::Error| Error::Io {
             path: "(checkpoint)".into(),

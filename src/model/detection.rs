@@ -283,6 +283,26 @@ fn place_subcontacts(
     unreachable!("the packed layout is returned")
 }
 
+/// Moves `list[range]` by `shift` places into dead room (elements never read: what lies
+/// between `range` and its destination, or beyond it, is dead), by swapping each element with
+/// the dead one at its destination: O(`range.len()`), whatever the shift, where a rotation of
+/// the range with the room it moves into costs O(`range.len() + |shift|`) (the first detection
+/// of a large model spreads its segments by shifts of up to a sixteenth of the list: quadratic
+/// by rotation). The live elements land where a rotation puts them; only the dead ones may end
+/// up in another order.
+fn move_into_dead_room<T>(list: &mut [T], range: std::ops::Range<usize>, shift: i64) {
+    let by = shift.unsigned_abs() as usize;
+    if shift > 0 {
+        for i in range.rev() {
+            list.swap(i, i + by);
+        }
+    } else if shift < 0 {
+        for i in range {
+            list.swap(i, i - by);
+        }
+    }
+}
+
 /// Which runs of kept contacts [`ContactLists::move_run`] moves.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Direction {
@@ -293,39 +313,24 @@ enum Direction {
 }
 
 impl<S> ContactLists<'_, S> {
-    /// Moves a run of old contacts to their new indices, if they move in `direction`, by
-    /// rotating the run with the dead room it moves into (their sub-contacts stay).
+    /// Moves a run of old contacts to their new indices, if they move in `direction`, into the
+    /// dead room they move into ([`move_into_dead_room`]; their sub-contacts stay).
     fn move_contacts(&mut self, run: &Run, direction: Direction) {
         let (c, k, len) = (run.old as usize, run.new as usize, run.len as usize);
-        match direction {
-            Direction::Front if k < c => {
-                self.pairs[k..c + len].rotate_left(c - k);
-                self.references[k..c + len].rotate_left(c - k);
-                self.wrenches[k..c + len].rotate_left(c - k);
-            }
-            Direction::Back if k > c => {
-                self.pairs[c..k + len].rotate_right(k - c);
-                self.references[c..k + len].rotate_right(k - c);
-                self.wrenches[c..k + len].rotate_right(k - c);
-            }
-            _ => {}
+        let shift = k as i64 - c as i64;
+        if (direction == Direction::Front && shift < 0) || (direction == Direction::Back && shift > 0) {
+            move_into_dead_room(self.pairs, c..c + len, shift);
+            move_into_dead_room(self.references, c..c + len, shift);
+            move_into_dead_room(self.wrenches, c..c + len, shift);
         }
     }
 
-    /// Moves the sub-contacts `range` by `shift`, if they move in `direction`, by rotating them
-    /// with the dead room they move into.
+    /// Moves the sub-contacts `range` by `shift`, if they move in `direction`, into the dead
+    /// room they move into ([`move_into_dead_room`]).
     fn move_subcontacts(&mut self, range: std::ops::Range<usize>, shift: i64, direction: Direction) {
-        let by = shift.unsigned_abs() as usize;
-        match direction {
-            Direction::Front if shift < 0 => {
-                self.subs[range.start - by..range.end].rotate_left(by);
-                self.records[range.start - by..range.end].rotate_left(by);
-            }
-            Direction::Back if shift > 0 => {
-                self.subs[range.start..range.end + by].rotate_right(by);
-                self.records[range.start..range.end + by].rotate_right(by);
-            }
-            _ => {}
+        if (direction == Direction::Front && shift < 0) || (direction == Direction::Back && shift > 0) {
+            move_into_dead_room(self.subs, range.clone(), shift);
+            move_into_dead_room(self.records, range, shift);
         }
     }
 }
@@ -980,8 +985,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 contacts[0].first as usize,
                 (last.first + last.count + run.shift) as usize,
             );
-            self.subs[start..end].rotate_right(run.shift as usize);
-            self.sub_records[start..end].rotate_right(run.shift as usize);
+            let moved = start..end - run.shift as usize;
+            move_into_dead_room(&mut self.subs, moved.clone(), i64::from(run.shift));
+            move_into_dead_room(&mut self.sub_records, moved, i64::from(run.shift));
             for p in contacts {
                 p.first += run.shift;
             }
@@ -1202,8 +1208,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             let contacts = &mut self.pairs[segment(k)];
             let last = &contacts[contacts.len() - 1];
             let (start, end) = (contacts[0].first as usize, (last.first + last.count) as usize);
-            self.subs[start..end + shift as usize].rotate_right(shift as usize);
-            self.sub_records[start..end + shift as usize].rotate_right(shift as usize);
+            move_into_dead_room(&mut self.subs, start..end, i64::from(shift));
+            move_into_dead_room(&mut self.sub_records, start..end, i64::from(shift));
             for p in contacts.iter_mut() {
                 p.first += shift;
             }

@@ -166,6 +166,9 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     pub started: bool,
     /// What the setters changed since the last step (read first by [`Model::step`]).
     pub changes: Changes,
+    /// Blocks whose fixity changed since the last detection ([`Model::set_fixity`]): the next
+    /// detection looks at their pairs as if they had moved.
+    pub refixed: Vec<u32>,
     pub unbalanced_ratio: Real,
     pub detections: u64,
     /// Base motions, by block ([`Model::set_base_motion`]).
@@ -282,6 +285,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 energy: Energies::default(),
                 started: false,
                 changes: Changes::DETECTION,
+                refixed: Vec::new(),
                 unbalanced_ratio: Real::INFINITY,
                 detections: 0,
                 motions: Vec::new(),
@@ -363,8 +367,19 @@ impl<L: ConstitutiveLaw> Model<L> {
         for b in &self.state.blocks {
             params.contact.check_block(b.shape().radius(), b.name())?;
         }
-        self.state.params = params;
-        self.state.changes.insert(Changes::PARAMETERS);
+        let old = std::mem::replace(&mut self.state.params, params);
+        if params.contact != old.contact || params.mode != old.mode {
+            // Contacts are detected and discretised afresh with the new contact parameters.
+            self.state.changes.insert(Changes::PARAMETERS);
+        } else if params != old {
+            // Gravity, the step's choice, the speed limit: no contact changes, the step is
+            // re-evaluated now (as `set_integrator` does), and nothing changes on an error.
+            if let Err(e) = self.state.refresh_time_step(&mut self.pipeline) {
+                self.state.params = old;
+                let _ = self.state.refresh_time_step(&mut self.pipeline);
+                return Err(e);
+            }
+        }
         Ok(())
     }
 
@@ -399,14 +414,16 @@ impl<L: ConstitutiveLaw> Model<L> {
             b.replace_fixity(old);
             return Err(e);
         }
-        // A released block may touch blocks it had no contact with while both were fixed.
-        self.state.changes.insert(Changes::FIXITY);
         if let Err(e) = self.state.refresh_time_step(&mut self.pipeline) {
             let b = self.block_mut(id)?;
             b.replace_fixity(old);
             let _ = self.state.refresh_time_step(&mut self.pipeline);
             return Err(e);
         }
+        // A released block may touch blocks it had no contact with while both were fixed, and
+        // a fixed one loses its contacts with fixed blocks: the next detection looks at this
+        // block's pairs as if it had moved (not at every pair of the model).
+        self.state.refixed.push(id.0);
         Ok(())
     }
 

@@ -30,7 +30,16 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if !self.started {
             self.start(pipeline)?;
         } else if large {
-            if changed || moved {
+            // A block whose fixity changed is looked at as if it had moved.
+            let refixed = !changed && !self.refixed.is_empty();
+            if refixed {
+                let flags = &mut pipeline.detection.moved;
+                flags.resize(self.blocks.len(), false);
+                for &i in &self.refixed {
+                    flags[i as usize] = true;
+                }
+            }
+            if changed || moved || refixed {
                 self.detect(pipeline)?;
             }
         } else if changed {
@@ -38,6 +47,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.refresh_time_step(pipeline)?;
             self.changes.clear();
         }
+        self.refixed.clear();
         if self.drift == 0.0 {
             // The first step: the initial velocities stand for those of the half step before.
             self.drift = self.dt;
