@@ -34,16 +34,26 @@ fn stiffer_law_mid_run_shortens_the_step() -> Result<()> {
     Ok(())
 }
 
-/// A fixed step above the limit set mid-run is an error at the next step, not ignored.
+/// A fixed step above the limit set mid-run is an error at once, and the parameters stay as
+/// they were; set before the first step, at the first step.
 #[test]
 fn unsafe_fixed_step_set_mid_run_is_an_error() -> Result<()> {
     let (mut model, _) = cube_on_base()?;
     model.run_steps(10)?;
-    model.set_parameters(ModelParameters {
+    let before = *model.parameters();
+    let unsafe_step = ModelParameters {
         time_step: TimeStep::Fixed(1.0),
-        ..*model.parameters()
-    })?;
-    assert!(matches!(model.step(), Err(Error::TimeStepTooLarge { .. })));
+        ..before
+    };
+    assert!(matches!(
+        model.set_parameters(unsafe_step),
+        Err(Error::TimeStepTooLarge { .. })
+    ));
+    assert_eq!(*model.parameters(), before);
+    model.run_steps(10)?;
+    let (mut fresh, _) = cube_on_base()?;
+    fresh.set_parameters(unsafe_step)?;
+    assert!(matches!(fresh.step(), Err(Error::TimeStepTooLarge { .. })));
     Ok(())
 }
 
@@ -75,4 +85,106 @@ fn contact_wrench_before_detection_is_zero() {
         .expect("added");
     assert_eq!(model.contact_wrench(added).expect("wrench"), Wrench::default());
     assert!(model.contact_wrench(base).expect("wrench").force.z < 0.0);
+}
+
+/// The block pairs in contact, in order.
+fn contact_pairs(model: &Model) -> Vec<(BlockId, BlockId)> {
+    model.contacts().map(|c| c.blocks()).collect()
+}
+
+/// A change of fixity looks at the block's own pairs, not at every pair of the model (a full
+/// detection of a 100k-block wall took seconds per `set_fixity`), and gives the contacts a full
+/// detection gives: fixing a brick of the first course drops its contacts with the fixed base,
+/// releasing it again finds them at once.
+#[test]
+fn fixity_change_re_detects_the_blocks_pairs_only() -> Result<()> {
+    let mut model = voussoir::scenes::benchmark_wall(300)?;
+    model.run_steps(3)?;
+    let before = contact_pairs(&model);
+    // A brick of the first course (on the base, between two bricks, under two).
+    let first_course = |m: &Model| {
+        m.blocks()
+            .iter()
+            .position(|b| !b.fixity().is_fixed() && b.state().pose.translation.z < 0.1)
+            .map(|i| BlockId(i as u32))
+    };
+    let brick = first_course(&model).expect("a brick of the first course");
+    // The brick's contacts with fixed blocks.
+    let touches_fixed = |m: &Model| {
+        m.contacts()
+            .filter_map(|c| match c.blocks() {
+                (a, other) | (other, a) if a == brick => Some(other),
+                _ => None,
+            })
+            .filter(|other| m.blocks()[other.0 as usize].fixity().is_fixed())
+            .count()
+    };
+    let on_fixed = touches_fixed(&model);
+    assert!(on_fixed >= 1, "the brick stands on the base");
+    let (tests, detections) = (model.pair_tests(), model.detection_count());
+    model.set_fixity(brick, Fixity::FIXED)?;
+    model.step()?;
+    let tested = model.pair_tests() - tests;
+    assert_eq!(
+        model.detection_count(),
+        detections + 1,
+        "one detection follows the change"
+    );
+    // The brick did not move: its pairs keep their verdicts, and those with fixed blocks are
+    // dropped without a test.
+    assert!(
+        tested <= 8,
+        "{tested} pairs tested of {} contacts: only the brick's",
+        before.len()
+    );
+    // The contacts a full detection finds: a wall built with the brick fixed from the start.
+    let mut fresh = voussoir::scenes::benchmark_wall(300)?;
+    assert_eq!(first_course(&fresh), Some(brick));
+    fresh.set_fixity(brick, Fixity::FIXED)?;
+    fresh.run_steps(4)?;
+    assert_eq!(contact_pairs(&model), contact_pairs(&fresh));
+    assert_eq!(touches_fixed(&model), 0, "its contacts with fixed blocks are gone");
+    model.set_fixity(brick, Fixity::FREE)?;
+    model.step()?;
+    assert_eq!(
+        touches_fixed(&model),
+        on_fixed,
+        "the released brick finds the base at once"
+    );
+    let mut free = voussoir::scenes::benchmark_wall(300)?;
+    free.run_steps(5)?;
+    assert_eq!(contact_pairs(&model), contact_pairs(&free));
+    assert!(contact_pairs(&model).len() >= before.len());
+    Ok(())
+}
+
+/// Parameters that leave the contacts as they are (the same ones, or new gravity) detect
+/// nothing; new contact parameters detect every contact afresh.
+#[test]
+fn parameters_re_detect_only_when_the_contacts_change() -> Result<()> {
+    let mut model = voussoir::scenes::benchmark_wall(300)?;
+    model.run_steps(3)?;
+    let tests = model.pair_tests();
+    let p = *model.parameters();
+    model.set_parameters(p)?;
+    model.step()?;
+    model.set_parameters(ModelParameters {
+        gravity: p.gravity * 1.01,
+        ..p
+    })?;
+    model.step()?;
+    assert_eq!(model.pair_tests(), tests, "no pair tested afresh");
+    model.set_parameters(ModelParameters {
+        contact: ContactParameters {
+            tolerance: p.contact.tolerance * 1.01,
+            ..p.contact
+        },
+        ..p
+    })?;
+    model.step()?;
+    assert!(
+        model.pair_tests() - tests >= model.contacts().len() as u64,
+        "a full detection"
+    );
+    Ok(())
 }

@@ -211,9 +211,10 @@ impl ContactPair {
         }
     }
 
-    /// Recomputes [`ContactPair::springs`] from the contact's own sub-contacts.
-    pub(crate) fn refresh_springs<S>(&mut self, subs: &[SubContact<S>]) {
-        self.springs = ForceMoments::of_springs(&self.axes(), &subs[self.range()]);
+    /// Recomputes [`ContactPair::springs`] from the contact's own sub-contacts (`own`: those
+    /// of its range).
+    pub(crate) fn refresh_springs<S>(&mut self, own: &[SubContact<S>]) {
+        self.springs = ForceMoments::of_springs(&self.axes(), own);
     }
 
     pub(crate) fn range(&self) -> std::ops::Range<usize> {

@@ -351,9 +351,10 @@ fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut Nar
     // Edge–edge axes must beat the face axes clearly, so that touching faces stay face contacts.
     let bias = 1e-9 * (a.shape.radius() + b.shape.radius());
     let centre = b.pose.translation - a.pose.translation;
-    for ea in a.shape.edges() {
+    // One axis per pair of edge directions: parallel edges give the same axis.
+    for ea in a.shape.edges_by_direction() {
         let da = wa[ea[1] as usize] - wa[ea[0] as usize];
-        for eb in b.shape.edges() {
+        for eb in b.shape.edges_by_direction() {
             let db = wb[eb[1] as usize] - wb[eb[0] as usize];
             let c = da.cross(db);
             let len = c.length();

@@ -47,6 +47,11 @@ pub struct Polyhedron {
     face_vertices: Vec<u32>,
     /// Unique edges as vertex index pairs.
     edges: Vec<[u32; 2]>,
+    /// One edge (its index in `edges`, the first in order) per direction of the edges: the
+    /// separating-axis test needs one axis per pair of directions, not per pair of edges (a
+    /// cuboid's 12 edges have 3). Derived from the vertices and edges.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    edge_directions: Vec<u32>,
     /// Largest distance from the centroid to a vertex (m).
     radius: Real,
     volume: Real,
@@ -62,8 +67,9 @@ fn empty_parry() -> Option<ConvexPolyhedron> {
 }
 
 /// The most vertices a block's convex hull may have. Contact detection (the separating-axis test
-/// in [`crate::geometry::detect`]) costs about `E_a·E_b·(V_a + V_b)` for two blocks with `V`
-/// vertices and `E ≈ 3V` edges: measured, the first step of two touching 256-vertex blocks takes
+/// in [`crate::geometry::detect`]) costs about `D_a·D_b·(V_a + V_b)` for two blocks with `V`
+/// vertices and `D` edge directions (`D ≤ E ≈ 3V` edges; a cuboid has 3, a generic hull `E`):
+/// measured, the first step of two touching 256-vertex blocks takes
 /// 0.24 s, of two 1,000-vertex blocks 12.9 s, and of a 20,000-vertex block on a box 10.4 s.
 /// Larger shapes are refused with [`Error::TooManyVertices`]; masonry units need far fewer (a
 /// 128-sided column drum has 256).
@@ -300,11 +306,13 @@ impl Polyhedron {
         }
         edges.sort_unstable();
         edges.dedup();
+        let edge_directions = distinct_directions(&vertices, &edges);
         Ok(Self {
             vertices,
             faces,
             face_vertices,
             edges,
+            edge_directions,
             radius,
             volume,
             unit_inertia,
@@ -337,6 +345,7 @@ impl Polyhedron {
         if self.edges.iter().any(|e| e[0] >= n || e[1] >= n) {
             return Err(bad("stored edges refer to missing vertices"));
         }
+        self.edge_directions = distinct_directions(&self.vertices, &self.edges);
         self.parry = Some(
             ConvexPolyhedron::from_convex_mesh(self.vertices.clone(), &tris)
                 .ok_or_else(|| bad("stored faces do not form a convex manifold"))?,
@@ -463,6 +472,12 @@ impl Polyhedron {
         &self.edges
     }
 
+    /// One edge per direction of the edges (parallel edges, either way round, share one): the
+    /// first of [`Polyhedron::edges`] along each direction, in that order.
+    pub fn edges_by_direction(&self) -> impl Iterator<Item = [u32; 2]> + '_ {
+        self.edge_directions.iter().map(|&e| self.edges[e as usize])
+    }
+
     /// Volume (m³).
     pub fn volume(&self) -> Real {
         self.volume
@@ -538,6 +553,25 @@ pub(crate) fn newell_normal(pts: &[Vector]) -> Vector {
         n += a.cross(b);
     }
     n
+}
+
+/// The first edge of `edges` along each direction (by index, in order): edges whose directions
+/// are parallel within the separating-axis test's own threshold (`|u × v| ≤ 10⁻⁹ |u| |v|`) share
+/// one. Quadratic in the edges, once per shape.
+fn distinct_directions(vertices: &[Vector], edges: &[[u32; 2]]) -> Vec<u32> {
+    let direction = |e: &[u32; 2]| vertices[e[1] as usize] - vertices[e[0] as usize];
+    let mut kept: Vec<u32> = Vec::new();
+    for (k, e) in edges.iter().enumerate() {
+        let d = direction(e);
+        let parallel = kept.iter().any(|&j| {
+            let u = direction(&edges[j as usize]);
+            u.cross(d).length() <= 1e-9 * u.length() * d.length()
+        });
+        if !parallel {
+            kept.push(k as u32);
+        }
+    }
+    kept
 }
 
 #[cfg(test)]

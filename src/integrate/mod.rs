@@ -11,7 +11,7 @@ pub use central_difference::CentralDifference;
 pub use damping::Damping;
 pub use time_step::{critical_time_step, CriticalStep, Stiffness6, StiffnessBound, TimeStep};
 
-pub(crate) use stability::{block_bound, AreaMoments, ContactStiffness};
+pub(crate) use stability::{block_bound, contact_eigenvalues, AreaMoments, ContactStiffness};
 
 use crate::block::{Block, BlockState, Fixity, RigidBlock, Wrench};
 use crate::geometry::MassProperties;

@@ -20,7 +20,10 @@ pub(crate) struct ContactStiffness {
     pub moments: AreaMoments,
 }
 
-/// The bound of block `i`, given its contacts in contact order: for a block in contact, the block Gershgorin bound
+/// The bound of block `i`, given its contacts in contact order, each with the largest
+/// eigenvalues of its mass-normalised stiffness on its two blocks ([`contact_eigenvalues`]:
+/// they do not depend on which block asks, so a caller evaluating every block computes them
+/// once per contact): for a block in contact, the block Gershgorin bound
 /// `λ ≤ λ_max(A_bb) + Σ_c √(λ_b λ_c)` of its mass-normalised contact stiffness; for a block
 /// in free flight, that of a contact of stiffness `k_max` (`kn + 2 ks`, the stiffest law's) over
 /// its largest face, so that its step is sensible when it lands (the landing contact is detected
@@ -32,7 +35,7 @@ pub(crate) struct ContactStiffness {
 pub(crate) fn block_bound(
     blocks: &[RigidBlock],
     i: usize,
-    contacts: impl Iterator<Item = ContactStiffness>,
+    contacts: impl Iterator<Item = (ContactStiffness, [Real; 2])>,
     k_max: Real,
 ) -> StiffnessBound {
     let b = &blocks[i];
@@ -42,23 +45,8 @@ pub(crate) fn block_bound(
     let mut own = Stiffness6::default();
     let mut coupling = 0.0;
     let mut in_contact = false;
-    for c in contacts {
-        let k = c.stiffness;
-        let side = |j: usize| -> Option<Stiffness6> {
-            let block = &blocks[j];
-            if all_constrained(block) {
-                return None;
-            }
-            let centre = block.state.pose.translation - c.origin;
-            Some(
-                c.moments
-                    .stiffness(centre, c.normal, k.normal, k.shear, &Normalisation::of(block)),
-            )
-        };
-        let (ka, kb) = (side(c.a), side(c.b));
-        let la = ka.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
-        let lb = kb.as_ref().map_or(0.0, |m| m.max_eigenvalue().max(0.0));
-        if let Some(m) = if c.a == i { ka } else { kb } {
+    for (c, [la, lb]) in contacts {
+        if let Some(m) = side_stiffness(blocks, &c, i) {
             own.add(&m);
         }
         coupling += (la * lb).sqrt();
@@ -71,6 +59,27 @@ pub(crate) fn block_bound(
             free_flight_bound(b, k_max)
         },
     }
+}
+
+/// The largest eigenvalues of contact `c`'s mass-normalised stiffness on its blocks `a` and
+/// `b` (zero on a block whose every degree of freedom is prescribed).
+pub(crate) fn contact_eigenvalues(blocks: &[RigidBlock], c: &ContactStiffness) -> [Real; 2] {
+    [c.a, c.b].map(|j| side_stiffness(blocks, c, j).map_or(0.0, |m| m.max_eigenvalue().max(0.0)))
+}
+
+/// Contact `c`'s mass-normalised stiffness on its block `j`, or `None` when every degree of
+/// freedom of that block is prescribed.
+fn side_stiffness(blocks: &[RigidBlock], c: &ContactStiffness, j: usize) -> Option<Stiffness6> {
+    let block = &blocks[j];
+    if all_constrained(block) {
+        return None;
+    }
+    let k = c.stiffness;
+    let centre = block.state.pose.translation - c.origin;
+    Some(
+        c.moments
+            .stiffness(centre, c.normal, k.normal, k.shear, &Normalisation::of(block)),
+    )
 }
 
 /// The bound of a block in free flight: a contact of stiffness `k_max` over its largest face.
@@ -302,8 +311,9 @@ mod tests {
             };
             let blocks = [base.clone(), cube.clone().with_fixity(fixity)];
             let k_max = kn + 2.0 * ks;
-            assert_eq!(block_bound(&blocks, 0, [contact].into_iter(), k_max).omega_squared, 0.0);
-            block_bound(&blocks, 1, [contact].into_iter(), k_max).omega_squared
+            let with = [(contact, contact_eigenvalues(&blocks, &contact))];
+            assert_eq!(block_bound(&blocks, 0, with.into_iter(), k_max).omega_squared, 0.0);
+            block_bound(&blocks, 1, with.into_iter(), k_max).omega_squared
         };
         let translations_only = bound([Dof::Fixed; 3]);
         let expected = kn * 0.04 / mass;

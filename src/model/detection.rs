@@ -109,11 +109,12 @@ pub(crate) struct DetectionScratch<S> {
     reindex: bool,
     /// Merge buffer of [`update_tested`].
     tested: Vec<TestedPair>,
-    pairs: Vec<ContactPair>,
-    references: Vec<ContactReference>,
-    wrenches: Vec<ContactWrench>,
-    subs: Vec<SubContact<S>>,
-    records: Vec<SubContactRecord>,
+    /// The contacts detected afresh, in plan order, with the history of the old ones.
+    staging: StagedLists<S>,
+    /// Whether the staging lists are in a fresh layout (a full detection), and the
+    /// sub-contacts of their last segment so far.
+    staging_spread: bool,
+    segment_subs: u32,
 }
 
 impl<S> DetectionScratch<S> {
@@ -130,11 +131,35 @@ impl<S> DetectionScratch<S> {
 
     /// Frees the staging lists (after they held a large share of the contacts).
     fn release_staging(&mut self) {
-        self.pairs = Vec::new();
-        self.references = Vec::new();
-        self.wrenches = Vec::new();
-        self.subs = Vec::new();
-        self.records = Vec::new();
+        self.staging = StagedLists::default();
+    }
+
+    /// Gives the contacts found in the planned pairs `batch` (tasks of `chunk` pairs) their
+    /// places in the staging lists, after those already staged, in plan order: each outcome's
+    /// `staged` and `first_sub`, each task's `place`. In a fresh layout (`staging_spread`)
+    /// [`segment_slack`] follows every [`SEGMENT`] contacts.
+    fn place_staged(&mut self, batch: std::ops::Range<usize>, chunk: usize) {
+        let (mut contacts, mut cursor) = (self.staging.pairs.len() as u32, self.staging.subs.len() as u32);
+        for (k, outcomes) in self.outcomes[batch].chunks_mut(chunk).enumerate() {
+            self.chunks[k].place = (contacts, cursor);
+            for o in outcomes {
+                if o.contact.is_none() || o.seed_count == 0 {
+                    o.staged = u32::MAX;
+                    continue;
+                }
+                (o.staged, o.first_sub) = (contacts, cursor);
+                contacts += 1;
+                cursor += o.seed_count;
+                if self.staging_spread {
+                    self.segment_subs += o.seed_count;
+                    if (contacts as usize).is_multiple_of(SEGMENT) {
+                        cursor += segment_slack(self.segment_subs);
+                        self.segment_subs = 0;
+                    }
+                }
+            }
+        }
+        self.staging.placed = (contacts as usize, cursor as usize);
     }
 }
 
@@ -166,11 +191,9 @@ impl<S> Default for DetectionScratch<S> {
             splice_mode: SpliceMode::Any,
             reindex: false,
             tested: Vec::new(),
-            pairs: Vec::new(),
-            references: Vec::new(),
-            wrenches: Vec::new(),
-            subs: Vec::new(),
-            records: Vec::new(),
+            staging: StagedLists::default(),
+            staging_spread: false,
+            segment_subs: 0,
         }
     }
 }
@@ -421,8 +444,10 @@ struct Outcome {
     /// The contact's seeds in its chunk's buffer.
     first_seed: u32,
     seed_count: u32,
-    /// Its index in the staging lists, once staged (else `u32::MAX`).
+    /// Its index in the staging lists, once placed (else `u32::MAX`), and that of its first
+    /// sub-contact.
     staged: u32,
+    first_sub: u32,
 }
 
 impl Default for Outcome {
@@ -439,21 +464,20 @@ impl Default for Outcome {
             first_seed: 0,
             seed_count: 0,
             staged: u32::MAX,
+            first_sub: 0,
         }
     }
 }
 
-/// One task's buffers of the parallel narrow phase.
+/// One task's buffers of the parallel narrow phase: the seeds of its contacts, and where it
+/// stages them.
 #[derive(Debug, Clone, Default)]
 struct ChunkScratch {
     narrow: NarrowPhaseScratch,
     seeds: Vec<SubcontactSeed>,
-}
-
-impl ChunkScratch {
-    fn seeds(&self, o: &Outcome) -> &[SubcontactSeed] {
-        &self.seeds[o.first_seed as usize..(o.first_seed + o.seed_count) as usize]
-    }
+    /// The index of its first staged contact and of that contact's first sub-contact in the
+    /// staging lists (those of the next one when it stages none).
+    place: (u32, u32),
 }
 
 /// What the parallel narrow phase reads.
@@ -513,6 +537,7 @@ impl PairTest<'_> {
                 first_seed: first as u32,
                 seed_count: (scratch.seeds.len() - first) as u32,
                 staged: u32::MAX,
+                first_sub: 0,
                 contact: found,
             };
         }
@@ -745,8 +770,13 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             pairs: &self.pairs,
         };
         // In batches, so that the seeds of a full detection are not all held at once: the tests
-        // of a batch in parallel, then its contacts staged in order.
-        ContactLists::of(sc).clear();
+        // of a batch in parallel; the places of its contacts in the staging lists, in plan
+        // order; then each task writes its contacts into its part of the lists, in parallel.
+        // A full detection stages its contacts in a fresh layout (`place_subcontacts`): dead
+        // room after every `SEGMENT` contacts.
+        sc.staging.lists().clear();
+        sc.staging_spread = full;
+        sc.segment_subs = 0;
         for start in (0..sc.plan.len()).step_by(BATCH) {
             let batch = start..(start + BATCH).min(sc.plan.len());
             sc.outcomes[batch.clone()]
@@ -754,7 +784,22 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 .zip(sc.plan[batch.clone()].par_chunks(chunk))
                 .zip(sc.chunks.par_iter_mut())
                 .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
-            self.stage(sc, batch)?;
+            let tasks = batch.len().div_ceil(chunk);
+            sc.place_staged(batch.clone(), chunk);
+            let slices = sc.staging.grow();
+            self.stage(
+                &mut sc.chunks[..tasks],
+                &sc.plan[batch.clone()],
+                &mut sc.outcomes[batch],
+                chunk,
+                slices,
+            )?;
+        }
+        if sc.staging_spread && sc.staging.pairs.len().is_multiple_of(SEGMENT) {
+            // No dead room after the last segment.
+            let end = sc.staging.pairs.last().map_or(0, |p| (p.first + p.count) as usize);
+            sc.staging.subs.truncate(end);
+            sc.staging.records.truncate(end);
         }
         let index = BlockIndex {
             offsets: &pipeline.block_offsets,
@@ -821,34 +866,57 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         Ok(())
     }
 
-    /// Stages the contacts the narrow phase found in the planned pairs `batch` (in order), with
-    /// the history of the old ones, and notes where in their outcomes.
-    fn stage(&self, sc: &mut DetectionScratch<L::State>, batch: std::ops::Range<usize>) -> Result<()> {
+    /// Stages the contacts the narrow phase found in the planned pairs of `chunks` (`chunk`
+    /// pairs each, the last one possibly fewer) at the places [`DetectionScratch::place_staged`]
+    /// gave them, with the history of the old ones: the tasks in parallel, each into its part of
+    /// the staging lists. The error is the first in plan order (a missing joint law).
+    fn stage(
+        &self,
+        chunks: &mut [ChunkScratch],
+        plan: &[Planned],
+        outcomes: &mut [Outcome],
+        chunk: usize,
+        slices: StagingSlices<'_, L::State>,
+    ) -> Result<()> {
+        if chunks.len() > 1 {
+            let mid = chunks.len() / 2;
+            let (pair, sub) = chunks[mid].place;
+            let (slices_a, slices_b) = slices.split_at(pair as usize, sub as usize);
+            let (chunks_a, chunks_b) = chunks.split_at_mut(mid);
+            let (plan_a, plan_b) = plan.split_at(mid * chunk);
+            let (outcomes_a, outcomes_b) = outcomes.split_at_mut(mid * chunk);
+            let (a, b) = rayon::join(
+                || self.stage(chunks_a, plan_a, outcomes_a, chunk, slices_a),
+                || self.stage(chunks_b, plan_b, outcomes_b, chunk, slices_b),
+            );
+            return a.and(b);
+        }
+        let Some(scratch) = chunks.first() else { return Ok(()) };
         let old = OldContacts {
             pairs: &self.pairs,
             references: &self.references,
             subs: &self.subs,
             records: &self.sub_records,
         };
-        let (first, chunk) = (batch.start, plan_chunk(sc.plan.len()));
-        for k in batch {
-            let (p, o) = (&sc.plan[k], &mut sc.outcomes[k]);
-            let Some(dc) = o.contact.take() else { continue };
-            if o.seed_count == 0 {
+        let mut slices = slices;
+        for (p, o) in plan.iter().zip(outcomes) {
+            if o.staged == u32::MAX {
                 continue;
             }
-            let seeds = sc.chunks[(k - first) / chunk].seeds(o);
+            let Some(dc) = o.contact.take() else { continue };
+            let seeds = &scratch.seeds[o.first_seed as usize..(o.first_seed + o.seed_count) as usize];
             let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let law = self.law_index(p.a, p.b)?;
-            o.staged = sc.pairs.len() as u32;
-            let mut staged = ContactLists {
-                pairs: &mut sc.pairs,
-                references: &mut sc.references,
-                wrenches: &mut sc.wrenches,
-                subs: &mut sc.subs,
-                records: &mut sc.records,
-            };
-            staged.add_detected(&old, p.old_contact(), (p.a, bi), (p.b, bj), &dc, law, seeds);
+            slices.write_detected(
+                (o.staged, o.first_sub),
+                &old,
+                p.old_contact(),
+                (p.a, bi),
+                (p.b, bj),
+                &dc,
+                law,
+                seeds,
+            );
         }
         Ok(())
     }
@@ -904,7 +972,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let room = self.subs.len() as u32;
         let mut needed = room;
         let mut window_end = 0;
-        let count = |staged: u32| sc.pairs[staged as usize].count;
+        let count = |staged: u32| sc.staging.pairs[staged as usize].count;
         for r in 0..sc.replaced.len() {
             let Replaced { contact: k, staged, .. } = sc.replaced[r];
             let k = k as usize;
@@ -959,7 +1027,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let dt = if self.drift > 0.0 { self.drift } else { self.dt };
         let mut owed = (0.0, 0.0);
         for r in &sc.replaced {
-            let successor = (&sc.pairs[r.staged as usize], sc.records.as_slice());
+            let successor = (&sc.staging.pairs[r.staged as usize], sc.staging.records.as_slice());
             add_dropped_work(
                 &old,
                 r.contact as usize,
@@ -994,19 +1062,19 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         for r in &sc.replaced {
             let (k, s) = (r.contact as usize, r.staged as usize);
-            let q = &sc.pairs[s];
+            let q = &sc.staging.pairs[s];
             let to = r.first as usize..(r.first + q.count) as usize;
-            self.subs[to.clone()].clone_from_slice(&sc.subs[q.range()]);
-            self.sub_records[to].clone_from_slice(&sc.records[q.range()]);
+            self.subs[to.clone()].clone_from_slice(&sc.staging.subs[q.range()]);
+            self.sub_records[to].clone_from_slice(&sc.staging.records[q.range()]);
             self.pairs[k] = q.clone();
             self.pairs[k].first = r.first;
-            self.references[k] = sc.references[s].clone();
-            self.wrenches[k] = sc.wrenches[s];
+            self.references[k] = sc.staging.references[s].clone();
+            self.wrenches[k] = sc.staging.wrenches[s];
         }
         sc.reindex = false;
         sc.splices.in_place += 1;
         sc.splices.pushed += u64::from(!sc.pushed.is_empty() || needed > room);
-        if STAGING_FRACTION * sc.subs.capacity() > self.subs.len().max(1) {
+        if STAGING_FRACTION * sc.staging.subs.capacity() > self.subs.len().max(1) {
             sc.release_staging();
         }
         Some(owed)
@@ -1061,7 +1129,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         let owed = dropped_work(
             &old,
-            (&sc.pairs, &sc.records),
+            (&sc.staging.pairs, &sc.staging.records),
             &sc.kept,
             &self.blocks,
             self.params.mode,
@@ -1071,23 +1139,25 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             || sc.layout.iter().enumerate().any(|(k, slot)| match *slot {
                 Slot::Kept(c) => c as usize != k,
                 Slot::Staged { staged, .. } => {
-                    let q = &sc.pairs[staged as usize];
+                    let q = &sc.staging.pairs[staged as usize];
                     self.pairs.get(k).is_none_or(|p| (p.a, p.b) != (q.a, q.b))
                 }
             });
         if sc.layout.iter().all(|slot| matches!(slot, Slot::Staged { .. })) {
             // Every contact detected afresh (the first detection, a full one): the staging lists
             // are the new lists, and the old ones are released rather than kept as staging.
-            std::mem::swap(&mut self.pairs, &mut sc.pairs);
-            std::mem::swap(&mut self.references, &mut sc.references);
-            std::mem::swap(&mut self.wrenches, &mut sc.wrenches);
-            std::mem::swap(&mut self.subs, &mut sc.subs);
-            std::mem::swap(&mut self.sub_records, &mut sc.records);
+            std::mem::swap(&mut self.pairs, &mut sc.staging.pairs);
+            std::mem::swap(&mut self.references, &mut sc.staging.references);
+            std::mem::swap(&mut self.wrenches, &mut sc.staging.wrenches);
+            std::mem::swap(&mut self.subs, &mut sc.staging.subs);
+            std::mem::swap(&mut self.sub_records, &mut sc.staging.records);
             sc.release_staging();
-            sc.room_limit = room_limit(self.subs.len());
+            sc.room_limit = room_limit(self.pairs.iter().map(|p| p.count as usize).sum());
             sc.splices.full += 1;
             sc.splices.fresh += 1;
-            self.spread_segments();
+            if !sc.staging_spread {
+                self.spread_segments();
+            }
             return Ok(owed);
         }
         // Where each contact goes: its index in `layout`, its sub-contacts from `firsts`, with
@@ -1095,7 +1165,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let (end, limit, fresh) = place_subcontacts(
             &sc.layout,
             &self.pairs,
-            &sc.pairs,
+            &sc.staging.pairs,
             self.subs.len() as u32,
             sc.room_limit == 0 || sc.fresh_forced(),
             &mut sc.firsts,
@@ -1106,7 +1176,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let (contacts, room) = (sc.layout.len(), end as usize);
         if contacts > self.pairs.len() {
             // Room for the new contacts (the fillers are overwritten below).
-            let filler = (sc.pairs[0].clone(), sc.references[0].clone());
+            let filler = (sc.staging.pairs[0].clone(), sc.staging.references[0].clone());
             self.pairs.resize(contacts, filler.0);
             self.references.resize(contacts, filler.1);
             self.wrenches.resize(contacts, ContactWrench::default());
@@ -1169,14 +1239,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             match *slot {
                 Slot::Kept(_) => lists.pairs[k].first = first,
                 Slot::Staged { staged: s, .. } => {
-                    let q = &sc.pairs[s as usize];
+                    let q = &sc.staging.pairs[s as usize];
                     let (from, to) = (q.range(), first as usize..(first + q.count) as usize);
-                    lists.subs[to.clone()].clone_from_slice(&sc.subs[from.clone()]);
-                    lists.records[to].clone_from_slice(&sc.records[from]);
+                    lists.subs[to.clone()].clone_from_slice(&sc.staging.subs[from.clone()]);
+                    lists.records[to].clone_from_slice(&sc.staging.records[from]);
                     lists.pairs[k] = q.clone();
                     lists.pairs[k].first = first;
-                    lists.references[k] = sc.references[s as usize].clone();
-                    lists.wrenches[k] = sc.wrenches[s as usize];
+                    lists.references[k] = sc.staging.references[s as usize].clone();
+                    lists.wrenches[k] = sc.staging.wrenches[s as usize];
                 }
             }
         }
@@ -1185,7 +1255,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         self.wrenches.truncate(contacts);
         self.subs.truncate(room);
         self.sub_records.truncate(room);
-        if STAGING_FRACTION * sc.subs.capacity() > self.subs.len().max(1) {
+        if STAGING_FRACTION * sc.staging.subs.capacity() > self.subs.len().max(1) {
             sc.release_staging();
         }
         Ok(owed)
@@ -1322,6 +1392,39 @@ fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord) {
     (sub, SubContactRecord::new(SubKey(0)))
 }
 
+/// A contact and its reference to fill room in the staging lists with until a contact is
+/// written there.
+fn dead_contact() -> (ContactPair, ContactReference) {
+    let pair = ContactPair {
+        a: 0,
+        b: 0,
+        kind: crate::geometry::ContactKind::Point {
+            plane_normal: Vector::ZERO,
+            plane_offset: 0.0,
+        },
+        host_is_a: true,
+        law: 0,
+        first: 0,
+        count: 0,
+        normal: Vector::ZERO,
+        tangent: Vector::ZERO,
+        anchors: AnchorPlane::default(),
+        plane_normal: Vector::ZERO,
+        plane_offset: 0.0,
+        dashpots: true,
+        normal_force: 0.0,
+        springs: ForceMoments::default(),
+    };
+    let reference = ContactReference {
+        ref_a: Vector::ZERO,
+        ref_b: Vector::ZERO,
+        ref_host_rotation: crate::math::Rotation::IDENTITY,
+        area: 0.0,
+        bound_area: 0.0,
+    };
+    (pair, reference)
+}
+
 /// The contact lists before a re-detection, for [`dropped_work`].
 struct OldContacts<'a, S> {
     pairs: &'a [ContactPair],
@@ -1340,15 +1443,68 @@ struct ContactLists<'a, S> {
     records: &'a mut Vec<SubContactRecord>,
 }
 
-impl<'a, S> ContactLists<'a, S> {
-    /// The staging lists of `sc`.
-    fn of(sc: &'a mut DetectionScratch<S>) -> Self {
+/// Contacts staged by detection: the contact lists' own (owned) form, of the whole detection
+/// and of each task of its narrow phase.
+#[derive(Debug, Clone)]
+struct StagedLists<S> {
+    pairs: Vec<ContactPair>,
+    references: Vec<ContactReference>,
+    wrenches: Vec<ContactWrench>,
+    subs: Vec<SubContact<S>>,
+    records: Vec<SubContactRecord>,
+    /// The contacts and sub-contacts (dead room included) placed so far.
+    placed: (usize, usize),
+}
+
+impl<S> Default for StagedLists<S> {
+    fn default() -> Self {
         Self {
-            pairs: &mut sc.pairs,
-            references: &mut sc.references,
-            wrenches: &mut sc.wrenches,
-            subs: &mut sc.subs,
-            records: &mut sc.records,
+            pairs: Vec::new(),
+            references: Vec::new(),
+            wrenches: Vec::new(),
+            subs: Vec::new(),
+            records: Vec::new(),
+            placed: (0, 0),
+        }
+    }
+}
+
+impl<S> StagedLists<S> {
+    fn lists(&mut self) -> ContactLists<'_, S> {
+        ContactLists {
+            pairs: &mut self.pairs,
+            references: &mut self.references,
+            wrenches: &mut self.wrenches,
+            subs: &mut self.subs,
+            records: &mut self.records,
+        }
+    }
+}
+
+impl<S: Clone + Default + Send + Sync> StagedLists<S> {
+    /// Extends the lists to the places [`DetectionScratch::place_staged`] gave (`placed`), with
+    /// dead entries written in parallel (the first touch of a large list's memory is most of
+    /// its cost), and returns the slices of the new entries, for the contacts to be written.
+    fn grow(&mut self) -> StagingSlices<'_, S> {
+        let (pair_base, sub_base) = (self.pairs.len(), self.subs.len());
+        let (contacts, subs) = self.placed;
+        let (pair, reference) = dead_contact();
+        let (sub, record) = dead_subcontact();
+        self.pairs.par_extend(rayon::iter::repeat_n(pair, contacts - pair_base));
+        self.references
+            .par_extend(rayon::iter::repeat_n(reference, contacts - pair_base));
+        self.wrenches
+            .par_extend(rayon::iter::repeat_n(ContactWrench::default(), contacts - pair_base));
+        self.subs.par_extend(rayon::iter::repeat_n(sub, subs - sub_base));
+        self.records.par_extend(rayon::iter::repeat_n(record, subs - sub_base));
+        StagingSlices {
+            pair_base,
+            sub_base,
+            pairs: &mut self.pairs[pair_base..],
+            references: &mut self.references[pair_base..],
+            wrenches: &mut self.wrenches[pair_base..],
+            subs: &mut self.subs[sub_base..],
+            records: &mut self.records[sub_base..],
         }
     }
 }
@@ -1361,13 +1517,62 @@ impl<S: Clone + Default> ContactLists<'_, S> {
         self.subs.clear();
         self.records.clear();
     }
+}
 
-    /// Adds the contact the narrow phase found between blocks `i < j` (`seeds` its sub-contacts,
-    /// `law` the index of its joint law), carrying the history of old contact `k_old` by
-    /// sub-contact key when it joins the same features with the same host.
+/// Slices of the staging lists that one task of the narrow phase writes its contacts into:
+/// `pairs[0]` is contact `pair_base` of the detection, `subs[0]` its sub-contact `sub_base`.
+struct StagingSlices<'a, S> {
+    pair_base: usize,
+    sub_base: usize,
+    pairs: &'a mut [ContactPair],
+    references: &'a mut [ContactReference],
+    wrenches: &'a mut [ContactWrench],
+    subs: &'a mut [SubContact<S>],
+    records: &'a mut [SubContactRecord],
+}
+
+impl<'a, S> StagingSlices<'a, S> {
+    /// The slices from contact `pair` and sub-contact `sub` of the detection on (the second
+    /// part), and those before (the first).
+    fn split_at(self, pair: usize, sub: usize) -> (Self, Self) {
+        let (p, s) = (pair - self.pair_base, sub - self.sub_base);
+        let (pairs_a, pairs_b) = self.pairs.split_at_mut(p);
+        let (references_a, references_b) = self.references.split_at_mut(p);
+        let (wrenches_a, wrenches_b) = self.wrenches.split_at_mut(p);
+        let (subs_a, subs_b) = self.subs.split_at_mut(s);
+        let (records_a, records_b) = self.records.split_at_mut(s);
+        (
+            Self {
+                pair_base: self.pair_base,
+                sub_base: self.sub_base,
+                pairs: pairs_a,
+                references: references_a,
+                wrenches: wrenches_a,
+                subs: subs_a,
+                records: records_a,
+            },
+            Self {
+                pair_base: pair,
+                sub_base: sub,
+                pairs: pairs_b,
+                references: references_b,
+                wrenches: wrenches_b,
+                subs: subs_b,
+                records: records_b,
+            },
+        )
+    }
+}
+
+impl<S: Clone + Default> StagingSlices<'_, S> {
+    /// Writes the contact the narrow phase found between blocks `i < j` as contact `staged` of
+    /// the detection, its sub-contacts (`seeds`) from `first` on (`law` the index of its joint
+    /// law), carrying the history of old contact `k_old` by sub-contact key when it joins the
+    /// same features with the same host.
     #[allow(clippy::too_many_arguments)]
-    fn add_detected(
+    fn write_detected(
         &mut self,
+        (staged, first): (u32, u32),
         old: &OldContacts<'_, S>,
         k_old: Option<usize>,
         (i, bi): (u32, &RigidBlock),
@@ -1393,8 +1598,12 @@ impl<S: Clone + Default> ContactLists<'_, S> {
         };
         let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
         let anchors = AnchorPlane::through(seeds.iter().map(|s| s.anchor));
-        let first = self.subs.len() as u32;
-        for seed in seeds {
+        let at = first as usize - self.sub_base;
+        let (subs, records) = (
+            &mut self.subs[at..at + seeds.len()],
+            &mut self.records[at..at + seeds.len()],
+        );
+        for ((seed, sub_slot), record_slot) in seeds.iter().zip(subs.iter_mut()).zip(records.iter_mut()) {
             let mut sub = SubContact {
                 plane: anchors.coordinates(seed.anchor),
                 area: seed.area,
@@ -1413,8 +1622,8 @@ impl<S: Clone + Default> ContactLists<'_, S> {
                 sub.state = o.state.clone();
                 record = old_records[k].clone();
             }
-            self.subs.push(sub);
-            self.records.push(record);
+            *sub_slot = sub;
+            *record_slot = record;
         }
         let mut pair = ContactPair {
             a: i,
@@ -1434,16 +1643,17 @@ impl<S: Clone + Default> ContactLists<'_, S> {
             springs: ForceMoments::default(),
         };
         pair.cache_local_faces(bi.shape(), bj.shape());
-        pair.refresh_springs(self.subs);
-        self.pairs.push(pair);
-        self.wrenches.push(ContactWrench::default());
-        self.references.push(ContactReference {
+        pair.refresh_springs(subs);
+        let k = staged as usize - self.pair_base;
+        self.pairs[k] = pair;
+        self.wrenches[k] = ContactWrench::default();
+        self.references[k] = ContactReference {
             ref_a: bi.state.pose.translation,
             ref_b: bj.state.pose.translation,
             ref_host_rotation: host.state.pose.rotation,
             area: seeds.iter().map(|s| s.area).sum(),
             bound_area,
-        });
+        };
     }
 }
 

@@ -360,15 +360,21 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// Replaces the global parameters (gravity, contact parameters, time step, mode).
     ///
+    /// New contact parameters or a new mode detect every contact afresh at the next step;
+    /// once the model has stepped, other changes (gravity, the step's choice, the speed limit,
+    /// the impact step) re-evaluate the critical step at once and keep the contacts; the same
+    /// parameters change nothing.
+    ///
     /// # Errors
-    /// As [`ModelParameters::validate`].
+    /// As [`ModelParameters::validate`]; [`Error::TimeStepTooLarge`] for a fixed step above the
+    /// limit of the current contacts (the parameters are then left as they were).
     pub fn set_parameters(&mut self, params: ModelParameters) -> Result<()> {
         params.validate()?;
         for b in &self.state.blocks {
             params.contact.check_block(b.shape().radius(), b.name())?;
         }
         let old = std::mem::replace(&mut self.state.params, params);
-        if params.contact != old.contact || params.mode != old.mode {
+        if !self.state.started || params.contact != old.contact || params.mode != old.mode {
             // Contacts are detected and discretised afresh with the new contact parameters.
             self.state.changes.insert(Changes::PARAMETERS);
         } else if params != old {
@@ -404,6 +410,11 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// Sets the fixity of a block.
     ///
+    /// Costs what the block's neighbourhood costs, not the model's: the critical step is
+    /// re-evaluated for the block and those in contact with it, and the next step looks at the
+    /// block's pairs as if it had moved (a released block meets the fixed blocks it had no
+    /// contact with; a fixed one drops its contacts with fixed blocks).
+    ///
     /// # Errors
     /// [`Error::UnknownBlock`], [`Error::NonFinite`] for a NaN prescribed velocity.
     pub fn set_fixity(&mut self, id: BlockId, fixity: Fixity) -> Result<()> {
@@ -414,10 +425,10 @@ impl<L: ConstitutiveLaw> Model<L> {
             b.replace_fixity(old);
             return Err(e);
         }
-        if let Err(e) = self.state.refresh_time_step(&mut self.pipeline) {
+        if let Err(e) = self.state.refresh_time_step_around(&mut self.pipeline, id.0) {
             let b = self.block_mut(id)?;
             b.replace_fixity(old);
-            let _ = self.state.refresh_time_step(&mut self.pipeline);
+            let _ = self.state.refresh_time_step_around(&mut self.pipeline, id.0);
             return Err(e);
         }
         // A released block may touch blocks it had no contact with while both were fixed, and
@@ -1019,7 +1030,7 @@ mod tests {
             sub.force.shear = crate::math::Vector2::new(30.0 - i as Real, 5.0 + 2.0 * i as Real);
             sub.status = JointStatus::Elastic;
         }
-        let subs = model.state.subs.clone();
+        let subs = model.state.subs[model.state.pairs[0].range()].to_vec();
         model.state.pairs[0].refresh_springs(&subs);
         let world_shears = |m: &Model| -> Vec<(SubKey, Vector)> {
             let view = m.contacts().next().expect("the joint");

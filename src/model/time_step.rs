@@ -6,7 +6,7 @@ use super::ModelState;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 
-use crate::integrate::{block_bound, AreaMoments, ContactStiffness, StiffnessBound, TimeStep};
+use crate::integrate::{block_bound, contact_eigenvalues, AreaMoments, ContactStiffness, StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Real, Vector};
 
@@ -26,7 +26,15 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             reference.bound_area = reference.area;
         }
         pipeline.bounds.resize(n, StiffnessBound::default());
-        let sources = self.bound_sources(&pipeline.block_offsets, &pipeline.block_contacts);
+        let mut sources = self.bound_sources(&pipeline.block_offsets, &pipeline.block_contacts);
+        // Each contact's eigenvalues once (each block would otherwise take both of each of
+        // its contacts: four per contact).
+        let eigenvalues: Vec<[Real; 2]> = (0..self.pairs.len())
+            .into_par_iter()
+            .with_min_len(CONTACTS_PER_TASK)
+            .map(|k| contact_eigenvalues(&self.blocks, &sources.contact(k)))
+            .collect();
+        sources.eigenvalues = Some(&eigenvalues);
         pipeline
             .bounds
             .par_iter_mut()
@@ -46,6 +54,28 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 blocks.extend([self.pairs[k].a, self.pairs[k].b]);
             }
         }
+    }
+
+    /// Re-evaluates the bounds of block `i` and of the blocks in contact with it (whose bounds
+    /// couple with its own through its fixity), then the critical step: what a change of `i`'s
+    /// fixity changes, without a pass over every block. The whole evaluation when the block →
+    /// contact index or the bounds are not up to date (blocks added since the last step).
+    pub(super) fn refresh_time_step_around(&mut self, pipeline: &mut Pipeline<L::State>, i: u32) -> Result<()> {
+        let n = self.blocks.len();
+        let offsets = &pipeline.block_offsets;
+        if offsets.len() != n + 1 || offsets[n] as usize != 2 * self.pairs.len() || pipeline.bounds.len() != n {
+            return self.refresh_time_step(pipeline);
+        }
+        let mut blocks = std::mem::take(&mut pipeline.refresh_blocks);
+        blocks.clear();
+        blocks.push(i);
+        let entries = &pipeline.block_contacts[offsets[i as usize] as usize..offsets[i as usize + 1] as usize];
+        for &e in entries {
+            let p = &self.pairs[(e / 2) as usize];
+            blocks.extend([p.a, p.b]);
+        }
+        pipeline.refresh_blocks = blocks;
+        self.refresh_time_step_of_grown(pipeline)
     }
 
     /// Re-evaluates the bounds of the blocks in `pipeline.refresh_blocks` (those of the grown
@@ -75,6 +105,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             state: self,
             offsets,
             contacts,
+            eigenvalues: None,
             k_max: self
                 .laws
                 .laws()
@@ -128,14 +159,26 @@ struct BoundSources<'a, L: ConstitutiveLaw> {
     state: &'a ModelState<L>,
     offsets: &'a [u32],
     contacts: &'a [u32],
+    /// Each contact's [`contact_eigenvalues`], when computed for all of them beforehand.
+    eigenvalues: Option<&'a [[Real; 2]]>,
     k_max: Real,
 }
+
+/// Contacts per task of the parallel pass over every contact's eigenvalues.
+const CONTACTS_PER_TASK: usize = 256;
 
 impl<L: ConstitutiveLaw> BoundSources<'_, L> {
     /// Block `i`'s bound, from its contacts in contact order.
     fn bound(&self, i: usize) -> StiffnessBound {
         let entries = &self.contacts[self.offsets[i] as usize..self.offsets[i + 1] as usize];
-        let contacts = entries.iter().map(|&e| self.contact((e / 2) as usize));
+        let contacts = entries.iter().map(|&e| {
+            let k = (e / 2) as usize;
+            let c = self.contact(k);
+            let eigenvalues = self
+                .eigenvalues
+                .map_or_else(|| contact_eigenvalues(&self.state.blocks, &c), |all| all[k]);
+            (c, eigenvalues)
+        });
         block_bound(&self.state.blocks, i, contacts, self.k_max)
     }
 
