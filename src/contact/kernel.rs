@@ -280,8 +280,10 @@ fn impact_probe<L: ConstitutiveLaw>(
 }
 
 /// The sub-contacts of a contact without dashpot forces, for a law with an [`ElasticRegime`]:
-/// a virgin sub-contact whose trial forces stand takes them directly; the others (open, sliding,
-/// failed) go through the law exactly as in the one-at-a-time loop. `face` holds the gap
+/// a virgin sub-contact whose trial forces stand, or slide in a regime that slides
+/// ([`ElasticRegime::step`]), takes them directly (a slide booked as `update_with_law` books
+/// it); the others (open, failed, sliding in a regime that does not) go through the law exactly
+/// as in the one-at-a-time loop. `face` holds the gap
 /// coefficients (large displacements), `None` for gaps carried incrementally. Returns the
 /// spring-force sums in the joint axes, taken in sub-contact order, and the energy the law
 /// dissipated.
@@ -307,10 +309,23 @@ fn update_elastic_first<L: ConstitutiveLaw>(
         };
         let du_s = Vector2::new(du_1, du_2);
         if sub.state == virgin {
-            if let Some(force) = regime.trial(sub.area, gap, du_s, sub.force.shear) {
+            if let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) {
+                if status == JointStatus::Sliding {
+                    // As `update_with_law` books a slide: the shear spring's work less the
+                    // change of its energy.
+                    let before = sub.force.shear;
+                    let work = -0.5 * (before + force.shear).dot(du_s);
+                    let ks_area = regime.shear_stiffness * sub.area;
+                    dissipated += if ks_area > 0.0 {
+                        work - 0.5 * (force.shear.length_squared() - before.length_squared()) / ks_area
+                    } else {
+                        work
+                    };
+                    sub.slip += du_s.length();
+                }
                 sub.force = force;
                 sub.gap = gap;
-                sub.status = JointStatus::Elastic;
+                sub.status = status;
                 sums.add_joint(&force, sub.plane);
                 continue;
             }

@@ -8,9 +8,12 @@
 //!   displacements (both zeros, and `1e-300`, 1, 2 and 5 per decade from `1e-12` to `5e-2`,
 //!   and `0.1` m, of both signs), shear increments, carried shear forces (from zero to several
 //!   times the normal force and the cohesion), carried normal forces, axes and time steps,
-//!   wherever [`ElasticRegime::trial`](super::ElasticRegime::trial) stands for a virgin
-//!   sub-contact, `update` returns [`JointStatus::Elastic`], exactly the trial's forces (the
-//!   same bits) and the virgin state.
+//!   wherever [`ElasticRegime::step`](super::ElasticRegime::step) gives forces for a virgin
+//!   sub-contact (the trial standing, or for a regime that
+//!   [`slides`](super::ElasticRegime::slides), the slide), `update` returns its status
+//!   ([`JointStatus::Elastic`] or [`JointStatus::Sliding`]), exactly its forces (the same bits)
+//!   and the virgin state; and `step` stands exactly where
+//!   [`ElasticRegime::trial`](super::ElasticRegime::trial) does.
 //! * **`stays_open`** ([`Clause::StaysOpen`]): for every state the histories reach (and any you
 //!   give to [`check_with_states`]), every area and normal displacement of the grid, wherever
 //!   `stays_open` promises, `update` from zero forces returns [`JointStatus::Open`], zero forces
@@ -327,7 +330,17 @@ impl<L: ConstitutiveLaw> Checker<'_, L> {
                 }
                 for &du in &increments {
                     for &shear in &carried {
-                        let Some(trial) = regime.trial(area, gap, du, shear) else {
+                        let stepped = regime.step(area, gap, du, shear);
+                        let elastic = stepped.filter(|(_, status)| *status == JointStatus::Elastic);
+                        if elastic.map(|(force, _)| bits(&force))
+                            != regime.trial(area, gap, du, shear).map(|f| bits(&f))
+                        {
+                            return fail(
+                                Clause::ElasticRegime,
+                                format!("{regime:?}: `step` and `trial` disagree at area {area}, gap {gap}, du {du:?}"),
+                            );
+                        }
+                        let Some((trial, expected)) = stepped else {
                             self.report.regime_declined += 1;
                             continue;
                         };
@@ -347,13 +360,13 @@ impl<L: ConstitutiveLaw> Checker<'_, L> {
                                     shear,
                                 };
                                 let (status, force, state) = self.update(&step, before, &virgin)?;
-                                if status != JointStatus::Elastic || bits(&force) != bits(&trial) || state != virgin {
+                                if status != expected || bits(&force) != bits(&trial) || state != virgin {
                                     return fail(
                                         Clause::ElasticRegime,
                                         format!(
-                                            "{step:?} from {before:?} in the virgin state: the trial \
-                                             of {regime:?} stands with {trial:?}, but `update` returned \
-                                             {status:?}, {force:?}, state {state:?}"
+                                            "{step:?} from {before:?} in the virgin state: the step \
+                                             of {regime:?} gives {expected:?} with {trial:?}, but `update` \
+                                             returned {status:?}, {force:?}, state {state:?}"
                                         ),
                                     );
                                 }
@@ -676,8 +689,11 @@ mod tests {
         OpenKeepsShear,
         /// Elastic energy of the wrong sign.
         NegativeEnergy,
-        /// Gives energy back while sliding: the shear force pushes along the slip.
+        /// Gives energy back while sliding: the shear force pushes along the slip (and does not
+        /// claim that its regime slides).
         ActiveSlip,
+        /// The same, claiming that its regime slides as Coulomb's does.
+        ActiveSlipInRegime,
         /// Returns a different force every other call.
         Flaky,
     }
@@ -702,7 +718,9 @@ mod tests {
                     force.normal = -self.law.normal_stiffness() * (step.normal_displacement * step.area);
                 }
                 Flaw::OpenKeepsShear if status == JointStatus::Open => force.shear = before,
-                Flaw::ActiveSlip if status == JointStatus::Sliding => force.shear = -force.shear,
+                Flaw::ActiveSlip | Flaw::ActiveSlipInRegime if status == JointStatus::Sliding => {
+                    force.shear = -force.shear
+                }
                 Flaw::Flaky => {
                     use std::sync::atomic::{AtomicU64, Ordering};
                     static CALLS: AtomicU64 = AtomicU64::new(0);
@@ -725,6 +743,10 @@ mod tests {
             Some(match self.flaw {
                 Flaw::StifferRegime => ElasticRegime {
                     normal_stiffness: regime.normal_stiffness * 1.001,
+                    ..regime
+                },
+                Flaw::ActiveSlip => ElasticRegime {
+                    slides: false,
                     ..regime
                 },
                 _ => regime,
@@ -753,6 +775,7 @@ mod tests {
             (bonded, Flaw::OpenKeepsShear, Clause::OpenWithForce),
             (dry, Flaw::NegativeEnergy, Clause::ElasticEnergy),
             (dry, Flaw::ActiveSlip, Clause::Dissipation),
+            (dry, Flaw::ActiveSlipInRegime, Clause::ElasticRegime),
             (dry, Flaw::Flaky, Clause::Determinism),
         ] {
             let error = check(&Broken { law, flaw }).expect_err(&format!("{flaw:?} passed"));

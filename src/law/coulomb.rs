@@ -214,7 +214,9 @@ impl ConstitutiveLaw for CoulombSlip {
         }
     }
 
-    /// Intact joint in compression below its strength: `c` and `tan φ` (peak values).
+    /// Intact joint in compression below its strength: `c` and `tan φ` (peak values); sliding
+    /// too when nothing fails as it slides (no cohesion, no tensile strength, residual friction
+    /// equal to the peak: a dry joint).
     #[inline]
     fn elastic_regime(&self) -> Option<ElasticRegime> {
         Some(ElasticRegime {
@@ -222,6 +224,7 @@ impl ConstitutiveLaw for CoulombSlip {
             shear_stiffness: self.shear_stiffness,
             cohesion: self.cohesion,
             tan_friction: self.tan_friction,
+            slides: self.cohesion == 0.0 && self.tensile_strength == 0.0 && self.tan_residual == self.tan_friction,
         })
     }
 

@@ -42,6 +42,7 @@ impl ConstitutiveLaw for LinearElastic {
             shear_stiffness: self.shear_stiffness,
             cohesion: 0.0,
             tan_friction: f64::INFINITY,
+            slides: false,
         })
     }
 

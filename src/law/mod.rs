@@ -145,6 +145,11 @@ pub struct ElasticRegime {
     pub cohesion: Real,
     /// Friction coefficient `tan φ` (may be infinite: no shear limit).
     pub tan_friction: Real,
+    /// Whether the regime also covers sliding: in compression beyond the strength, the law
+    /// scales the trial shear back onto it, `F_s ← F_s·(max(L, 0)/|F_s|)`, and leaves the state
+    /// as it is (no cohesion, tensile strength or peak friction to lose), returning
+    /// [`JointStatus::Sliding`] ([`ElasticRegime::step`]). `false` promises nothing.
+    pub slides: bool,
 }
 
 impl ElasticRegime {
@@ -165,6 +170,47 @@ impl ElasticRegime {
         let limit = self.cohesion * area + normal * self.tan_friction;
         let stands = normal > 0.0 && !(limit < 0.0 || shear.length_squared() > limit * limit);
         stands.then_some(JointForce { normal, shear })
+    }
+
+    /// As [`ElasticRegime::trial`], and when the trial shear exceeds the strength of a joint in
+    /// compression whose regime [`slides`](ElasticRegime::slides), the slid forces: the trial
+    /// shear scaled back onto the strength, with [`JointStatus::Sliding`]. `None` where the law's
+    /// own update decides.
+    ///
+    /// ```
+    /// use voussoir::law::{ConstitutiveLaw, CoulombSlip, JointStatus};
+    /// use voussoir::math::Vector2;
+    /// let regime = CoulombSlip::dry(1e9, 4e8, 45.0)?.elastic_regime().expect("a regime");
+    /// // 10 N of compression carries 10 N of shear; a trial of 20 N slides back onto it.
+    /// let (force, status) = regime.step(0.01, -1e-6, Vector2::new(-5e-6, 0.0), Vector2::ZERO).expect("slides");
+    /// assert_eq!(status, JointStatus::Sliding);
+    /// assert!((force.shear.x - 10.0).abs() < 1e-9);
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    #[inline(always)]
+    pub fn step(
+        &self,
+        area: Real,
+        normal_displacement: Real,
+        shear_increment: Vector2,
+        shear: Vector2,
+    ) -> Option<(JointForce, JointStatus)> {
+        let normal = -self.normal_stiffness * normal_displacement * area;
+        let shear = shear - shear_increment * (self.shear_stiffness * area);
+        let limit = self.cohesion * area + normal * self.tan_friction;
+        if normal <= 0.0 || normal.is_nan() {
+            return None;
+        }
+        let trial_squared = shear.length_squared();
+        if !(limit < 0.0 || trial_squared > limit * limit) {
+            return Some((JointForce { normal, shear }, JointStatus::Elastic));
+        }
+        if !self.slides {
+            return None;
+        }
+        let trial = trial_squared.sqrt();
+        let shear = shear * if trial > 0.0 { limit.max(0.0) / trial } else { 0.0 };
+        Some((JointForce { normal, shear }, JointStatus::Sliding))
     }
 }
 

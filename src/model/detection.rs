@@ -37,7 +37,9 @@ const BATCH: usize = 64 * MAX_PLAN_CHUNK;
 /// Planned pairs per task of the parallel narrow phase, at most: a batch is split in 64 tasks,
 /// of at least `MIN_PLAN_CHUNK` pairs (the few pairs of a local re-detection still run in
 /// parallel). Each pair's outcome depends on that pair alone, so the split does not change it.
-const MAX_PLAN_CHUNK: usize = 256;
+/// A batch's seeds are held at once (48 bytes each, about 17 per pair of a wall): 4,096 pairs
+/// hold 3 MB.
+const MAX_PLAN_CHUNK: usize = 64;
 const MIN_PLAN_CHUNK: usize = 4;
 
 /// The pairs per task of the narrow phase over `pairs` planned pairs.
@@ -132,6 +134,18 @@ impl<S> DetectionScratch<S> {
     /// Frees the staging lists (after they held a large share of the contacts).
     fn release_staging(&mut self) {
         self.staging = StagedLists::default();
+    }
+
+    /// Frees the buffers sized by a full detection's candidate pairs: the plan, the outcomes,
+    /// the candidates and the tasks' seeds.
+    fn release_full(&mut self) {
+        self.release_staging();
+        self.candidates = Vec::new();
+        self.plan = Vec::new();
+        self.outcomes = Vec::new();
+        for chunk in &mut self.chunks {
+            chunk.seeds = Vec::new();
+        }
     }
 
     /// Gives the contacts found in the planned pairs `batch` (tasks of `chunk` pairs) their
@@ -861,6 +875,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 self.changes.insert(Changes::DETECTION);
                 self.refresh_time_step_of_grown(pipeline)?;
             }
+        }
+        if full {
+            // A full detection's buffers (the plan and outcomes of every candidate pair, a
+            // batch's seeds) are not what the next, local detections need: freed.
+            pipeline.detection.release_full();
         }
         self.changes.clear();
         Ok(())
