@@ -1,0 +1,323 @@
+//! Staging the contacts a detection found: their places in the staging lists, in pair order,
+//! and each task of the narrow phase writing its contacts into its part of them.
+
+use rayon::prelude::*;
+
+use super::super::ModelState;
+use super::*;
+use crate::block::{Block, RigidBlock};
+use crate::contact::{
+    AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
+};
+use crate::error::Result;
+use crate::geometry::{DetectedContact, SubKey, SubcontactSeed};
+use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
+use crate::math::{Vector, Vector2};
+
+/// A sub-contact and a record to fill dead room with (never read).
+pub(super) fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord) {
+    let sub = SubContact {
+        plane: Vector2::ZERO,
+        area: 0.0,
+        gap: 0.0,
+        force: JointForce::default(),
+        slip: 0.0,
+        status: JointStatus::Open,
+        state: S::default(),
+    };
+    (sub, SubContactRecord::new(SubKey(0)))
+}
+
+/// A contact and its reference to fill room in the staging lists with until a contact is
+/// written there.
+pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
+    let pair = ContactPair {
+        a: 0,
+        b: 0,
+        kind: crate::geometry::ContactKind::Point {
+            plane_normal: Vector::ZERO,
+            plane_offset: 0.0,
+        },
+        host_is_a: true,
+        law: 0,
+        first: 0,
+        count: 0,
+        normal: Vector::ZERO,
+        tangent: Vector::ZERO,
+        anchors: AnchorPlane::default(),
+        plane_normal: Vector::ZERO,
+        plane_offset: 0.0,
+        dashpots: true,
+        normal_force: 0.0,
+        springs: ForceMoments::default(),
+    };
+    let reference = ContactReference {
+        ref_a: Vector::ZERO,
+        ref_b: Vector::ZERO,
+        ref_host_rotation: crate::math::Rotation::IDENTITY,
+        area: 0.0,
+        bound_area: 0.0,
+    };
+    (pair, reference)
+}
+
+/// Contacts staged by detection: the contact lists' own (owned) form, of the whole detection
+/// and of each task of its narrow phase.
+#[derive(Debug, Clone)]
+pub(super) struct StagedLists<S> {
+    pub(super) pairs: Vec<ContactPair>,
+    pub(super) references: Vec<ContactReference>,
+    pub(super) wrenches: Vec<ContactWrench>,
+    pub(super) subs: Vec<SubContact<S>>,
+    pub(super) records: Vec<SubContactRecord>,
+    /// The contacts and sub-contacts (dead room included) placed so far.
+    pub(super) placed: (usize, usize),
+}
+
+impl<S> Default for StagedLists<S> {
+    fn default() -> Self {
+        Self {
+            pairs: Vec::new(),
+            references: Vec::new(),
+            wrenches: Vec::new(),
+            subs: Vec::new(),
+            records: Vec::new(),
+            placed: (0, 0),
+        }
+    }
+}
+
+impl<S> StagedLists<S> {
+    pub(super) fn lists(&mut self) -> ContactLists<'_, S> {
+        ContactLists {
+            pairs: &mut self.pairs,
+            references: &mut self.references,
+            wrenches: &mut self.wrenches,
+            subs: &mut self.subs,
+            records: &mut self.records,
+        }
+    }
+}
+
+impl<S: Clone + Default + Send + Sync> StagedLists<S> {
+    /// Extends the lists to the places [`DetectionScratch::place_staged`] gave (`placed`), with
+    /// dead entries written in parallel (the first touch of a large list's memory is most of
+    /// its cost), and returns the slices of the new entries, for the contacts to be written.
+    pub(super) fn grow(&mut self) -> StagingSlices<'_, S> {
+        let (pair_base, sub_base) = (self.pairs.len(), self.subs.len());
+        let (contacts, subs) = self.placed;
+        let (pair, reference) = dead_contact();
+        let (sub, record) = dead_subcontact();
+        self.pairs.par_extend(rayon::iter::repeat_n(pair, contacts - pair_base));
+        self.references
+            .par_extend(rayon::iter::repeat_n(reference, contacts - pair_base));
+        self.wrenches
+            .par_extend(rayon::iter::repeat_n(ContactWrench::default(), contacts - pair_base));
+        self.subs.par_extend(rayon::iter::repeat_n(sub, subs - sub_base));
+        self.records.par_extend(rayon::iter::repeat_n(record, subs - sub_base));
+        StagingSlices {
+            pair_base,
+            sub_base,
+            pairs: &mut self.pairs[pair_base..],
+            references: &mut self.references[pair_base..],
+            wrenches: &mut self.wrenches[pair_base..],
+            subs: &mut self.subs[sub_base..],
+            records: &mut self.records[sub_base..],
+        }
+    }
+}
+
+/// Slices of the staging lists that one task of the narrow phase writes its contacts into:
+/// `pairs[0]` is contact `pair_base` of the detection, `subs[0]` its sub-contact `sub_base`.
+pub(super) struct StagingSlices<'a, S> {
+    pub(super) pair_base: usize,
+    pub(super) sub_base: usize,
+    pub(super) pairs: &'a mut [ContactPair],
+    pub(super) references: &'a mut [ContactReference],
+    pub(super) wrenches: &'a mut [ContactWrench],
+    pub(super) subs: &'a mut [SubContact<S>],
+    pub(super) records: &'a mut [SubContactRecord],
+}
+
+impl<'a, S> StagingSlices<'a, S> {
+    /// The slices from contact `pair` and sub-contact `sub` of the detection on (the second
+    /// part), and those before (the first).
+    pub(super) fn split_at(self, pair: usize, sub: usize) -> (Self, Self) {
+        let (p, s) = (pair - self.pair_base, sub - self.sub_base);
+        let (pairs_a, pairs_b) = self.pairs.split_at_mut(p);
+        let (references_a, references_b) = self.references.split_at_mut(p);
+        let (wrenches_a, wrenches_b) = self.wrenches.split_at_mut(p);
+        let (subs_a, subs_b) = self.subs.split_at_mut(s);
+        let (records_a, records_b) = self.records.split_at_mut(s);
+        (
+            Self {
+                pair_base: self.pair_base,
+                sub_base: self.sub_base,
+                pairs: pairs_a,
+                references: references_a,
+                wrenches: wrenches_a,
+                subs: subs_a,
+                records: records_a,
+            },
+            Self {
+                pair_base: pair,
+                sub_base: sub,
+                pairs: pairs_b,
+                references: references_b,
+                wrenches: wrenches_b,
+                subs: subs_b,
+                records: records_b,
+            },
+        )
+    }
+}
+
+impl<S: Clone + Default> StagingSlices<'_, S> {
+    /// Writes the contact the narrow phase found between blocks `i < j` as contact `staged` of
+    /// the detection, its sub-contacts (`seeds`) from `first` on (`law` the index of its joint
+    /// law), carrying the history of old contact `k_old` by sub-contact key when it joins the
+    /// same features with the same host.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn write_detected(
+        &mut self,
+        (staged, first): (u32, u32),
+        old: &OldContacts<'_, S>,
+        k_old: Option<usize>,
+        (i, bi): (u32, &RigidBlock),
+        (j, bj): (u32, &RigidBlock),
+        dc: &DetectedContact,
+        law: u32,
+        seeds: &[SubcontactSeed],
+    ) {
+        let host = if dc.host_is_a { bi } else { bj };
+        let bound_area = k_old.map_or(0.0, |k| old.references[k].bound_area);
+        let old_subs = k_old.map(|k| {
+            let p = &old.pairs[k];
+            (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
+                .then(|| (&old.subs[p.range()], &old.records[p.range()]))
+        });
+        let old_subs = old_subs.flatten();
+        // Carried spring forces were composed in the old contact's axes: their shear forces
+        // are components along its tangents, and the next step's energy increment needs its
+        // normal as the previous one. A new contact starts with any tangents.
+        let axes = match (k_old, old_subs) {
+            (Some(k), Some(_)) => old.pairs[k].axes(),
+            _ => JointAxes::from_normal(dc.normal),
+        };
+        let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
+        let anchors = AnchorPlane::through(seeds.iter().map(|s| s.anchor));
+        let at = first as usize - self.sub_base;
+        let (subs, records) = (
+            &mut self.subs[at..at + seeds.len()],
+            &mut self.records[at..at + seeds.len()],
+        );
+        for ((seed, sub_slot), record_slot) in seeds.iter().zip(subs.iter_mut()).zip(records.iter_mut()) {
+            let mut sub = SubContact {
+                plane: anchors.coordinates(seed.anchor),
+                area: seed.area,
+                gap: seed.gap,
+                force: JointForce::default(),
+                slip: 0.0,
+                status: JointStatus::Open,
+                state: S::default(),
+            };
+            let mut record = SubContactRecord::new(seed.key);
+            if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
+                let o = &old_subs[k];
+                sub.force = o.force;
+                sub.slip = o.slip;
+                sub.status = o.status;
+                sub.state = o.state.clone();
+                record = old_records[k].clone();
+            }
+            *sub_slot = sub;
+            *record_slot = record;
+        }
+        let mut pair = ContactPair {
+            a: i,
+            b: j,
+            kind: dc.kind,
+            host_is_a: dc.host_is_a,
+            law,
+            first,
+            count: seeds.len() as u32,
+            normal: axes.normal,
+            tangent: axes.tangent,
+            anchors,
+            plane_normal: Vector::ZERO,
+            plane_offset: 0.0,
+            dashpots: true,
+            normal_force: 0.0,
+            springs: ForceMoments::default(),
+        };
+        pair.cache_local_faces(bi.shape(), bj.shape());
+        pair.refresh_springs(subs);
+        let k = staged as usize - self.pair_base;
+        self.pairs[k] = pair;
+        self.wrenches[k] = ContactWrench::default();
+        self.references[k] = ContactReference {
+            ref_a: bi.state.pose.translation,
+            ref_b: bj.state.pose.translation,
+            ref_host_rotation: host.state.pose.rotation,
+            area: seeds.iter().map(|s| s.area).sum(),
+            bound_area,
+        };
+    }
+}
+
+impl<L: ConstitutiveLaw> ModelState<L> {
+    /// Stages the contacts the narrow phase found in the planned pairs of `chunks` (`chunk`
+    /// pairs each, the last one possibly fewer) at the places [`DetectionScratch::place_staged`]
+    /// gave them, with the history of the old ones: the tasks in parallel, each into its part of
+    /// the staging lists. The error is the first in plan order (a missing joint law).
+    pub(super) fn stage(
+        &self,
+        chunks: &mut [ChunkScratch],
+        plan: &[Planned],
+        outcomes: &mut [Outcome],
+        chunk: usize,
+        slices: StagingSlices<'_, L::State>,
+    ) -> Result<()> {
+        if chunks.len() > 1 {
+            let mid = chunks.len() / 2;
+            let (pair, sub) = chunks[mid].place;
+            let (slices_a, slices_b) = slices.split_at(pair as usize, sub as usize);
+            let (chunks_a, chunks_b) = chunks.split_at_mut(mid);
+            let (plan_a, plan_b) = plan.split_at(mid * chunk);
+            let (outcomes_a, outcomes_b) = outcomes.split_at_mut(mid * chunk);
+            let (a, b) = rayon::join(
+                || self.stage(chunks_a, plan_a, outcomes_a, chunk, slices_a),
+                || self.stage(chunks_b, plan_b, outcomes_b, chunk, slices_b),
+            );
+            return a.and(b);
+        }
+        let Some(scratch) = chunks.first() else { return Ok(()) };
+        let old = OldContacts {
+            pairs: &self.pairs,
+            references: &self.references,
+            subs: &self.subs,
+            records: &self.sub_records,
+        };
+        let mut slices = slices;
+        for (p, o) in plan.iter().zip(outcomes) {
+            if o.staged == u32::MAX {
+                continue;
+            }
+            let Some(dc) = o.contact.take() else { continue };
+            let seeds = &scratch.seeds[o.first_seed as usize..(o.first_seed + o.seed_count) as usize];
+            let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
+            let law = self.law_index(p.a, p.b)?;
+            slices.write_detected(
+                (o.staged, o.first_sub),
+                &old,
+                p.old_contact(),
+                (p.a, bi),
+                (p.b, bj),
+                &dc,
+                law,
+                seeds,
+            );
+        }
+        Ok(())
+    }
+}
