@@ -1,0 +1,392 @@
+//! Narrow phase: the common plane, the contact polygon and its sub-contacts for one block pair.
+//!
+//! The common plane comes from a separating-axis test over face normals and edge pairs (exact for
+//! convex polyhedra, also for faces that just touch, where GJK/EPA normals are arbitrary); the
+//! face-to-face polygon and the sub-contact grid are built here. See `docs/theory.md`, "Contact geometry".
+
+use glam::DVec2;
+#[cfg(feature = "serde")]
+use serde::{Deserialize, Serialize};
+
+use super::polyhedron::Polyhedron;
+use crate::error::{in_range, positive, Result};
+use crate::math::{Pose, Real, Vector};
+
+mod face;
+mod point;
+
+pub(crate) use face::contact_polygon;
+use face::*;
+use point::*;
+
+/// How densely joint faces are covered with sub-contacts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub enum SubcontactDensity {
+    /// `n` sub-contacts along each edge of the host face's bounding rectangle (`n × n` cells);
+    /// the reference paper uses 15.
+    PerEdge(u16),
+    /// Nodes at most this far apart (m); at most [`MAX_SUBCONTACTS_PER_EDGE`] nodes along a
+    /// face edge of any block.
+    Spacing(Real),
+}
+
+/// The most sub-contacts along an edge of a face (`n × n` per face): 1,000, a million per
+/// face. A denser grid is refused rather than allocated (the reference paper uses 15).
+pub const MAX_SUBCONTACTS_PER_EDGE: u16 = 1000;
+
+/// Two faces further apart than the face angle tolerance but within this angle (rad, 60°) still
+/// form a face-face contact when the larger face covers the smaller one whole: an edge or a
+/// corner landing on a face is then the edge row or corner node of the grid that carries the
+/// face once it lands, instead of a differently discretised point contact (`docs/theory.md`
+/// §2.2). Where the faces overlap only in part (edge against edge), a point contact.
+const COVERED_FACE_ANGLE: Real = std::f64::consts::FRAC_PI_3;
+
+/// Largest face angle tolerance (rad, 75°): beyond it the projection of one face on the other
+/// is too oblique to place sub-contacts.
+const MAX_FACE_ANGLE: Real = 5.0 * std::f64::consts::PI / 12.0;
+
+/// Largest number of sub-contact nodes along a face edge (keys hold 16-bit indices).
+const MAX_NODES_PER_EDGE: u32 = 65_535;
+
+/// Parameters of contact detection and discretisation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
+pub struct ContactParameters {
+    /// Blocks closer than this (m) are in contact; contacts whose gap grows beyond it are dropped.
+    /// Default `1e-3` m.
+    pub tolerance: Real,
+    /// The re-detection trigger, as a fraction of `tolerance`: contacts are re-detected once
+    /// some block has moved more than this since it last did, and then a pair is tested afresh
+    /// only if its two blocks moved relative to each other (a contact: by more than half the
+    /// trigger since its test; `docs/theory.md` §2.3). Default `0.25`.
+    pub redetect_fraction: Real,
+    /// The two faces most aligned with the contact normal form a face-to-face joint (a grid of
+    /// sub-contacts on one of the faces, gaps measured to the other face's plane) while their
+    /// normals are opposite within this angle (rad). Default 15°, so that an opening hinge keeps
+    /// its sub-contacts and their history. Beyond it and up to 60°, they still form a face-face
+    /// contact when the larger face covers the smaller one whole (an edge or corner landing on
+    /// a face); otherwise the contact is a point contact (`docs/theory.md` §2.2).
+    pub face_angle_tolerance: Real,
+    /// Sub-contact density on joint faces. Default `PerEdge(15)` (the paper's value).
+    pub density: SubcontactDensity,
+}
+
+impl Default for ContactParameters {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-3,
+            redetect_fraction: 0.25,
+            face_angle_tolerance: 15f64.to_radians(),
+            density: SubcontactDensity::PerEdge(15),
+        }
+    }
+}
+
+impl ContactParameters {
+    /// Checks that a [`SubcontactDensity::Spacing`] leaves at most
+    /// [`MAX_SUBCONTACTS_PER_EDGE`] sub-contacts along the faces of a block of circumradius
+    /// `radius` (m), named `block` in the error.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] naming the block.
+    pub fn check_block(&self, radius: Real, block: &str) -> Result<()> {
+        if let SubcontactDensity::Spacing(h) = self.density {
+            let nodes = (2.0 * radius / h).ceil() + 1.0;
+            if nodes.is_nan() || nodes > MAX_SUBCONTACTS_PER_EDGE as Real {
+                return Err(crate::Error::InvalidParameter {
+                    name: format!(
+                        "contact.density.spacing for block {block:?} ({:.3} m across)",
+                        2.0 * radius
+                    ),
+                    value: h,
+                    expected: "must leave at most 1000 sub-contacts along a face edge (MAX_SUBCONTACTS_PER_EDGE)",
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks every field.
+    ///
+    /// # Errors
+    /// [`crate::Error::InvalidParameter`] naming the bad field.
+    pub fn validate(&self) -> Result<()> {
+        positive("contact.tolerance", self.tolerance)?;
+        in_range(
+            "contact.redetect_fraction",
+            self.redetect_fraction,
+            1e-6,
+            1.0 + 1e-12,
+            "must lie in (0, 1]",
+        )?;
+        in_range(
+            "contact.face_angle_tolerance",
+            self.face_angle_tolerance,
+            0.0,
+            MAX_FACE_ANGLE,
+            "must lie in [0, 5 pi/12) rad (75 degrees)",
+        )?;
+        match self.density {
+            SubcontactDensity::PerEdge(n) => {
+                in_range(
+                    "contact.density.per_edge",
+                    n as Real,
+                    1.0,
+                    MAX_SUBCONTACTS_PER_EDGE as Real + 1.0,
+                    "must lie in 1..=1000 (MAX_SUBCONTACTS_PER_EDGE)",
+                )?;
+            }
+            SubcontactDensity::Spacing(h) => {
+                positive("contact.density.spacing", h)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Stable identity of a sub-contact within its block pair: used to carry history across
+/// re-detection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct SubKey(pub u64);
+
+impl SubKey {
+    fn cell(face_host: u32, face_other: u32, i: u32, j: u32) -> Self {
+        Self(((face_host as u64) << 48) | ((face_other as u64 & 0xffff) << 32) | ((i as u64) << 16) | j as u64)
+    }
+    fn point(feature: u32, i: u32) -> Self {
+        Self((0xffffu64 << 48) | ((feature as u64 & 0xffff) << 32) | i as u64)
+    }
+}
+
+/// The kind of a detected contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub enum ContactKind {
+    /// Two nearly parallel faces: a polygon covered with a grid of sub-contacts anchored to the
+    /// host face. Faces are indices into each block's [`Polyhedron::faces`].
+    FaceFace {
+        /// Face of block `a`.
+        face_a: u32,
+        /// Face of block `b`.
+        face_b: u32,
+    },
+    /// Edge–face, edge–edge or vertex–face beyond the face angle tolerance: sub-contacts on a
+    /// segment or at a point, anchored to the host (the block whose feature has the lower
+    /// dimension), their gaps measured to a plane fixed in the other block: its face, or for
+    /// an edge or vertex the plane through it normal to the contact normal at detection.
+    Point {
+        /// Outward unit normal of the plane, in the other block's body frame.
+        plane_normal: Vector,
+        /// Offset of the plane along `plane_normal` (m): the plane is `plane_normal·x = offset`
+        /// in the other block's body frame.
+        plane_offset: Real,
+    },
+}
+
+impl ContactKind {
+    /// Whether a contact re-detected as `other` is the same joint, whose sub-contacts may carry
+    /// their history over by key: the same pair of faces, or a point contact again. A point
+    /// contact's plane is set afresh at each detection, so it is not compared; the keys (which
+    /// name the features) decide which sub-contacts carry on.
+    pub(crate) fn same_joint(&self, other: &ContactKind) -> bool {
+        match (self, other) {
+            (ContactKind::FaceFace { .. }, ContactKind::FaceFace { .. }) => self == other,
+            (ContactKind::Point { .. }, ContactKind::Point { .. }) => true,
+            _ => false,
+        }
+    }
+}
+
+/// A sub-contact as created by detection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubcontactSeed {
+    /// Identity within the pair.
+    pub key: SubKey,
+    /// Material point in the host block's body frame (m).
+    pub anchor: Vector,
+    /// Tributary area (m²).
+    pub area: Real,
+    /// Normal gap at detection (m, positive = open): the signed distance of the anchor from the
+    /// other block's plane.
+    pub gap: Real,
+}
+
+/// A detected contact between blocks `a` and `b`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DetectedContact {
+    /// The geometric case.
+    pub kind: ContactKind,
+    /// `true` if sub-contacts are anchored to block `a`, `false` for block `b`.
+    pub host_is_a: bool,
+    /// World normal from `a` to `b`: the normal of the other block's plane, oriented from `a`
+    /// to `b`.
+    pub normal: Vector,
+}
+
+/// Scratch buffers reused between detections.
+#[derive(Debug, Default, Clone)]
+pub struct NarrowPhaseScratch {
+    world_a: Vec<Vector>,
+    world_b: Vec<Vector>,
+    host: Vec<DVec2>,
+    other: Vec<DVec2>,
+    cell: Vec<DVec2>,
+    tmp_cell: Vec<DVec2>,
+    tmp: Vec<DVec2>,
+    separation: Real,
+}
+
+impl NarrowPhaseScratch {
+    /// The separation the last [`detect`] call found along its separating axis (m): when
+    /// positive, a lower bound on the distance between the two blocks (positive = apart,
+    /// negative = overlap depth along that axis).
+    pub fn separation(&self) -> Real {
+        self.separation
+    }
+}
+
+/// Everything the narrow phase needs to know about one block.
+#[derive(Debug, Clone, Copy)]
+pub struct BlockGeometry<'a> {
+    /// The shape in its body frame.
+    pub shape: &'a Polyhedron,
+    /// Its pose.
+    pub pose: &'a Pose,
+}
+
+/// Detects the contact between `a` and `b`, pushing its sub-contacts into `seeds`.
+/// Returns `None` (and pushes nothing) when the gap exceeds the tolerance.
+///
+/// `previous` is the contact the pair had before, if any: a face-face contact between the same
+/// two faces keeps its host, so that its sub-contacts keep their keys and history (the host of
+/// a new face-face contact between tilted faces is chosen by where the overlap is deepest, see
+/// `face_face`).
+pub fn detect(
+    a: BlockGeometry<'_>,
+    b: BlockGeometry<'_>,
+    previous: Option<(ContactKind, bool)>,
+    params: &ContactParameters,
+    scratch: &mut NarrowPhaseScratch,
+    seeds: &mut Vec<SubcontactSeed>,
+) -> Option<DetectedContact> {
+    let axis = separating_axis(a, b, scratch);
+    scratch.separation = axis.separation;
+    if axis.separation > params.tolerance {
+        return None;
+    }
+    let n = axis.normal;
+    let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
+    let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
+    let na = a.pose.rotation * a.shape.faces()[fa].normal;
+    let nb = b.pose.rotation * b.shape.faces()[fb].normal;
+    let cos = -na.dot(nb);
+    if cos >= params.face_angle_tolerance.cos() || cos >= COVERED_FACE_ANGLE.cos() {
+        let start = seeds.len();
+        let require_cover = cos < params.face_angle_tolerance.cos();
+        let kept_host = match previous {
+            Some((ContactKind::FaceFace { face_a, face_b }, host_is_a))
+                if face_a as usize == fa && face_b as usize == fb =>
+            {
+                Some(host_is_a)
+            }
+            _ => None,
+        };
+        if let Some(found) = face_face(a, fa, b, fb, require_cover, kept_host, params, scratch, seeds) {
+            return Some(found);
+        }
+        seeds.truncate(start);
+    }
+    point_contact(a, b, n, axis.separation, params, seeds)
+}
+
+/// The common-plane normal from the separating axis theorem.
+#[derive(Debug, Clone, Copy)]
+struct Axis {
+    /// Unit normal from `a` to `b`.
+    normal: Vector,
+    /// Signed separation along it (m): positive = gap, negative = overlap depth.
+    separation: Real,
+}
+
+/// Separating axis test over the face normals of both blocks and the cross products of their
+/// edges: the axis of largest separation is the contact normal (the least-penetration axis when
+/// they overlap). Exact for convex polyhedra, including faces that touch with zero overlap, where
+/// GJK/EPA normals are arbitrary. Face axes win ties against edge axes.
+fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut NarrowPhaseScratch) -> Axis {
+    scratch.world_a.clear();
+    scratch
+        .world_a
+        .extend(a.shape.vertices().iter().map(|v| a.pose.transform_point(*v)));
+    scratch.world_b.clear();
+    scratch
+        .world_b
+        .extend(b.shape.vertices().iter().map(|v| b.pose.transform_point(*v)));
+    let (wa, wb) = (&scratch.world_a, &scratch.world_b);
+    let separation = |d: Vector| {
+        let max_a = wa.iter().map(|p| d.dot(*p)).fold(Real::NEG_INFINITY, Real::max);
+        let min_b = wb.iter().map(|p| d.dot(*p)).fold(Real::INFINITY, Real::min);
+        min_b - max_a
+    };
+    let mut best = Axis {
+        normal: Vector::Z,
+        separation: Real::NEG_INFINITY,
+    };
+    for f in a.shape.faces() {
+        let d = a.pose.rotation * f.normal;
+        let s = separation(d);
+        if s > best.separation {
+            best = Axis {
+                normal: d,
+                separation: s,
+            };
+        }
+    }
+    for f in b.shape.faces() {
+        let d = -(b.pose.rotation * f.normal);
+        let s = separation(d);
+        if s > best.separation {
+            best = Axis {
+                normal: d,
+                separation: s,
+            };
+        }
+    }
+    // Edge–edge axes must beat the face axes clearly, so that touching faces stay face contacts.
+    let bias = 1e-9 * (a.shape.radius() + b.shape.radius());
+    let centre = b.pose.translation - a.pose.translation;
+    // One axis per pair of edge directions: parallel edges give the same axis.
+    for ea in a.shape.edges_by_direction() {
+        let da = wa[ea[1] as usize] - wa[ea[0] as usize];
+        for eb in b.shape.edges_by_direction() {
+            let db = wb[eb[1] as usize] - wb[eb[0] as usize];
+            let c = da.cross(db);
+            let len = c.length();
+            if len <= 1e-9 * da.length() * db.length() {
+                continue;
+            }
+            let mut d = c / len;
+            if d.dot(centre) < 0.0 {
+                d = -d;
+            }
+            let s = separation(d);
+            if s > best.separation + bias {
+                best = Axis {
+                    normal: d,
+                    separation: s,
+                };
+            }
+        }
+    }
+    best
+}
+
+/// Characteristic sub-contact spacing for a pair (m), used for point contacts.
+fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubcontactDensity) -> Real {
+    match density {
+        SubcontactDensity::Spacing(h) => h,
+        SubcontactDensity::PerEdge(n) => a.volume().cbrt().min(b.volume().cbrt()) / n as Real,
+    }
+}
