@@ -1,0 +1,132 @@
+//! Golden fingerprints: the bits of a few fixed scenes (every block state, contact and energy
+//! term after a fixed number of steps, [`common::fingerprint`]), hashed and kept here, on one and
+//! on two threads.
+//!
+//! A change that should not change the physics (a faster loop, a new layout, a split file) must
+//! leave every hash as it is. A change that does change it (a new contact formulation) updates
+//! the hashes of the scenes it changes, and only those, in the same commit, saying why: the
+//! failure message prints the new value. The scenes cover face contacts (a wall settling, a
+//! shaking wall, a cube landing flat), point contacts (a cube landing on an edge and on a
+//! corner, a tetrahedron landing on a vertex) and the changes between them.
+//!
+//! The values are those of x86_64 (with or without AVX2: both kernels give the same bits); the
+//! test does not run elsewhere.
+#![cfg(target_arch = "x86_64")]
+
+mod common;
+
+use common::{cube, fingerprint, fixed_slab};
+use voussoir::prelude::*;
+
+/// FNV-1a over the words of a fingerprint.
+fn hash(words: &[u64]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for w in words {
+        for byte in w.to_le_bytes() {
+            h ^= u64::from(byte);
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
+
+/// An undamped, frictionless model (the drops) or the default one.
+fn drop_model() -> Model {
+    let mut model = common::model(CoulombSlip::dry(1e9, 1e9, 0.0).expect("law"));
+    model.set_damping(Damping::None).expect("damping");
+    model
+}
+
+/// A cube released 20 mm above the slab, turned by `tilt` (rad) about x then about y.
+fn cube_drop(tilt: (Real, Real)) -> Model {
+    let mut model = drop_model();
+    model.add_block(fixed_slab("slab")).expect("slab");
+    let turn = Rotation::from_rotation_y(tilt.1) * Rotation::from_rotation_x(tilt.0);
+    let block = cube("cube", Vector::ZERO);
+    let centre = block.state().pose.translation;
+    // Lowest corner 20 mm above the slab once turned about the centroid.
+    let corners = voussoir::block::cuboid_corners(Vector::splat(-0.1), Vector::splat(0.1));
+    let lowest = corners.iter().map(|c| (turn * *c).z).fold(Real::INFINITY, Real::min);
+    let lift = Vector::new(0.0, 0.0, 0.02 - lowest - centre.z);
+    let pose = Pose::from_parts(centre + lift, turn) * Pose::from_translation(-centre);
+    model.add_block(block.transformed(pose)).expect("cube");
+    model
+}
+
+/// A regular tetrahedron (0.2 m edges) released vertex down 20 mm above the slab.
+fn tetrahedron_drop() -> Model {
+    let mut model = drop_model();
+    model.add_block(fixed_slab("slab")).expect("slab");
+    let a = 0.2 / 2f64.sqrt();
+    let up = [
+        Vector::new(a, a, a),
+        Vector::new(a, -a, -a),
+        Vector::new(-a, a, -a),
+        Vector::new(-a, -a, a),
+    ]
+    .map(|v| 0.5 * v);
+    // Turned so that the vertex (a, a, a) points down, slightly off the vertical.
+    let turn = Rotation::from_rotation_arc(Vector::new(1.0, 1.0, 1.0).normalize(), -Vector::Z)
+        * Rotation::from_rotation_x(0.05);
+    let vertices = up.map(|v| turn * v);
+    let lowest = vertices.iter().map(|v| v.z).fold(Real::INFINITY, Real::min);
+    let placed = vertices.map(|v| v + Vector::new(0.0, 0.0, 0.02 - lowest));
+    model
+        .add_block(RigidBlock::from_vertices("tetrahedron", &placed, common::STONE_DENSITY).expect("tetrahedron"))
+        .expect("tetrahedron");
+    model
+}
+
+/// A scene: its name, how it is built, its steps and its golden hash.
+type Scene = (&'static str, fn() -> Model, u64, u64);
+
+/// The scenes.
+fn scenes() -> Vec<Scene> {
+    vec![
+        ("cube flat", || cube_drop((0.0, 0.0)), 1500, 0x3c1d_3504_be65_1022),
+        ("cube on an edge", || cube_drop((0.5, 0.0)), 1500, 0xcbad_23d2_da6a_9e03),
+        (
+            "cube on a corner",
+            || cube_drop((0.6, 0.7)),
+            1500,
+            0x7eed_7c3c_3b2e_9b0b,
+        ),
+        ("tetrahedron on a vertex", tetrahedron_drop, 1500, 0xbe24_9983_bcfa_956c),
+        (
+            "settling wall",
+            || voussoir::scenes::benchmark_wall(300).expect("wall"),
+            200,
+            0x3d51_5525_1fd3_babd,
+        ),
+        (
+            "shaking wall",
+            || voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall"),
+            400,
+            0xc053_d0b2_da61_3ef3,
+        ),
+    ]
+}
+
+#[test]
+fn fixed_scenes_keep_their_bits_on_one_and_two_threads() {
+    let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build().expect("pool");
+    let mut changed = Vec::new();
+    for (name, build, steps, golden) in scenes() {
+        let run = || {
+            let mut model = build();
+            model.run_steps(steps).expect("run");
+            hash(&fingerprint(&model))
+        };
+        let (one, two) = (pool(1).install(run), pool(2).install(run));
+        assert_eq!(one, two, "{name}: 1 and 2 threads differ");
+        if one != golden {
+            changed.push(format!("{name}: {one:#018x} (kept: {golden:#018x})"));
+        }
+    }
+    assert!(
+        changed.is_empty(),
+        "the bits of these scenes changed; if the physics changed on purpose, update their hashes \
+         in tests/golden_fingerprints.rs and say why in the commit:\n{}",
+        changed.join("\n")
+    );
+}
