@@ -4,7 +4,9 @@
 
 mod common;
 
-use voussoir::build::{barrel_vault, dome, multi_leaf_wall, BarrelVaultSpec, DomeSpec, MultiLeafSpec};
+use voussoir::build::{
+    barrel_vault, dome, multi_leaf_wall, rubble_wall, BarrelVaultSpec, DomeSpec, MultiLeafSpec, RubbleWallSpec,
+};
 use voussoir::prelude::*;
 
 /// Joint normal stiffness (Pa/m): stone-like, so that elastic settlements are a fraction of a
@@ -71,6 +73,22 @@ fn multi_leaf_wall_settles() -> Result<()> {
     };
     let (moved, n) = settle(multi_leaf_wall(&spec)?, Vector::new(0.0, 0.0, -9.81), 0.05)?;
     println!("multi-leaf wall, {n} blocks: largest settlement {moved:.3e} m");
+    assert!(moved < 1e-4, "moved {moved} m");
+    Ok(())
+}
+
+/// A rubble wall (irregular convex stones on a jittered grid, through-stones) stands: its stones
+/// meet face to face with no gap and no overlap, and it settles elastically.
+#[test]
+fn rubble_wall_settles() -> Result<()> {
+    let spec = RubbleWallSpec {
+        length: 1.2,
+        height: 0.8,
+        through_stones: 0.2,
+        ..RubbleWallSpec::default()
+    };
+    let (moved, n) = settle(rubble_wall(&spec)?, Vector::new(0.0, 0.0, -9.81), 0.05)?;
+    println!("rubble wall, {n} blocks: largest settlement {moved:.3e} m");
     assert!(moved < 1e-4, "moved {moved} m");
     Ok(())
 }
