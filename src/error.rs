@@ -225,6 +225,14 @@ pub enum Error {
     /// A model with no blocks was asked to step (time could not advance: a run would never end).
     #[error("the model has no blocks: add one before stepping")]
     EmptyModel,
+    /// The interrupt check ([`crate::Model::set_interrupt_check`]) asked a step to stop. The
+    /// step did not happen: the model is as before it, and its next step detects every contact
+    /// afresh.
+    #[error("step {step} interrupted during contact detection; the model is as before the step")]
+    Interrupted {
+        /// The step that was interrupted (the model's step count).
+        step: u64,
+    },
     /// An operation this model cannot do as set up, e.g. checkpointing a custom integrator.
     #[error("unsupported: {what}")]
     Unsupported {

@@ -188,3 +188,44 @@ fn parameters_re_detect_only_when_the_contacts_change() -> Result<()> {
     );
     Ok(())
 }
+
+/// An interrupt check that fires stops the step before it changes anything: the model's state
+/// (blocks, contacts, energies, clock) is as before, and the run goes on afterwards.
+#[test]
+fn interrupted_step_leaves_the_model_as_it_was() -> Result<()> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    use voussoir::model::InterruptCheck;
+
+    // A wall shaken on its base, so that its steps re-detect contacts.
+    let mut model = voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    model.set_interrupt_check(Some(InterruptCheck::new(move || flag.load(Ordering::Relaxed))));
+    model.run_steps(300)?;
+    stop.store(true, Ordering::Relaxed);
+    // Steps until one detects (and is interrupted); the others run as usual.
+    let mut interrupted = None;
+    for _ in 0..200 {
+        let before = common::fingerprint(&model);
+        match model.step() {
+            Ok(()) => {}
+            Err(Error::Interrupted { step }) => {
+                assert_eq!(step, model.step_count());
+                assert!(
+                    common::fingerprint(&model) == before,
+                    "the interrupted step changed the model"
+                );
+                interrupted = Some(step);
+                break;
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    assert!(interrupted.is_some(), "no step detected contacts in 200 steps");
+    stop.store(false, Ordering::Relaxed);
+    let detections = model.detection_count();
+    model.run_steps(50)?;
+    assert!(model.detection_count() > detections);
+    Ok(())
+}

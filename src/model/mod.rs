@@ -19,6 +19,28 @@ use serde::{Deserialize, Serialize};
 
 #[cfg(feature = "serde")]
 pub use checkpoint::reseal_checkpoint;
+
+/// A check that a long step asks whether to stop ([`Model::set_interrupt_check`]).
+#[derive(Clone)]
+pub struct InterruptCheck(std::sync::Arc<dyn Fn() -> bool + Send + Sync>);
+
+impl InterruptCheck {
+    /// The check `stop`: the step stops when it returns `true`.
+    pub fn new(stop: impl Fn() -> bool + Send + Sync + 'static) -> Self {
+        Self(std::sync::Arc::new(stop))
+    }
+
+    /// Whether to stop.
+    pub fn stop(&self) -> bool {
+        (self.0)()
+    }
+}
+
+impl std::fmt::Debug for InterruptCheck {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("InterruptCheck")
+    }
+}
 pub use energy::Energies;
 pub use observe::Observer;
 
@@ -687,6 +709,33 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Restarts the stage timers.
     pub fn reset_timings(&mut self) {
         self.pipeline.timings = Timings::default();
+    }
+
+    /// Sets the check a long step asks, between the batches of a contact detection, whether to
+    /// stop (`None` removes it): a front end watching for Ctrl-C or a deadline. When it returns
+    /// `true` the step stops with [`Error::Interrupted`] before it changes any contact or block:
+    /// the model is as before the step, and its next step detects every contact afresh. The
+    /// first detection of a 100k-block wall asks it about every 25 ms on 2 cores. Not saved in
+    /// checkpoints.
+    ///
+    /// ```
+    /// use std::sync::atomic::{AtomicBool, Ordering};
+    /// use std::sync::Arc;
+    /// use voussoir::model::InterruptCheck;
+    /// use voussoir::prelude::*;
+    ///
+    /// let mut model = voussoir::scenes::benchmark_wall(200)?;
+    /// let stop = Arc::new(AtomicBool::new(true));
+    /// let flag = Arc::clone(&stop);
+    /// model.set_interrupt_check(Some(InterruptCheck::new(move || flag.load(Ordering::Relaxed))));
+    /// assert!(matches!(model.step(), Err(Error::Interrupted { step: 0 })));
+    /// stop.store(false, Ordering::Relaxed);
+    /// model.step()?;
+    /// assert_eq!(model.step_count(), 1);
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    pub fn set_interrupt_check(&mut self, check: Option<InterruptCheck>) {
+        self.pipeline.interrupt = check;
     }
 
     /// The integrator's damping model.

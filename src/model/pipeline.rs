@@ -33,6 +33,8 @@ pub(super) struct Pipeline<S> {
     pub detection: DetectionScratch<S>,
     /// Wall-clock time per stage.
     pub timings: Timings,
+    /// Asked at a long step's sequential points whether to stop ([`crate::Model::set_interrupt_check`]).
+    pub interrupt: Option<crate::model::InterruptCheck>,
 }
 
 impl<S> Default for Pipeline<S> {
@@ -49,6 +51,7 @@ impl<S> Default for Pipeline<S> {
             refresh_bounds: Vec::new(),
             detection: DetectionScratch::default(),
             timings: Timings::default(),
+            interrupt: None,
         }
     }
 }

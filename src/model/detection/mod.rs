@@ -381,6 +381,12 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         sc.staging_spread = full;
         sc.segment_subs = 0;
         for start in (0..sc.plan.len()).step_by(BATCH) {
+            if pipeline.interrupt.as_ref().is_some_and(|check| check.stop()) {
+                // Nothing of the contacts has changed yet, but the moved blocks took their
+                // reference poses: the next detection is a full one.
+                self.changes.insert(Changes::DETECTION);
+                return Err(Error::Interrupted { step: self.step });
+            }
             let batch = start..(start + BATCH).min(sc.plan.len());
             sc.outcomes[batch.clone()]
                 .par_chunks_mut(chunk)
