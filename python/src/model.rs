@@ -1055,23 +1055,12 @@ contact_resultant, energy or unbalanced_ratio"
         scene_json(&Scene::from_model(&self.model).with_recorder(&recorder)).py()
     }
 
-    /// Writes ``to_scene_json()`` to a file.
+    /// Writes ``to_scene_json()`` to a file, atomically: into a temporary file beside it, then
+    /// renamed over it (a failed write leaves the previous file whole). A symbolic link is
+    /// written through (its target is replaced, the link kept).
     fn save_scene(&self, path: PathBuf) -> PyResult<()> {
         let text = self.to_scene_json()?;
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| Error::Io {
-                    path: dir.display().to_string(),
-                    message: e.to_string(),
-                })
-                .py()?;
-        }
-        std::fs::write(&path, text)
-            .map_err(|e| Error::Io {
-                path: path.display().to_string(),
-                message: e.to_string(),
-            })
-            .py()
+        voussoir::io::write_atomically(&path, text.as_bytes()).py()
     }
 
     /// A model from scene JSON, with its monitors (laws with or without their kind).

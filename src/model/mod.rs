@@ -404,9 +404,17 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// Sets the fixity of a block.
     ///
+    /// A translation driven by a base motion ([`Model::set_base_motion`]) cannot be set free
+    /// while the motion applies (the motion would put it back at the next step, and a model
+    /// saved in between would not load): remove the motion first. Setting it fixed or
+    /// prescribed is accepted; the motion sets its velocity at every step.
+    ///
     /// # Errors
-    /// [`Error::UnknownBlock`], [`Error::NonFinite`] for a NaN prescribed velocity.
+    /// [`Error::UnknownBlock`], [`Error::NonFinite`] for a NaN prescribed velocity,
+    /// [`Error::DrivenAxisFreed`] naming the block, the axis and the motion.
     pub fn set_fixity(&mut self, id: BlockId, fixity: Fixity) -> Result<()> {
+        self.block(id)?;
+        self.check_driven_axes(id, &fixity)?;
         let b = self.block_mut(id)?;
         let old = b.fixity().to_owned();
         b.replace_fixity(fixity);
