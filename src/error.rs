@@ -263,6 +263,18 @@ pub enum Error {
         /// The longest step at that speed that stays within the tolerance (s).
         max_dt: Real,
     },
+    /// A size beyond what voussoir builds or reads (blocks of a generator, facets of a friction
+    /// pyramid, bytes of a file): refused before allocating, instead of the process aborting
+    /// when memory runs out. (Python: `MemoryError`.)
+    #[error("{what}: {requested} is more than the limit {limit}")]
+    TooLarge {
+        /// What was asked for, e.g. `"wall.courses × (wall.bricks_per_course + 1) blocks"`.
+        what: String,
+        /// The size asked for.
+        requested: u128,
+        /// The largest size accepted.
+        limit: u64,
+    },
     /// A model with no blocks was asked to step (time could not advance: a run would never end).
     #[error("the model has no blocks: add one before stepping")]
     EmptyModel,

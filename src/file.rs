@@ -24,13 +24,24 @@ static TEMPORARIES: AtomicU64 = AtomicU64::new(0);
 
 /// Writes `bytes` to `path`, creating its folder: into a temporary file beside it, synced, then
 /// renamed over `path`. A `path` that is a symbolic link is followed: its target is replaced and
-/// the link stays.
+/// the link stays. A target that exists and is not a regular file (a folder, a device such as
+/// `/dev/null`, a pipe) is refused, never replaced.
 ///
 /// # Errors
 /// [`crate::Error::Io`] naming the folder, the temporary file or the target (also for a cycle of
 /// symbolic links).
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     let path = &resolve_links(path)?;
+    // Renaming over a device, a pipe or a folder would replace it (as root, `/dev/full` by a
+    // regular file): only regular files are replaced.
+    if let Ok(m) = std::fs::metadata(path) {
+        if !m.is_file() {
+            return Err(crate::Error::Io {
+                path: path.display().to_string(),
+                message: "not a regular file (a folder, a device or a pipe): not replaced".into(),
+            });
+        }
+    }
     let dir = path.parent().filter(|d| !d.as_os_str().is_empty());
     if let Some(dir) = dir {
         std::fs::create_dir_all(dir).map_err(|e| io_error(dir, &e))?;
@@ -81,12 +92,72 @@ fn temporary_name(name: &str, n: u64) -> String {
     if 1 + name.len() + suffix.len() <= MAX_NAME_BYTES {
         return format!(".{name}{suffix}");
     }
-    let hash = format!("~{:08x}", crc32fast::hash(name.as_bytes()));
+    let hash = format!("~{:016x}", fnv1a(name.as_bytes()));
     let mut keep = MAX_NAME_BYTES - 1 - suffix.len() - hash.len();
     while !name.is_char_boundary(keep) {
         keep -= 1;
     }
     format!(".{}{hash}{suffix}", &name[..keep])
+}
+
+/// The 64-bit FNV-1a hash of `bytes` (a short stand-in for a long name).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The largest text file voussoir reads (checkpoints, scenes, time histories): 4 GiB. A
+/// checkpoint of the 100,000-block wall is about 0.5 GB.
+pub const MAX_TEXT_BYTES: u64 = 4 << 30;
+
+/// Reads a UTF-8 text file of at most [`MAX_TEXT_BYTES`], refusing at the first NUL byte (no
+/// text format voussoir reads holds one: `/dev/zero` or a UTF-16 file is refused at once
+/// instead of being read without end).
+///
+/// # Errors
+/// [`crate::Error::Io`] naming the file: unreadable, larger than the limit, holding a NUL byte
+/// (saying where), or not UTF-8.
+pub fn read_text(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let fail = |message: String| crate::Error::Io {
+        path: path.display().to_string(),
+        message,
+    };
+    let mut file = std::fs::File::open(path).map_err(|e| io_error(path, &e))?;
+    let mut bytes = Vec::new();
+    let mut chunk = vec![0u8; 1 << 16];
+    loop {
+        let n = match file.read(&mut chunk) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(io_error(path, &e)),
+        };
+        if let Some(k) = chunk[..n].iter().position(|&b| b == 0) {
+            let utf16 = if bytes.is_empty() && (chunk.starts_with(&[0xFF, 0xFE]) || chunk.starts_with(&[0xFE, 0xFF])) {
+                " (a UTF-16 file: save it as UTF-8)"
+            } else {
+                ""
+            };
+            return Err(fail(format!(
+                "a NUL byte at byte {}: not a text file{utf16}",
+                bytes.len() + k
+            )));
+        }
+        if (bytes.len() + n) as u64 > MAX_TEXT_BYTES {
+            return Err(fail(format!(
+                "larger than {MAX_TEXT_BYTES} bytes, the most voussoir reads"
+            )));
+        }
+        bytes.extend_from_slice(&chunk[..n]);
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        fail(format!(
+            "not UTF-8 text (an invalid byte at byte {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })
 }
 
 /// Creates a new temporary file beside `path` (never opening one that exists).

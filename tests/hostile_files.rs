@@ -106,6 +106,34 @@ fn saving_through_a_symlink_writes_its_target() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A target that is not a regular file is refused and left as it is: a folder, and a link to a
+/// device (as root, renaming over the link's target would have replaced `/dev/null` by a file).
+#[cfg(unix)]
+#[test]
+fn targets_that_are_not_regular_files_are_refused() {
+    let dir = scratch("devices");
+    let folder = dir.join("a folder.json");
+    std::fs::create_dir_all(&folder).expect("folder");
+    let e = stepped_model(1).save_checkpoint(&folder).unwrap_err();
+    assert!(e.to_string().contains("not a regular file"), "{e}");
+    assert!(folder.is_dir());
+    let link = dir.join("null.json");
+    std::os::unix::fs::symlink("/dev/null", &link).expect("link");
+    let e = stepped_model(1).save_checkpoint(&link).unwrap_err();
+    assert!(
+        e.to_string().contains("/dev/null") && e.to_string().contains("not a regular file"),
+        "{e}"
+    );
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::metadata("/dev/null")
+        .expect("null")
+        .file_type()
+        .is_char_device());
+    let left: Vec<_> = std::fs::read_dir(&dir).expect("list").collect();
+    assert_eq!(left.len(), 2, "nothing else written");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 fn table_with_motion() -> (Model, BlockId) {
     let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
     let table = model.add_block(common::fixed_slab("table")).expect("slab");

@@ -21,7 +21,7 @@ use voussoir::monitor::{Component, EnergyTerm, Monitor, Recorder};
 use voussoir::Error;
 
 use crate::blocks::PyBlock;
-use crate::convert::{array1, array_n3, array_n33, array_nk, vec3, vec3_or_zero, vector};
+use crate::convert::{array1, array_n3, array_n33, array_nk, vec3, vec3_or_zero, vector, Int};
 use crate::errors::{bad, OrPy};
 use crate::laws::{law_from_py, law_to_py};
 
@@ -58,10 +58,23 @@ impl Samples {
         }
     }
 
-    fn add(&mut self, name: &str, monitor: Monitor) {
+    /// Adds a monitor; its name must be new and not `step` or `time` (the columns of
+    /// `history()` that every history has).
+    fn add(&mut self, name: &str, monitor: Monitor) -> PyResult<()> {
+        if name == "step" || name == "time" {
+            return Err(bad(format!(
+                "monitor name {name:?} is taken by the history's own {name:?} column: choose another"
+            )));
+        }
+        if self.monitors.iter().any(|(n, _)| n == name) {
+            return Err(bad(format!(
+                "a monitor named {name:?} exists already: names must differ"
+            )));
+        }
         self.monitors.push((name.to_owned(), monitor));
         // A monitor added late has NaN for the samples it missed, as in a Recorder.
         self.columns.push(vec![f64::NAN; self.steps.len()]);
+        Ok(())
     }
 
     /// As a `voussoir::monitor::Recorder` (monitors and interval; no samples).
@@ -123,10 +136,10 @@ impl PyModel {
         }
     }
 
-    fn id(&self, block: usize) -> PyResult<BlockId> {
-        let id = BlockId(u32::try_from(block).map_err(|_| bad(format!("block index {block} is too large")))?);
-        self.model.block(id).py()?;
-        Ok(id)
+    /// The block of index `block` (`IndexError` naming the argument `what` when out of range).
+    fn id(&self, block: &Int, what: &str) -> PyResult<BlockId> {
+        let k = block.index(what, self.model.blocks().len())?;
+        Ok(BlockId(k as u32))
     }
 
     /// Runs to `goal`, in chunks: the GIL is released during a chunk; between chunks Ctrl-C is
@@ -307,6 +320,11 @@ fn as_any_law(doc: &mut serde_json::Value) {
 
 /// Parses JSON text for [`as_any_law`]; on a syntax error, `None` (the typed parser then
 /// reports it with its own message).
+/// A material id from a Python int (`ValueError` naming `what` outside [0, 65535]).
+fn material(k: &Int, what: &str) -> PyResult<MaterialId> {
+    Ok(MaterialId(k.at_most(what, u64::from(u16::MAX))? as u16))
+}
+
 fn normalised(text: &str) -> Option<String> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut doc: serde_json::Value = serde_json::from_str(text).ok()?;
@@ -315,12 +333,7 @@ fn normalised(text: &str) -> Option<String> {
 }
 
 fn read(path: &PathBuf) -> PyResult<String> {
-    std::fs::read_to_string(path)
-        .map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })
-        .py()
+    voussoir::io::read_text(path).py()
 }
 
 /// A scene of `Model<AnyLaw>` as JSON, written as a `Scene<CoulombSlip>` when every law is
@@ -401,16 +414,17 @@ impl PyModel {
 
     /// Sets the joint law between two materials (ints, either order): a ``CoulombSlip`` or a
     /// ``LinearElastic``.
-    fn set_joint_law(&mut self, a: u16, b: u16, law: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set_joint_law(&mut self, a: Int, b: Int, law: &Bound<'_, PyAny>) -> PyResult<()> {
+        let (a, b) = (material(&a, "material a")?, material(&b, "material b")?);
         let law = law_from_py(law)?;
-        self.model.set_joint_law(MaterialId(a), MaterialId(b), law).py()
+        self.model.set_joint_law(a, b, law).py()
     }
 
     /// The joint law between two materials, or None.
-    fn joint_law<'py>(&self, py: Python<'py>, a: u16, b: u16) -> PyResult<Option<Bound<'py, PyAny>>> {
+    fn joint_law<'py>(&self, py: Python<'py>, a: Int, b: Int) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.model
             .law_table()
-            .get(MaterialId(a), MaterialId(b))
+            .get(material(&a, "material a")?, material(&b, "material b")?)
             .map(|l| law_to_py(py, l))
             .transpose()
     }
@@ -506,8 +520,17 @@ impl PyModel {
         Ok(self.model.add_block(block.inner.clone()).py()?.index())
     }
 
-    /// Adds blocks (a list from ``voussoir.build``, say); returns their indices.
+    /// Adds blocks (a list from ``voussoir.build``, say); returns their indices. All or nothing:
+    /// when one is refused, none is added (the error names the first refused, by its position
+    /// in the list).
     fn add_blocks(&mut self, blocks: Vec<PyRef<'_, PyBlock>>) -> PyResult<Vec<usize>> {
+        // The checks of `add_block` depend on the parameters only: tried on an empty model first.
+        let mut trial = Model::<AnyLaw>::new(self.model.parameters().clone()).py()?;
+        for (k, b) in blocks.iter().enumerate() {
+            trial
+                .add_block(b.inner.clone())
+                .map_err(|e| bad(format!("blocks[{k}] ({:?}): {e}; no block was added", b.inner.name())))?;
+        }
         blocks
             .iter()
             .map(|b| Ok(self.model.add_block(b.inner.clone()).py()?.index()))
@@ -565,8 +588,8 @@ impl PyModel {
 
     /// Sets a block's fixity: ``"fixed"``, ``"free"``, a bool, or ``{"translation": [d, d, d],
     /// "rotation": [d, d, d]}`` with each ``d`` ``"free"``, ``"fixed"`` or a velocity.
-    fn set_fixity(&mut self, block: usize, fixity: &Bound<'_, PyAny>) -> PyResult<()> {
-        let id = self.id(block)?;
+    fn set_fixity(&mut self, block: Int, fixity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let id = self.id(&block, "block index")?;
         let f = crate::convert::fixity(Some(fixity))?;
         self.model.set_fixity(id, f).py()
     }
@@ -575,11 +598,11 @@ impl PyModel {
     #[pyo3(signature = (block, force=None, moment=None))]
     fn set_load(
         &mut self,
-        block: usize,
+        block: Int,
         force: Option<&Bound<'_, PyAny>>,
         moment: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let id = self.id(block)?;
+        let id = self.id(&block, "block index")?;
         let w = Wrench {
             force: vec3_or_zero(force, "force")?,
             moment: vec3_or_zero(moment, "moment")?,
@@ -591,11 +614,11 @@ impl PyModel {
     #[pyo3(signature = (block, velocity, angular_velocity=None))]
     fn set_velocity(
         &mut self,
-        block: usize,
+        block: Int,
         velocity: &Bound<'_, PyAny>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let id = self.id(block)?;
+        let id = self.id(&block, "block index")?;
         self.model
             .set_velocity(
                 id,
@@ -608,8 +631,8 @@ impl PyModel {
     /// Changes the values of a block's prescribed translation velocities (m/s): each
     /// translation that its fixity prescribes (a number in ``set_fixity``) takes the matching
     /// component; free and fixed ones stay. Cheap enough to call between every step.
-    fn set_prescribed_velocity(&mut self, block: usize, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
-        let id = self.id(block)?;
+    fn set_prescribed_velocity(&mut self, block: Int, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let id = self.id(&block, "block index")?;
         self.model.set_prescribed_velocity(id, vec3(velocity, "velocity")?).py()
     }
 
@@ -714,8 +737,8 @@ impl PyModel {
     }
 
     /// A copy of block ``i`` as it is now (a ``Block``).
-    fn block(&self, i: usize) -> PyResult<PyBlock> {
-        let id = self.id(i)?;
+    fn block(&self, i: Int) -> PyResult<PyBlock> {
+        let id = self.id(&i, "block index")?;
         Ok(PyBlock {
             inner: self.model.block(id).py()?.clone(),
         })
@@ -881,15 +904,15 @@ impl PyModel {
 
     /// The force (N) and moment (N·m) that supports and prescribed velocities applied to a
     /// block in the last step: ``{"force": (3,), "moment": (3,)}``.
-    fn reaction<'py>(&self, py: Python<'py>, block: usize) -> PyResult<Bound<'py, PyDict>> {
-        let w = self.model.reaction(self.id(block)?).py()?;
+    fn reaction<'py>(&self, py: Python<'py>, block: Int) -> PyResult<Bound<'py, PyDict>> {
+        let w = self.model.reaction(self.id(&block, "block index")?).py()?;
         wrench(py, w)
     }
 
     /// The total contact force (N) and moment (N·m, about the centroid) on a block:
     /// ``{"force": (3,), "moment": (3,)}``.
-    fn contact_wrench<'py>(&self, py: Python<'py>, block: usize) -> PyResult<Bound<'py, PyDict>> {
-        let w = self.model.contact_wrench(self.id(block)?).py()?;
+    fn contact_wrench<'py>(&self, py: Python<'py>, block: Int) -> PyResult<Bound<'py, PyDict>> {
+        let w = self.model.contact_wrench(self.id(&block, "block index")?).py()?;
         wrench(py, w)
     }
 
@@ -908,17 +931,19 @@ impl PyModel {
         &mut self,
         name: &str,
         kind: &str,
-        block: Option<usize>,
+        block: Option<Int>,
         point: Option<&Bound<'_, PyAny>>,
         component: &str,
-        a: Option<usize>,
-        b: Option<usize>,
+        a: Option<Int>,
+        b: Option<Int>,
         term: Option<&str>,
     ) -> PyResult<()> {
         let c = self::component(component)?;
         let need_block = || -> PyResult<BlockId> {
-            let k = block.ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give block=")))?;
-            self.id(k)
+            let k = block
+                .as_ref()
+                .ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give block=")))?;
+            self.id(k, "block index")
         };
         let monitor = match kind.to_ascii_lowercase().as_str() {
             "displacement" | "velocity" => {
@@ -953,8 +978,8 @@ impl PyModel {
                     )));
                 };
                 Monitor::ContactResultant {
-                    a: self.id(a)?,
-                    b: self.id(b)?,
+                    a: self.id(&a, "block index a")?,
+                    b: self.id(&b, "block index b")?,
                     component: c,
                 }
             }
@@ -973,8 +998,7 @@ contact_resultant, energy or unbalanced_ratio"
         Recorder::<AnyLaw>::new(1)
             .add_monitor(&self.model, name, monitor)
             .py()?;
-        self.samples.add(name, monitor);
-        Ok(())
+        self.samples.add(name, monitor)
     }
 
     /// Steps between monitor samples (default 1).
@@ -1076,7 +1100,7 @@ contact_resultant, energy or unbalanced_ratio"
         let mut m = Self::wrap(model);
         m.samples.interval = recorder.interval();
         for (name, monitor) in recorder.monitors() {
-            m.samples.add(name, *monitor);
+            m.samples.add(name, *monitor)?;
         }
         Ok(m)
     }

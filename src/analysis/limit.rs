@@ -455,7 +455,8 @@ impl LimitProblem {
     /// joint law (e.g. a table of your own per pair of materials, or a law of your own).
     ///
     /// # Errors
-    /// [`Error::Unsupported`] naming the contact whose law `strength` gives no strength for;
+    /// [`Error::Unsupported`] for a model never stepped (no contact detected yet), or naming
+    /// the contact whose law `strength` gives no strength for;
     /// [`Error::InvalidParameter`] for a negative or non-finite strength.
     pub fn from_model_with<L: ConstitutiveLaw>(
         model: &Model<L>,
@@ -479,6 +480,13 @@ impl LimitProblem {
                 }
             })
             .collect();
+        if model.detection_count() == 0 {
+            return Err(Error::Unsupported {
+                what: "limit analysis of a model whose contacts were never detected (it was never stepped): \
+                       step it once (Model::step) so that its contacts are found"
+                    .into(),
+            });
+        }
         let mut contacts = Vec::new();
         for view in model.contacts() {
             let (a, b) = view.blocks();
@@ -510,11 +518,18 @@ impl LimitProblem {
                 view.host_is_a(),
                 view.normal(),
                 &points,
+                model.parameters().contact.tolerance,
             );
             if vertices.is_empty() {
                 continue;
             }
-            let area: Real = view.subcontacts().map(|s| s.area()).sum();
+            // Cohesion acts on the part of the joint that touches: at most the polygon's area
+            // (a tilted face touches along a strip).
+            let area: Real = view
+                .subcontacts()
+                .map(|s| s.area())
+                .sum::<Real>()
+                .min(polygon_area(&vertices));
             let axes = view.axes();
             contacts.push(ContactData {
                 a: ia,
@@ -599,12 +614,15 @@ impl LimitProblem {
                 })
             }
         }
-        let multiplier = solution.x[0] * scales.multiplier;
+        // A multiplier within round-off below zero is a zero capacity (e.g. a block on a joint
+        // without friction, pushed along it): reported as 0.
+        let multiplier = solution.x[0].max(0.0) * scales.multiplier;
         if solution.x[0] < -FEASIBILITY_TOLERANCE {
             return Err(Error::LimitInfeasible {
                 reason: format!(
-                    "the largest admissible multiplier of the live load is {multiplier:.6e} < 0: the dead loads are \
-                     carried only with a live load against its direction"
+                    "the largest admissible multiplier of the live load is {:.6e} < 0: the dead loads are \
+                     carried only with a live load against its direction",
+                    solution.x[0] * scales.multiplier
                 ),
             });
         }
@@ -661,12 +679,22 @@ impl LimitProblem {
                 });
             }
         }
-        let total: Real = live.iter().map(|l| l.force.length()).sum();
+        let total: Real = live.iter().map(|l| norm(l.force)).sum();
         if total <= 0.0 {
             return Err(Error::InvalidParameter {
                 name: "live load force".into(),
                 value: total,
                 expected: "must not be zero",
+            });
+        }
+        // λ is in units of the live load: the reference force over it must be a number.
+        let reference = self.scales(&[]).force;
+        if !(total.is_finite() && (reference / total).is_finite() && reference / total > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "live load force (sum of magnitudes, N)".into(),
+                value: total,
+                expected: "a size whose ratio to the blocks' weight is a finite, non-zero number \
+                           (scale the live load; λ is reported in its units)",
             });
         }
         Ok(())
@@ -682,7 +710,7 @@ impl LimitProblem {
         } else {
             free.iter().map(|b| b.radius).sum::<Real>() / free.len() as Real
         };
-        let live_total: Real = live.iter().map(|l| l.force.length()).sum();
+        let live_total: Real = live.iter().map(|l| norm(l.force)).sum();
         Scales {
             force,
             length,
@@ -700,6 +728,13 @@ impl LimitProblem {
                     name: "limit analysis pyramid facets".into(),
                     value: facets as Real,
                     expected: "at least 3",
+                });
+            }
+            if facets as u64 > MAX_PYRAMID_FACETS {
+                return Err(Error::TooLarge {
+                    what: "limit analysis pyramid facets".into(),
+                    requested: facets as u128,
+                    limit: MAX_PYRAMID_FACETS,
                 });
             }
         }
@@ -895,8 +930,33 @@ impl LimitProblem {
     }
 }
 
+/// The most facets of a friction pyramid ([`FrictionModel::Pyramid`]): each adds a row per
+/// contact corner; 4096 facets approximate the cone to 3e-7 of its friction, and ten million
+/// used to abort the process when memory ran out.
+pub const MAX_PYRAMID_FACETS: u64 = 4096;
+
 /// Below this (in units of the reference force) a negative multiplier is round-off.
 const FEASIBILITY_TOLERANCE: Real = 1e-7;
+
+/// `|v|` without overflow or underflow of the squares (a force of 1e-300 N or 1e300 N).
+fn norm(v: Vector) -> Real {
+    let m = v.abs().max_element();
+    if m > 0.0 && m.is_finite() {
+        m * (v / m).length()
+    } else {
+        m
+    }
+}
+
+/// The area of a planar polygon (m²; 0 for a segment or a point).
+fn polygon_area(vertices: &[Vector]) -> Real {
+    let Some(&o) = vertices.first() else { return 0.0 };
+    let mut twice = Vector::ZERO;
+    for k in 1..vertices.len().saturating_sub(1) {
+        twice += (vertices[k] - o).cross(vertices[k + 1] - o);
+    }
+    0.5 * twice.length()
+}
 
 fn free_dofs(f: &Fixity) -> [bool; 6] {
     let free = |d: &Dof| matches!(d, Dof::Free);

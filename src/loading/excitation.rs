@@ -249,22 +249,7 @@ impl TimeHistory {
     /// [`Error::Io`] naming the file (also for a UTF-16 or other non-UTF-8 file, saying so),
     /// and as [`TimeHistory::from_csv`].
     pub fn from_csv_file(path: &std::path::Path, time_column: usize, value_column: usize, scale: Real) -> Result<Self> {
-        let io = |message: String| Error::Io {
-            path: path.display().to_string(),
-            message,
-        };
-        let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
-        if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) {
-            return Err(io(
-                "a UTF-16 file (its byte-order mark says so): save it as UTF-8".into()
-            ));
-        }
-        let text = String::from_utf8(bytes).map_err(|e| {
-            io(format!(
-                "not UTF-8 text (invalid byte at {}): save it as UTF-8",
-                e.utf8_error().valid_up_to()
-            ))
-        })?;
+        let text = crate::file::read_text(path)?;
         Self::from_csv(&text, time_column, value_column, scale)
     }
 

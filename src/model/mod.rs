@@ -3,6 +3,8 @@
 mod changes;
 #[cfg(feature = "serde")]
 mod checkpoint;
+#[cfg(feature = "serde")]
+mod checkpoint_tested;
 mod contact_pass;
 mod detection;
 mod energy;
@@ -227,6 +229,11 @@ struct BlockSums {
     kinetic: Real,
     /// First block of the chunk that diverged.
     diverged: Option<usize>,
+    /// The largest [`motion::move_speed`] of the chunk's blocks after the move (m/s).
+    max_speed: Real,
+    /// First block of the chunk that the step moved further than the contact tolerance, and
+    /// how far (m).
+    too_far: Option<(usize, Real)>,
     /// Whether a block of the chunk moved beyond the re-detection trigger (fused pass only).
     moved: bool,
 }
@@ -315,6 +322,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.state.records.push(StepRecord::default());
         self.pipeline.bounds.push(StiffnessBound::default());
         self.state.changes.insert(Changes::BLOCKS);
+        self.pipeline.max_speed = None;
         Ok(id)
     }
 
@@ -496,6 +504,8 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     fn block_mut(&mut self, id: BlockId) -> Result<&mut RigidBlock> {
         let count = self.state.blocks.len();
+        // A velocity or fixity may change: the next step measures the speeds afresh.
+        self.pipeline.max_speed = None;
         self.state
             .blocks
             .get_mut(id.index())

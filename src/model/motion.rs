@@ -13,11 +13,19 @@ use rayon::prelude::*;
 use super::detection::prepare_chunk;
 use super::pipeline::Pipeline;
 use super::{diverged, BlockSums, ModelState, BLOCK_CHUNK};
-use crate::block::{Block, RigidBlock, Wrench};
+use crate::block::{Block, Dof, RigidBlock, Wrench};
 use crate::contact::{ContactWrench, DisplacementMode};
-use crate::integrate::{Integrator, StepDurations, StepRecord};
+use crate::error::Error;
+use crate::ids::BlockId;
+use crate::integrate::{Integrator, StepDurations, StepRecord, TimeStep};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real, Vector};
+
+/// The fraction of the contact tolerance that an automatic step lets the fastest block move
+/// (estimated from the speeds at the end of the last step and gravity): half, so that a speed
+/// that doubles within a step still moves no block further than the tolerance, beyond which a
+/// contact could be missed and the run stops ([`Error::StepTooLong`]).
+pub(super) const STEP_TRAVEL: Real = 0.5;
 
 /// What the per-block stages read besides the block itself.
 #[derive(Clone, Copy)]
@@ -41,6 +49,25 @@ struct BlockPass<'a> {
     /// The re-detection trigger (m) in large-displacement mode, for the next step's movement
     /// check.
     trigger: Option<Real>,
+    /// This step's drift `Δt_{n+½}` (s), over which the blocks move.
+    drift: Real,
+    /// The contact tolerance (m): no block may move further in one step.
+    tolerance: Real,
+}
+
+/// The speed of the fastest point of a block for its next move (m/s): its translation speed,
+/// with prescribed velocities ([`Dof::Velocity`]) in place of the state's on those axes, plus
+/// its angular speed times its radius. After a step the state's velocity on a prescribed axis
+/// is the prescribed one, so this is the speed the block just moved at.
+#[inline]
+pub(super) fn move_speed(b: &RigidBlock) -> Real {
+    let mut v = b.state.velocity.to_array();
+    for (v, d) in v.iter_mut().zip(b.fixity().translation) {
+        if let Dof::Velocity(p) = d {
+            *v = p;
+        }
+    }
+    Vector::from_array(v).length() + b.state.angular_velocity.length() * b.radius
 }
 
 /// `total` plus the wrenches of a block's contacts, in index order: `entries` are the block's
@@ -119,13 +146,22 @@ impl BlockPass<'_> {
             if sums.diverged.is_none() && diverged(b, self.max_speed2) {
                 sums.diverged = Some(first_block + j);
             }
+            // The move of this step: `v_{n+½} Δt_{n+½}` (and the rotation's at the radius).
+            let speed = move_speed(b);
+            sums.max_speed = sums.max_speed.max(speed);
+            let distance = speed * self.drift;
+            if sums.too_far.is_none() && distance > self.tolerance {
+                sums.too_far = Some((first_block + j, distance));
+            }
         }
     }
 }
 
 impl<L: ConstitutiveLaw> ModelState<L> {
     /// Gathers every block's forces, moves the blocks and books the energy; returns the first
-    /// block whose state is no longer finite or faster than `max_speed`.
+    /// block whose state is no longer finite or faster than `max_speed`, and the first block
+    /// moved further than the contact tolerance with the distance (the largest speed is left in
+    /// `pipeline.max_speed`).
     ///
     /// Every force `F` is booked with the trapezoidal rule over the displacement of the step,
     /// `½(F_{n−1} + F_n)·v_{n−½}·Δt` (a force that did not exist before the first step counts as
@@ -138,7 +174,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         pipeline: &mut Pipeline<L::State>,
         kick: Real,
         drift: Real,
-    ) -> Option<usize> {
+    ) -> (Option<usize>, Option<(usize, Real)>) {
         let pass = BlockPass {
             wrenches: &self.wrenches,
             contacts: &pipeline.block_contacts,
@@ -150,6 +186,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             max_speed2: self.params.max_speed * self.params.max_speed,
             trigger: (self.params.mode == DisplacementMode::Large)
                 .then_some(self.params.contact.redetect_fraction * self.params.contact.tolerance),
+            drift,
+            tolerance: self.params.contact.tolerance,
         };
         pipeline.block_sums.clear();
         pipeline
@@ -184,11 +222,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     }
 
     /// Adds the chunk sums of the block pass to the energies in chunk order, sets the
-    /// unbalanced-force ratio, and returns the first diverged block.
-    fn gather_block_sums(&mut self, pipeline: &mut Pipeline<L::State>) -> Option<usize> {
+    /// unbalanced-force ratio and the largest speed, and returns the first diverged block and
+    /// the first block moved too far.
+    fn gather_block_sums(&mut self, pipeline: &mut Pipeline<L::State>) -> (Option<usize>, Option<(usize, Real)>) {
         let mut max_unbalanced: Real = 0.0;
         let mut kinetic = 0.0;
         let mut first_diverged = None;
+        let mut first_too_far = None;
+        let mut max_speed: Real = 0.0;
         let e = &mut self.energy;
         for s in &pipeline.block_sums {
             max_unbalanced = max_unbalanced.max(s.max_unbalanced);
@@ -198,7 +239,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             e.damping += s.damping;
             kinetic += s.kinetic;
             first_diverged = first_diverged.or(s.diverged);
+            first_too_far = first_too_far.or(s.too_far);
+            max_speed = max_speed.max(s.max_speed);
         }
+        pipeline.max_speed = Some(max_speed);
         e.kinetic = kinetic;
         for s in &pipeline.pair_sums {
             e.joint_work += s.work;
@@ -216,6 +260,47 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         } else {
             Real::INFINITY
         };
-        first_diverged
+        (first_diverged, first_too_far)
+    }
+
+    /// `drift` cut, with an automatic step ([`TimeStep::Auto`]), so that the fastest block moves
+    /// at most [`STEP_TRAVEL`] of the contact tolerance: `d` with `v d + g d² = STEP_TRAVEL ×
+    /// tolerance`, `v` the largest speed at the end of the last step ([`move_speed`]), `g` the
+    /// gravity (central difference moves a block by its velocity after the kick, `(v + g d) d`). A fixed step is not cut (the block pass stops the run instead).
+    pub(super) fn cap_drift(&self, pipeline: &mut Pipeline<L::State>, drift: Real) -> Real {
+        if !matches!(self.params.time_step, TimeStep::Auto { .. }) {
+            return drift;
+        }
+        let v = *pipeline.max_speed.get_or_insert_with(|| self.max_move_speed());
+        let c = STEP_TRAVEL * self.params.contact.tolerance;
+        let a = self.params.gravity.length();
+        let root = v + (v * v + 4.0 * a * c).sqrt();
+        if root > 0.0 {
+            drift.min(2.0 * c / root)
+        } else {
+            drift
+        }
+    }
+
+    /// [`Error::StepTooLong`] for block `i` moved `distance` by the step of length `drift` that
+    /// has just been booked.
+    pub(super) fn too_far_error(&self, i: usize, distance: Real, drift: Real) -> Error {
+        let tolerance = self.params.contact.tolerance;
+        let speed = distance / drift;
+        Error::StepTooLong {
+            step: self.step,
+            time: self.time - drift,
+            dt: drift,
+            block: BlockId(i as u32),
+            distance,
+            tolerance,
+            speed,
+            max_dt: tolerance / speed,
+        }
+    }
+
+    /// The largest [`move_speed`] of the blocks (m/s), as the block pass leaves it.
+    pub(super) fn max_move_speed(&self) -> Real {
+        self.blocks.iter().map(move_speed).fold(0.0, Real::max)
     }
 }
