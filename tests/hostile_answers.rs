@@ -244,3 +244,39 @@ fn limit_analysis_messages_and_extreme_live_loads() {
         .expect("solved");
     assert_eq!(r.multiplier, 0.0);
 }
+
+/// A checkpoint whose tested pair's slack was raised and resealed is refused: the slack is
+/// re-derived from the two shapes at the stored relative pose (it let a moving cube pass
+/// through a fixed one). The honest slack loads.
+#[test]
+fn a_raised_slack_in_a_checkpoint_is_refused() {
+    let params = ModelParameters {
+        gravity: Vector::ZERO,
+        ..ModelParameters::default()
+    };
+    let mut model = common::model_with(params, CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
+    model
+        .add_block(common::cube("fixed", Vector::ZERO).with_fixity(Fixity::FIXED))
+        .expect("fixed");
+    // 1.2 mm apart along x: found apart with a slack of 0.2 mm.
+    model
+        .add_block(common::cube("free", Vector::new(0.2012, 0.0, 0.0)))
+        .expect("free");
+    model.step().expect("detected");
+    let text = model.to_checkpoint_string().expect("checkpoint");
+    Model::<CoulombSlip>::from_checkpoint_str(&text).expect("the honest checkpoint loads");
+    let mut doc: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let slack = doc["tested"][0]["slack"].as_f64().expect("a slack");
+    assert!((slack - 2e-4).abs() < 1e-9, "slack {slack}");
+    doc["tested"][0]["slack"] = 1.0.into();
+    let edited = voussoir::model::reseal_checkpoint(&doc.to_string()).expect("resealed");
+    let e = Model::<CoulombSlip>::from_checkpoint_str(&edited).unwrap_err();
+    assert!(
+        matches!(&e, Error::Checkpoint { path, .. } if path == "tested[0].slack"),
+        "{e}"
+    );
+    // Lowered (a conservative edit) it loads: the pair is only tested sooner.
+    doc["tested"][0]["slack"] = 1e-4.into();
+    let lowered = voussoir::model::reseal_checkpoint(&doc.to_string()).expect("resealed");
+    Model::<CoulombSlip>::from_checkpoint_str(&lowered).expect("a lower slack loads");
+}

@@ -187,3 +187,51 @@ fn removing_a_base_motion_stops_the_block() {
     assert_eq!(after, x, "the table stays where the motion left it");
     model.set_fixity(table, Fixity::FREE).expect("no motion now");
 }
+
+/// A series whose folder is deleted mid-run: the next frame is an error naming the missing
+/// file (it used to recreate the folder and list frames that no longer exist).
+#[test]
+fn a_series_whose_folder_is_deleted_mid_run_says_so() {
+    let dir = scratch("series-deleted");
+    let mut model = stepped_model(1);
+    let mut series = voussoir::io::vtk::Series::try_new(dir.join("out"), "run").expect("series");
+    series.write_frame(&model).expect("frame 0");
+    model.run_steps(2).expect("run");
+    series.write_frame(&model).expect("frame 1");
+    std::fs::remove_dir_all(dir.join("out")).expect("deleted");
+    let e = series.write_frame(&model).unwrap_err().to_string();
+    assert!(e.contains("run_blocks_00000.vtu") && e.contains("gone"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Two series writing one name into one folder: the second is refused at its first frame,
+/// naming the lock file (they used to overwrite each other's frames). Once the first is
+/// dropped its lock is gone and a new series writes; a lock left by a process that ended is
+/// taken over.
+#[test]
+fn two_series_of_one_name_in_one_folder_are_refused() {
+    use voussoir::io::vtk::Series;
+    let dir = scratch("series-lock");
+    let model = stepped_model(1);
+    let mut first = Series::try_new(&dir, "wall").expect("series");
+    first.write_frame(&model).expect("first");
+    let mut second = Series::try_new(&dir, "wall").expect("series");
+    let e = second.write_frame(&model).unwrap_err().to_string();
+    assert!(e.contains(".wall.lock") && e.contains("another series"), "{e}");
+    let mut clone = first.clone();
+    assert!(clone.write_frame(&model).is_err(), "a clone holds no lock");
+    // Another name in the same folder is fine.
+    Series::try_new(&dir, "arch").expect("series").write_frame(&model).expect("another name");
+    drop(first);
+    assert!(!dir.join(".wall.lock").exists(), "the lock is removed with its series");
+    second.write_frame(&model).expect("the folder is free now");
+    drop(second);
+    // A lock of a process that no longer runs (pid beyond Linux's pid_max).
+    std::fs::write(dir.join(".wall.lock"), "4294967295 0\n").expect("stale lock");
+    let mut third = Series::try_new(&dir, "wall").expect("series");
+    if cfg!(target_os = "linux") {
+        third.write_frame(&model).expect("a stale lock is taken over");
+    }
+    drop(third);
+    let _ = std::fs::remove_dir_all(&dir);
+}

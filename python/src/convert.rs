@@ -3,7 +3,7 @@
 
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
-use pyo3::exceptions::{PyIndexError, PyMemoryError, PyTypeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyInt, PyString};
 use voussoir::block::{Dof, Fixity};
@@ -29,7 +29,7 @@ pub fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector> {
 
 /// The most items read from an iterable of points or blocks: an endless iterable raises
 /// `MemoryError` there instead of growing until the allocator aborts the process.
-pub const MAX_ITEMS: usize = 10_000_000;
+pub const MAX_ITEMS: usize = 1_000_000;
 
 /// `MemoryError` for an iterable longer than [`MAX_ITEMS`].
 pub fn too_many(what: &str) -> PyErr {
@@ -57,21 +57,23 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Int {
 }
 
 impl Int {
-    /// The index of an item among `count` (`IndexError` naming `what` otherwise).
-    pub fn index(&self, what: &str, count: usize) -> PyResult<usize> {
+    /// A block index among `count` blocks (`VoussoirError`, a `ValueError`, naming `what`
+    /// otherwise: negative, beyond the blocks, or beyond any int the model holds).
+    pub fn block(&self, what: &str, count: usize) -> PyResult<voussoir::block::BlockId> {
         match self.0 {
-            Ok(k) if k >= 0 && (k as u64) < count as u64 => Ok(k as usize),
-            Ok(k) if k < 0 => Err(PyIndexError::new_err(format!(
-                "{what} {k} is negative: indices run from 0 to {} (negative indices are not counted from the end)",
-                count as i64 - 1
+            Ok(k) if k >= 0 && (k as u64) < count as u64 => Ok(voussoir::block::BlockId(k as u32)),
+            Ok(k) if k < 0 => Err(bad(format!(
+                "{what} {k} is negative: block indices run from 0 (negative indices are not counted from the end)"
             ))),
-            Ok(k) => Err(PyIndexError::new_err(format!(
-                "{what} {k} is out of range: there are {count} (indices 0 to {})",
-                count as i64 - 1
+            Ok(k) if k <= i64::from(u32::MAX) => Err(bad(format!(
+                "{what} {k}: {}",
+                voussoir::Error::UnknownBlock {
+                    id: voussoir::block::BlockId(k as u32),
+                    count
+                }
             ))),
-            Err(ref big) => Err(PyIndexError::new_err(format!(
-                "{what} {big} is out of range: there are {count}"
-            ))),
+            Ok(k) => Err(bad(format!("{what} {k} is out of range: the model has {count} blocks"))),
+            Err(ref big) => Err(bad(format!("{what} {big} is out of range: the model has {count} blocks"))),
         }
     }
 

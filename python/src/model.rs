@@ -136,10 +136,9 @@ impl PyModel {
         }
     }
 
-    /// The block of index `block` (`IndexError` naming the argument `what` when out of range).
+    /// The block of index `block` (`VoussoirError` naming the argument `what` when out of range).
     fn id(&self, block: &Int, what: &str) -> PyResult<BlockId> {
-        let k = block.index(what, self.model.blocks().len())?;
-        Ok(BlockId(k as u32))
+        block.block(what, self.model.blocks().len())
     }
 
     /// Runs to `goal`, in chunks: the GIL is released during a chunk; between chunks Ctrl-C is
@@ -1159,7 +1158,10 @@ fn wrench<'py>(py: Python<'py>, w: Wrench) -> PyResult<Bound<'py, PyDict>> {
 
 /// A ParaView series: ``ParaviewSeries(folder, name)``; ``write_frame(model)`` writes the
 /// blocks and sub-contacts of the model as a frame and rewrites the ``.pvd`` collections
-/// (``blocks_pvd``), which ParaView opens as a time series.
+/// (``blocks_pvd``), which ParaView opens as a time series. One series writes a name in a
+/// folder at a time (a lock file ``.<name>.lock`` from the first frame until the series is
+/// freed): a second one, in this process or another, raises ``VoussoirIOError``; so does a
+/// frame after the folder was deleted or emptied mid-run.
 #[pyclass(name = "ParaviewSeries", module = "voussoir")]
 pub struct PySeries {
     inner: voussoir::io::vtk::Series,
