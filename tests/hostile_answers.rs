@@ -280,3 +280,49 @@ fn a_raised_slack_in_a_checkpoint_is_refused() {
     let lowered = voussoir::model::reseal_checkpoint(&doc.to_string()).expect("resealed");
     Model::<CoulombSlip>::from_checkpoint_str(&lowered).expect("a lower slack loads");
 }
+
+/// Servo loading refuses, before its first step, what it used to run silently: a direction
+/// along a translation that is not prescribed (20,000 steps without moving the plate), a block
+/// with a base motion (which overrode the servo), an increment above half the contact
+/// tolerance (1 mm a step drove a cube 66 mm into its base).
+#[test]
+fn servo_refuses_what_it_cannot_do() {
+    use voussoir::loading::{BaseMotion, MotionKind, Servo, TimeHistory};
+    let plate_model = |fixity: Fixity| {
+        let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
+        model.add_block(common::fixed_slab("base")).expect("slab");
+        model.add_block(common::cube("cube", Vector::ZERO)).expect("cube");
+        let plate = model
+            .add_block(common::cube("plate", Vector::new(0.0, 0.0, common::CUBE_EDGE)).with_fixity(fixity))
+            .expect("plate");
+        (model, plate)
+    };
+    let mut none = |_: &Model| Ok::<_, Error>(std::ops::ControlFlow::Continue(()));
+    // Only x prescribed, driven along z.
+    let mut only_x = Fixity::FIXED;
+    only_x.translation[0] = Dof::Velocity(0.0);
+    let (mut model, plate) = plate_model(only_x);
+    let servo = Servo::new(plate, Vector::NEG_Z, 1e-6, 1e-3).expect("servo");
+    let e = servo.run(&mut model, 20_000, &mut none).unwrap_err();
+    assert!(e.to_string().contains("along z"), "{e}");
+    assert_eq!(model.step_count(), 0, "refused before stepping");
+    // A base motion on the plate.
+    let (mut model, plate) = plate_model(Fixity::velocity(Vector::ZERO));
+    let shake = TimeHistory::sine(1.0, 2.0, 1.0, 20).expect("history");
+    model
+        .set_base_motion(
+            plate,
+            Some(BaseMotion::new(MotionKind::Acceleration, [Some(shake), None, None]).expect("motion")),
+        )
+        .expect("motion");
+    let e = servo.run(&mut model, 10, &mut none).unwrap_err();
+    assert!(e.to_string().contains("base motion"), "{e}");
+    // An increment of the contact tolerance.
+    let (mut model, plate) = plate_model(Fixity::velocity(Vector::ZERO));
+    let coarse = Servo::new(plate, Vector::NEG_Z, 1e-3, 1e-3).expect("servo");
+    let e = coarse.run(&mut model, 10, &mut none).unwrap_err();
+    assert!(e.to_string().contains("half the contact tolerance"), "{e}");
+    let fine = Servo::new(plate, Vector::NEG_Z, 5e-4, 1e-3).expect("servo");
+    fine.run(&mut model, 10, &mut none)
+        .expect("half the tolerance is accepted");
+}

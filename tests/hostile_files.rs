@@ -221,7 +221,10 @@ fn two_series_of_one_name_in_one_folder_are_refused() {
     let mut clone = first.clone();
     assert!(clone.write_frame(&model).is_err(), "a clone holds no lock");
     // Another name in the same folder is fine.
-    Series::try_new(&dir, "arch").expect("series").write_frame(&model).expect("another name");
+    Series::try_new(&dir, "arch")
+        .expect("series")
+        .write_frame(&model)
+        .expect("another name");
     drop(first);
     assert!(!dir.join(".wall.lock").exists(), "the lock is removed with its series");
     second.write_frame(&model).expect("the folder is free now");

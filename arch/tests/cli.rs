@@ -100,10 +100,10 @@ fn the_setup_names_are_the_scenarios() {
 #[test]
 fn static_servo_and_friction_are_checked_when_parsed() {
     for (flag, value, range) in [
-        ("--servo-increment", "0", "(0, 0.001]"),
-        ("--servo-increment", "-2e-5", "(0, 0.001]"),
-        ("--servo-increment", "inf", "(0, 0.001]"),
-        ("--servo-increment", "0.01", "(0, 0.001]"),
+        ("--servo-increment", "0", "(0, 0.0005]"),
+        ("--servo-increment", "-2e-5", "(0, 0.0005]"),
+        ("--servo-increment", "inf", "(0, 0.0005]"),
+        ("--servo-increment", "0.01", "(0, 0.0005]"),
         ("--servo-ratio", "0", "(0, 0.1]"),
         ("--servo-ratio", "nan", "(0, 0.1]"),
         ("--servo-ratio", "0.5", "(0, 0.1]"),

@@ -73,7 +73,9 @@ impl Int {
                 }
             ))),
             Ok(k) => Err(bad(format!("{what} {k} is out of range: the model has {count} blocks"))),
-            Err(ref big) => Err(bad(format!("{what} {big} is out of range: the model has {count} blocks"))),
+            Err(ref big) => Err(bad(format!(
+                "{what} {big} is out of range: the model has {count} blocks"
+            ))),
         }
     }
 

@@ -87,10 +87,11 @@ pub const FRICTION_RANGE: Interval = Interval {
     lo: Excluded(0.0),
     hi: Excluded(90.0),
 };
-/// Range of `--servo-increment` (m).
+/// Range of `--servo-increment` (m): at most half the contact tolerance (1 mm), as
+/// `voussoir::loading::Servo::run` requires.
 pub const SERVO_INCREMENT_RANGE: Interval = Interval {
     lo: Excluded(0.0),
-    hi: Included(1e-3),
+    hi: Included(5e-4),
 };
 /// Range of `--servo-ratio`.
 pub const SERVO_RATIO_RANGE: Interval = Interval {
