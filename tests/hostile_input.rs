@@ -184,3 +184,20 @@ fn huge_generators_are_refused() {
     let e = voussoir::build::arch::Arch::new(&spec).unwrap_err();
     assert!(matches!(e, Error::TooLarge { .. }), "{e:?}");
 }
+
+/// A joint stiffness near f64's limit (1.7e308 Pa/m, found by the fuzzer) overflows the
+/// stability bound: the step is an error naming the critical step, not a NaN `dt` after a
+/// step reported as successful.
+#[test]
+fn a_stiffness_that_overflows_the_step_is_an_error() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fuzz/corpus/scene/overflow-stiffness.json"),
+    )
+    .expect("seed");
+    let mut model = Scene::<CoulombSlip>::from_json(&text)
+        .expect("scene")
+        .build()
+        .expect("model");
+    let e = model.step().unwrap_err();
+    assert!(e.to_string().contains("critical time step"), "{e}");
+}
