@@ -201,3 +201,23 @@ fn a_stiffness_that_overflows_the_step_is_an_error() {
     let e = model.step().unwrap_err();
     assert!(e.to_string().contains("critical time step"), "{e}");
 }
+
+/// Found by the fuzzers of issue 33: samples 1e-323 s apart (their slope overflows) are
+/// refused; a velocity whose kinetic energy overflows is refused, so that the model still
+/// saves a checkpoint that loads (its energy used to be written as null).
+#[test]
+fn overflowing_histories_and_velocities_are_refused() {
+    let e = TimeHistory::new(vec![0.0, 1e-323], vec![0.0, -49.05]).unwrap_err();
+    assert!(e.to_string().contains("overflow"), "{e}");
+    let mut model: Model = Model::new(ModelParameters::default()).expect("model");
+    let cube = model
+        .add_block(RigidBlock::cuboid("c", Vector::ZERO, Vector::splat(0.2), 2500.0).expect("cube"))
+        .expect("cube");
+    let e = model
+        .set_velocity(cube, Vector::new(1e308, 0.0, 0.0), Vector::ZERO)
+        .unwrap_err();
+    assert!(matches!(e, Error::NonFinite { .. }), "{e:?}");
+    assert_eq!(model.block(cube).expect("cube").state().velocity, Vector::ZERO);
+    let text = model.to_checkpoint_string().expect("saves");
+    Model::<CoulombSlip>::from_checkpoint_str(&text).expect("loads");
+}

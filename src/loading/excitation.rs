@@ -116,6 +116,20 @@ impl TimeHistory {
                 u,
             );
             integrals.push((v, u));
+            let slope = (values[k + 1] - values[k]) / (times[k + 1] - times[k]);
+            if !(slope.is_finite() && v.is_finite() && u.is_finite()) {
+                return Err(Error::InvalidParameter {
+                    name: format!(
+                        "time history: samples {k} and {} (times {} and {})",
+                        k + 1,
+                        times[k],
+                        times[k + 1]
+                    ),
+                    value: slope,
+                    expected: "samples whose slope and integrals are finite (times this close, or values this \
+                               large, overflow f64)",
+                });
+            }
         }
         Ok(Self {
             times,

@@ -331,6 +331,18 @@ where
             message: e.to_string(),
         };
         let mut value = serde_json::to_value(&snap).map_err(io)?;
+        // A non-finite energy is written as null, which would not load: what saves must load.
+        if let Some((term, _)) = value["energy"]
+            .as_object()
+            .and_then(|m| m.iter().find(|(_, v)| v.is_null()))
+        {
+            return Err(Error::NonFinite {
+                what: format!(
+                    "energy term `{term}` of the model (a velocity, load or force beyond f64's range): a checkpoint \
+                     of it would not load"
+                ),
+            });
+        }
         let checksum = checksum_of(&value);
         if let serde_json::Value::Object(map) = &mut value {
             map.insert(CHECKSUM.into(), checksum.into());

@@ -483,7 +483,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// kinetic energy counts as energy put in ([`Energies::initial_kinetic`]).
     ///
     /// # Errors
-    /// [`Error::UnknownBlock`], [`Error::NonFinite`].
+    /// [`Error::UnknownBlock`], [`Error::NonFinite`] (also for a kinetic energy that overflows).
     pub fn set_velocity(&mut self, id: BlockId, velocity: Vector, angular_velocity: Vector) -> Result<()> {
         if !is_finite_vector(velocity) || !is_finite_vector(angular_velocity) {
             return Err(Error::NonFinite {
@@ -492,8 +492,16 @@ impl<L: ConstitutiveLaw> Model<L> {
         }
         let b = self.block_mut(id)?;
         let before = b.kinetic_energy();
+        let (v0, w0) = (b.state.velocity, b.state.angular_velocity);
         b.replace_velocity(velocity, angular_velocity);
         let after = b.kinetic_energy();
+        if !after.is_finite() {
+            // 1e308 m/s: the kinetic energy overflows (and a checkpoint would not load).
+            b.replace_velocity(v0, w0);
+            return Err(Error::NonFinite {
+                what: format!("kinetic energy of block {id} at the velocity given (beyond f64's range)"),
+            });
+        }
         // Kinetic energy given by the user counts as energy put in.
         if self.state.started {
             self.state.energy.initial_kinetic += after - before;
