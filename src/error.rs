@@ -375,7 +375,6 @@ pub fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'static 
 }
 
 /// [`Error::Io`] naming the file.
-#[cfg(feature = "serde")]
 pub(crate) fn io_error(path: &std::path::Path, e: &std::io::Error) -> Error {
     Error::Io {
         path: path.display().to_string(),

@@ -26,6 +26,9 @@ fn motion() -> serde_json::Value {
     })
 }
 
+/// An edit of a scene document.
+type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+
 /// Each documented object refuses a field it does not know, naming it and its path (they all
 /// loaded without a word: a record meant in g ran 9.81 times too weak).
 #[test]
@@ -33,7 +36,7 @@ fn unknown_fields_are_refused_everywhere() {
     let mut base = example();
     base["blocks"][0]["motion"] = motion();
     load(&base).expect("the example with a motion loads");
-    let edits: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>)> = vec![
+    let edits: Vec<(&str, Edit)> = vec![
         (
             "unit",
             Box::new(|d| d["blocks"][0]["motion"]["axes"][0]["unit"] = "g".into()),

@@ -331,7 +331,7 @@ fn normalised(text: &str) -> Option<String> {
     serde_json::to_string(&doc).ok()
 }
 
-fn read(path: &PathBuf) -> PyResult<String> {
+fn read(path: &std::path::Path) -> PyResult<String> {
     voussoir::io::read_text(path).py()
 }
 
@@ -524,7 +524,7 @@ impl PyModel {
     /// in the list).
     fn add_blocks(&mut self, blocks: Vec<PyRef<'_, PyBlock>>) -> PyResult<Vec<usize>> {
         // The checks of `add_block` depend on the parameters only: tried on an empty model first.
-        let mut trial = Model::<AnyLaw>::new(self.model.parameters().clone()).py()?;
+        let mut trial = Model::<AnyLaw>::new(*self.model.parameters()).py()?;
         for (k, b) in blocks.iter().enumerate() {
             trial
                 .add_block(b.inner.clone())
