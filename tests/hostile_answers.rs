@@ -145,20 +145,28 @@ fn a_cube_on_its_edge_has_no_capacity_in_limit_analysis() {
     assert_eq!(model.contacts().count(), 1);
     let weight = common::STONE_DENSITY * a * a * a * 9.81;
     let problem = LimitProblem::from_model(&model).expect("problem");
-    let result = problem
-        .solve(
-            &[LiveLoad {
-                block: cube,
-                point: Vector::new(0.0, 0.0, r),
-                force: Vector::X,
-            }],
-            &LimitOptions::default(),
-        )
-        .expect("solved");
-    let ratio = result.multiplier / weight;
-    println!("cube on its edge: λ = {:.4e} W", ratio);
-    // Strip of half-width tolerance/2 at the foot, lever arm r: λ ≈ (0.5 mm / 141 mm) W.
-    assert!(ratio.abs() < 0.01, "λ = {ratio} W");
+    for (pair, corners) in problem.polygons() {
+        println!("contact {pair:?}: corners {corners:?}");
+    }
+    // Pushed either way: towards the side of the face that the contact was found on (where
+    // the old analysis took the whole face and answered sliding, W tan 40°), and away from it.
+    for direction in [Vector::NEG_X, Vector::X] {
+        let result = problem
+            .solve(
+                &[LiveLoad {
+                    block: cube,
+                    point: Vector::new(0.0, 0.0, r),
+                    force: direction,
+                }],
+                &LimitOptions::default(),
+            )
+            .expect("solved");
+        let ratio = result.multiplier / weight;
+        println!("cube on its edge pushed along {direction}: λ = {ratio:.4e} W");
+        // The strip is 0.7 mm wide in x; the lever arm of the weight about its far edge is
+        // at most 0.7 mm against a height of 141 mm: λ ≤ 0.005 W.
+        assert!(ratio.abs() < 0.01, "λ = {ratio} W");
+    }
     // A cube flat on the slab keeps its capacity: W tan 40° by sliding (its overturning
     // capacity is W/2, above that).
     let mut flat = common::model(CoulombSlip::dry(1e9, 4e8, 40.0).expect("law"));
