@@ -229,8 +229,10 @@ struct BlockSums {
     kinetic: Real,
     /// First block of the chunk that diverged.
     diverged: Option<usize>,
-    /// The largest [`motion::move_speed`] of the chunk's blocks after the move (m/s).
-    max_speed: Real,
+    /// The largest squared speeds of translation and of rotation at the radius of the
+    /// chunk's blocks after the move (m²/s², see [`motion::move_speeds2`]).
+    max_v2: Real,
+    max_w2: Real,
     /// First block of the chunk that the step moved further than the contact tolerance, and
     /// how far (m).
     too_far: Option<(usize, Real)>,

@@ -49,25 +49,36 @@ struct BlockPass<'a> {
     /// The re-detection trigger (m) in large-displacement mode, for the next step's movement
     /// check.
     trigger: Option<Real>,
-    /// This step's drift `Δt_{n+½}` (s), over which the blocks move.
+    /// This step's drift `Δt_{n+½}` (s), over which the blocks move, and its square.
     drift: Real,
-    /// The contact tolerance (m): no block may move further in one step.
+    drift2: Real,
+    /// The contact tolerance (m): no block may move further in one step; and its square.
     tolerance: Real,
+    tolerance2: Real,
 }
 
-/// The speed of the fastest point of a block for its next move (m/s): its translation speed,
-/// with prescribed velocities ([`Dof::Velocity`]) in place of the state's on those axes, plus
-/// its angular speed times its radius. After a step the state's velocity on a prescribed axis
-/// is the prescribed one, so this is the speed the block just moved at.
+/// The squared speeds of a block for its next move: of its translation, with prescribed
+/// velocities ([`Dof::Velocity`]) in place of the state's on those axes, and of its fastest
+/// point in rotation (angular speed times radius). After a step the state's velocity on a
+/// prescribed axis is the prescribed one, so these are what the block just moved at, as the
+/// block pass measures them from the state alone.
 #[inline]
-pub(super) fn move_speed(b: &RigidBlock) -> Real {
+pub(super) fn move_speeds2(b: &RigidBlock) -> (Real, Real) {
     let mut v = b.state.velocity.to_array();
     for (v, d) in v.iter_mut().zip(b.fixity().translation) {
         if let Dof::Velocity(p) = d {
             *v = p;
         }
     }
-    Vector::from_array(v).length() + b.state.angular_velocity.length() * b.radius
+    let w2 = b.state.angular_velocity.length_squared() * b.radius * b.radius;
+    (Vector::from_array(v).length_squared(), w2)
+}
+
+/// The speed bound of the step length from the largest squared speeds of translation and of
+/// rotation at the radius (m/s): at least the largest speed of any point of any block.
+#[inline]
+pub(super) fn speed_bound(max_v2: Real, max_w2: Real) -> Real {
+    max_v2.sqrt() + max_w2.sqrt()
 }
 
 /// `total` plus the wrenches of a block's contacts, in index order: `entries` are the block's
@@ -146,12 +157,18 @@ impl BlockPass<'_> {
             if sums.diverged.is_none() && diverged(b, self.max_speed2) {
                 sums.diverged = Some(first_block + j);
             }
-            // The move of this step: `v_{n+½} Δt_{n+½}` (and the rotation's at the radius).
-            let speed = move_speed(b);
-            sums.max_speed = sums.max_speed.max(speed);
-            let distance = speed * self.drift;
-            if sums.too_far.is_none() && distance > self.tolerance {
-                sums.too_far = Some((first_block + j, distance));
+            // The move of this step: `v_{n+½} Δt_{n+½}` (and the rotation's at the radius),
+            // with square roots only for a block that may have moved past the tolerance
+            // (`(a + b)² ≤ 2 (a² + b²)`).
+            let v2 = b.state.velocity.length_squared();
+            let w2 = b.state.angular_velocity.length_squared() * b.radius * b.radius;
+            sums.max_v2 = sums.max_v2.max(v2);
+            sums.max_w2 = sums.max_w2.max(w2);
+            if sums.too_far.is_none() && 2.0 * (v2 + w2) * self.drift2 > self.tolerance2 {
+                let distance = (v2.sqrt() + w2.sqrt()) * self.drift;
+                if distance > self.tolerance {
+                    sums.too_far = Some((first_block + j, distance));
+                }
             }
         }
     }
@@ -187,7 +204,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             trigger: (self.params.mode == DisplacementMode::Large)
                 .then_some(self.params.contact.redetect_fraction * self.params.contact.tolerance),
             drift,
+            drift2: drift * drift,
             tolerance: self.params.contact.tolerance,
+            tolerance2: self.params.contact.tolerance * self.params.contact.tolerance,
         };
         pipeline.block_sums.clear();
         pipeline
@@ -229,7 +248,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let mut kinetic = 0.0;
         let mut first_diverged = None;
         let mut first_too_far = None;
-        let mut max_speed: Real = 0.0;
+        let (mut max_v2, mut max_w2): (Real, Real) = (0.0, 0.0);
         let e = &mut self.energy;
         for s in &pipeline.block_sums {
             max_unbalanced = max_unbalanced.max(s.max_unbalanced);
@@ -240,9 +259,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             kinetic += s.kinetic;
             first_diverged = first_diverged.or(s.diverged);
             first_too_far = first_too_far.or(s.too_far);
-            max_speed = max_speed.max(s.max_speed);
+            max_v2 = max_v2.max(s.max_v2);
+            max_w2 = max_w2.max(s.max_w2);
         }
-        pipeline.max_speed = Some(max_speed);
+        pipeline.max_speed = Some(speed_bound(max_v2, max_w2));
         e.kinetic = kinetic;
         for s in &pipeline.pair_sums {
             e.joint_work += s.work;
@@ -265,7 +285,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
 
     /// `drift` cut, with an automatic step ([`TimeStep::Auto`]), so that the fastest block moves
     /// at most [`STEP_TRAVEL`] of the contact tolerance: `d` with `v d + g d² = STEP_TRAVEL ×
-    /// tolerance`, `v` the largest speed at the end of the last step ([`move_speed`]), `g` the
+    /// tolerance`, `v` a bound of the largest speed at the end of the last step ([`speed_bound`]), `g` the
     /// gravity (central difference moves a block by its velocity after the kick, `(v + g d) d`). A fixed step is not cut (the block pass stops the run instead).
     pub(super) fn cap_drift(&self, pipeline: &mut Pipeline<L::State>, drift: Real) -> Real {
         if !matches!(self.params.time_step, TimeStep::Auto { .. }) {
@@ -299,8 +319,13 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
     }
 
-    /// The largest [`move_speed`] of the blocks (m/s), as the block pass leaves it.
+    /// The [`speed_bound`] of the blocks' [`move_speeds2`] (m/s), as the block pass leaves it.
     pub(super) fn max_move_speed(&self) -> Real {
-        self.blocks.iter().map(move_speed).fold(0.0, Real::max)
+        let (v2, w2) = self
+            .blocks
+            .iter()
+            .map(move_speeds2)
+            .fold((0.0, 0.0), |(a, b): (Real, Real), (v, w)| (a.max(v), b.max(w)));
+        speed_bound(v2, w2)
     }
 }
