@@ -2,6 +2,7 @@
 index arguments, sizes that would abort, endless inputs, series written twice."""
 
 import itertools
+import pathlib
 import subprocess
 import sys
 import time
@@ -115,3 +116,35 @@ def test_two_series_of_one_name_in_one_folder(tmp_path, model):
         second.write_frame(model)
     del first
     second.write_frame(model)
+
+
+def test_two_processes_writing_one_series_folder(tmp_path):
+    """A series held by another running process is refused (the lock file names its process);
+    once that process has ended, its lock is taken over."""
+    script = f"""
+import sys, time
+sys.path = {sys.path!r}
+sys.path.insert(0, {str(pathlib.Path(__file__).parent)!r})
+import voussoir as vs
+from conftest import block_on_base
+m = block_on_base()
+m.run_steps(1)
+s = vs.ParaviewSeries({str(tmp_path)!r}, "shared")
+s.write_frame(m)
+print("holding", flush=True)
+time.sleep(30)
+"""
+    other = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    try:
+        assert other.stdout.readline().strip() == "holding"
+        m = block_on_base()
+        m.run_steps(1)
+        mine = vs.ParaviewSeries(tmp_path, "shared")
+        with pytest.raises(vs.VoussoirIOError, match=f"process {other.pid}"):
+            mine.write_frame(m)
+    finally:
+        other.kill()
+        other.wait()
+    # The other process was killed holding its lock: the lock is stale and taken over.
+    mine.write_frame(m)
+    assert len(mine) == 1
