@@ -285,8 +285,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
 
     /// `drift` cut, with an automatic step ([`TimeStep::Auto`]), so that the fastest block moves
     /// at most [`STEP_TRAVEL`] of the contact tolerance: `d` with `v d + g d² = STEP_TRAVEL ×
-    /// tolerance`, `v` a bound of the largest speed at the end of the last step ([`speed_bound`]), `g` the
-    /// gravity (central difference moves a block by its velocity after the kick, `(v + g d) d`). A fixed step is not cut (the block pass stops the run instead).
+    /// tolerance`, `v` a bound of the largest speed at the end of the last step
+    /// ([`speed_bound`]), `g` the gravity (central difference moves a block by its velocity
+    /// after the kick, `(v + g d) d`). A fixed step is not cut (the block pass stops the run
+    /// instead).
     pub(super) fn cap_drift(&self, pipeline: &mut Pipeline<L::State>, drift: Real) -> Real {
         if !matches!(self.params.time_step, TimeStep::Auto { .. }) {
             return drift;
