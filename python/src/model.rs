@@ -14,7 +14,7 @@ use voussoir::contact::DisplacementMode;
 use voussoir::geometry::SubcontactDensity;
 use voussoir::integrate::{Damping, TimeStep};
 use voussoir::io::scene::Scene;
-use voussoir::law::{AnyLaw, CoulombSlip, JointStatus, MaterialId};
+use voussoir::law::{AnyLaw, JointStatus, MaterialId};
 use voussoir::math::Vector;
 use voussoir::model::{Model, ModelParameters};
 use voussoir::monitor::{Component, EnergyTerm, Monitor, Recorder};
@@ -22,6 +22,7 @@ use voussoir::Error;
 
 use crate::blocks::PyBlock;
 use crate::convert::{array1, array_n3, array_n33, array_nk, vec3, vec3_or_zero, vector, Int};
+use crate::documents::{normalised, read, scene_json};
 use crate::errors::{bad, OrPy};
 use crate::laws::{law_from_py, law_to_py};
 
@@ -124,7 +125,7 @@ enum Goal {
 /// rows of the arrays that ``positions()``, ``velocities()`` etc. return.
 #[pyclass(name = "Model", module = "voussoir")]
 pub struct PyModel {
-    model: Model<AnyLaw>,
+    pub(crate) model: Model<AnyLaw>,
     samples: Samples,
 }
 
@@ -266,107 +267,9 @@ fn status_name(s: JointStatus) -> &'static str {
     }
 }
 
-/// A scene or checkpoint document of a model with one law type, as one of `Model<AnyLaw>`: a
-/// law without its kind (`{"normal_stiffness": ..}` of a `Scene<CoulombSlip>`) is named
-/// (`{"Coulomb": ..}`, or `{"Elastic": ..}` without a friction angle), and so is a
-/// sub-contact's law state.
-fn as_any_law(doc: &mut serde_json::Value) {
-    use serde_json::Value;
-    fn wrap_law(law: &mut Value) {
-        if let Value::Object(map) = law {
-            if !map.contains_key("Coulomb") && !map.contains_key("Elastic") {
-                let kind = if map.contains_key("friction_deg") {
-                    "Coulomb"
-                } else {
-                    "Elastic"
-                };
-                *law = serde_json::json!({ kind: law.take() });
-            }
-        }
-    }
-    // Scenes: joints[k].law.
-    if let Some(Value::Array(joints)) = doc.get_mut("joints") {
-        for j in joints {
-            if let Some(law) = j.get_mut("law") {
-                wrap_law(law);
-            }
-        }
-    }
-    // Checkpoints: joints.laws[k], contacts[k].subcontacts[j].state.
-    if let Some(Value::Array(laws)) = doc.get_mut("joints").and_then(|j| j.get_mut("laws")) {
-        for law in laws {
-            wrap_law(law);
-        }
-    }
-    if let Some(Value::Array(contacts)) = doc.get_mut("contacts") {
-        for c in contacts {
-            if let Some(Value::Array(subs)) = c.get_mut("subcontacts") {
-                for s in subs {
-                    if let Some(state) = s.get_mut("state") {
-                        match state {
-                            Value::Null => *state = serde_json::json!({}),
-                            Value::Object(m) if !m.contains_key("coulomb") && m.contains_key("failed") => {
-                                *state = serde_json::json!({ "coulomb": state.take() });
-                            }
-                            _ => {}
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Parses JSON text for [`as_any_law`]; on a syntax error, `None` (the typed parser then
-/// reports it with its own message).
 /// A material id from a Python int (`ValueError` naming `what` outside [0, 65535]).
 fn material(k: &Int, what: &str) -> PyResult<MaterialId> {
     Ok(MaterialId(k.at_most(what, u64::from(u16::MAX))? as u16))
-}
-
-fn normalised(text: &str) -> Option<String> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut doc: serde_json::Value = serde_json::from_str(text).ok()?;
-    as_any_law(&mut doc);
-    serde_json::to_string(&doc).ok()
-}
-
-fn read(path: &std::path::Path) -> PyResult<String> {
-    voussoir::io::read_text(path).py()
-}
-
-/// A scene of `Model<AnyLaw>` as JSON, written as a `Scene<CoulombSlip>` when every law is
-/// Coulomb's (what a Rust program with the default `Model` reads).
-fn scene_json(scene: &Scene<AnyLaw>) -> voussoir::Result<String> {
-    let laws: Option<Vec<CoulombSlip>> = scene
-        .joints
-        .iter()
-        .map(|j| match j.law {
-            AnyLaw::Coulomb(c) => Some(c),
-            _ => None,
-        })
-        .collect();
-    let text = scene.to_json()?;
-    if laws.is_none() {
-        return Ok(text);
-    }
-    let mut doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::Io {
-        path: "(scene)".into(),
-        message: e.to_string(),
-    })?;
-    if let Some(serde_json::Value::Array(joints)) = doc.get_mut("joints") {
-        for j in joints {
-            if let Some(law) = j.get_mut("law") {
-                if let Some(inner) = law.get_mut("Coulomb").map(serde_json::Value::take) {
-                    *law = inner;
-                }
-            }
-        }
-    }
-    serde_json::to_string_pretty(&doc).map_err(|e| Error::Io {
-        path: "(scene)".into(),
-        message: e.to_string(),
-    })
 }
 
 #[pymethods]
@@ -1088,7 +991,7 @@ contact_resultant, energy or unbalanced_ratio"
 
     /// A model from scene JSON, with its monitors (laws with or without their kind).
     #[staticmethod]
-    fn from_scene_json(text: &str) -> PyResult<Self> {
+    pub(crate) fn from_scene_json(text: &str) -> PyResult<Self> {
         let scene = match normalised(text) {
             Some(t) => Scene::<AnyLaw>::from_json(&t),
             None => Scene::<AnyLaw>::from_json(text),
@@ -1154,58 +1057,4 @@ fn wrench<'py>(py: Python<'py>, w: Wrench) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("force", vector(py, w.force))?;
     d.set_item("moment", vector(py, w.moment))?;
     Ok(d)
-}
-
-/// A ParaView series: ``ParaviewSeries(folder, name)``; ``write_frame(model)`` writes the
-/// blocks and sub-contacts of the model as a frame and rewrites the ``.pvd`` collections
-/// (``blocks_pvd``), which ParaView opens as a time series. One series writes a name in a
-/// folder at a time (a lock file ``.<name>.lock`` from the first frame until the series is
-/// freed): a second one, in this process or another, raises ``VoussoirIOError``; so does a
-/// frame after the folder was deleted or emptied mid-run.
-#[pyclass(name = "ParaviewSeries", module = "voussoir")]
-pub struct PySeries {
-    inner: voussoir::io::vtk::Series,
-}
-
-#[pymethods]
-impl PySeries {
-    #[new]
-    #[pyo3(signature = (folder, name="model"))]
-    fn new(folder: PathBuf, name: &str) -> Self {
-        Self {
-            inner: voussoir::io::vtk::Series::new(folder, name),
-        }
-    }
-
-    /// Writes a frame of the model.
-    fn write_frame(&mut self, model: PyRef<'_, PyModel>) -> PyResult<()> {
-        self.inner.write_frame(&model.model).py()
-    }
-
-    /// The blocks' ``.pvd`` collection.
-    #[getter]
-    fn blocks_pvd(&self) -> PathBuf {
-        self.inner.blocks_pvd()
-    }
-
-    fn __len__(&self) -> usize {
-        self.inner.len()
-    }
-}
-
-/// The benchmarks' wall (``voussoir::scenes::benchmark_wall``): about ``blocks`` bricks in
-/// running bond on a fixed base, dry Coulomb joints (kn 1 GPa/m, ks 0.4 GPa/m, φ 30°),
-/// sub-contacts at most ``spacing`` m apart (default 0.025), local damping; not yet stepped.
-#[pyfunction]
-#[pyo3(signature = (blocks, *, spacing=None))]
-pub fn benchmark_wall(blocks: usize, spacing: Option<f64>) -> PyResult<PyModel> {
-    let model = match spacing {
-        Some(h) => voussoir::scenes::benchmark_wall_with_spacing(blocks, h),
-        None => voussoir::scenes::benchmark_wall(blocks),
-    }
-    .py()?;
-    // A Model<CoulombSlip> as a Model<AnyLaw>, through its scene.
-    let scene = Scene::from_model(&model);
-    let text = scene.to_json().py()?;
-    PyModel::from_scene_json(&text)
 }
