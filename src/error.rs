@@ -222,6 +222,59 @@ pub enum Error {
         /// The contact tolerance (m).
         tolerance: Real,
     },
+    /// A block's translation driven by a base motion was to be set free: the motion would put
+    /// it back at the next step, and a model saved in between would not load.
+    #[error(
+        "block {block}: its translation along {axis} is driven by a base motion ({motion}) and cannot \
+         be set free while the motion applies: remove the motion first (set_base_motion(block, None))"
+    )]
+    DrivenAxisFreed {
+        /// The block.
+        block: BlockId,
+        /// The world axis, `"x"`, `"y"` or `"z"`.
+        axis: &'static str,
+        /// The motion, e.g. `"Acceleration on x, y, started at t = 0 s"`.
+        motion: String,
+    },
+    /// A step moved a block further than the contact tolerance allows: contacts could be
+    /// missed (a block passing through another). The step is too long for the block's speed:
+    /// lower the speed or the fixed time step, or raise the contact tolerance.
+    #[error(
+        "step {step} (t = {time} s, dt = {dt} s) moved block {block} by {distance:.4e} m, more than \
+         the contact tolerance {tolerance} m allows in one step: contacts could be missed \
+         (a speed of {speed:.4e} m/s needs dt <= {max_dt:.4e} s)"
+    )]
+    StepTooLong {
+        /// The step that moved the block.
+        step: u64,
+        /// Time at the start of the step.
+        time: Real,
+        /// The step's length (s).
+        dt: Real,
+        /// The block.
+        block: BlockId,
+        /// How far a point of the block moved in the step (m): translation plus rotation times
+        /// the block's radius.
+        distance: Real,
+        /// The contact tolerance (m).
+        tolerance: Real,
+        /// The block's speed in the step (`distance / dt`, m/s).
+        speed: Real,
+        /// The longest step at that speed that stays within the tolerance (s).
+        max_dt: Real,
+    },
+    /// A size beyond what voussoir builds or reads (blocks of a generator, facets of a friction
+    /// pyramid, bytes of a file): refused before allocating, instead of the process aborting
+    /// when memory runs out. (Python: `MemoryError`.)
+    #[error("{what}: {requested} is more than the limit {limit}")]
+    TooLarge {
+        /// What was asked for, e.g. `"wall.courses × (wall.bricks_per_course + 1) blocks"`.
+        what: String,
+        /// The size asked for.
+        requested: u128,
+        /// The largest size accepted.
+        limit: u64,
+    },
     /// A model with no blocks was asked to step (time could not advance: a run would never end).
     #[error("the model has no blocks: add one before stepping")]
     EmptyModel,
@@ -330,7 +383,6 @@ pub fn in_range(name: &str, value: Real, lo: Real, hi: Real, expected: &'static 
 }
 
 /// [`Error::Io`] naming the file.
-#[cfg(feature = "serde")]
 pub(crate) fn io_error(path: &std::path::Path, e: &std::io::Error) -> Error {
     Error::Io {
         path: path.display().to_string(),

@@ -79,7 +79,7 @@ pub mod build;
 pub mod contact;
 mod dispatch;
 pub mod error;
-#[cfg(feature = "serde")]
+#[cfg_attr(not(feature = "serde"), allow(dead_code))]
 mod file;
 pub mod geometry;
 pub mod ids;

@@ -93,6 +93,7 @@ pub enum EnergyTerm {
 /// A quantity sampled during a run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub enum Monitor {
     /// Displacement (m) of the material point that was at `point` (world) when the block was built.
     Displacement {

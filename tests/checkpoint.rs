@@ -312,29 +312,34 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
 }
 
 /// A checkpoint is never written in place: the text goes to a temporary file beside the
-/// target, which then replaces it. Here the target is a link to `/dev/full` (a disk that is
-/// always full): writing in place fails with "no space left" (and on a real full disk would
-/// have truncated the previous checkpoint); writing beside and renaming replaces the link.
-#[cfg(target_os = "linux")]
+/// target, which then replaces it. Here the target is a hard link of another file: writing in
+/// place would change both names' content (and on a full disk would have truncated the
+/// previous checkpoint); writing beside and renaming leaves the other name's content as it was.
+/// (This test used a link to `/dev/full`, which the writer now follows to its target:
+/// `tests/hostile_files.rs`.)
+#[cfg(unix)]
 #[test]
 fn checkpoints_are_written_beside_and_renamed_over_the_target() -> Result<()> {
     let dir = std::env::temp_dir().join(format!("voussoir_atomic_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("dir");
     let path = dir.join("state.json");
-    let _ = std::fs::remove_file(&path);
-    std::os::unix::fs::symlink("/dev/full", &path).expect("symlink");
+    let other = dir.join("other-name.json");
+    std::fs::write(&other, "previous").expect("file");
+    std::fs::hard_link(&other, &path).expect("hard link");
     let mut model = moving_wall()?;
     model.run_steps(10)?;
     model.save_checkpoint(&path)?;
-    assert!(!std::fs::symlink_metadata(&path).expect("file").file_type().is_symlink());
+    assert_eq!(std::fs::read_to_string(&other).expect("other"), "previous");
     let restored: Model = Model::load_checkpoint(&path)?;
     assert_eq!(restored.step_count(), 10);
     // No temporary file is left behind.
-    let names: Vec<String> = std::fs::read_dir(&dir)
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
         .expect("list")
         .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
         .collect();
-    assert_eq!(names, ["state.json"]);
+    names.sort();
+    assert_eq!(names, ["other-name.json", "state.json"]);
     std::fs::remove_dir_all(&dir).ok();
     Ok(())
 }

@@ -1,4 +1,5 @@
-//! Fuzzing of the loaders (issue 18): scene files and checkpoints, mutated from the seeds in
+//! Fuzzing of the loaders (issues 18 and 33): scene files (with base motions) and checkpoints,
+//! and base-motion CSV records (`TimeHistory::from_csv`), mutated from the seeds in
 //! `tests/fuzz/corpus/` by the engine of `tests/fuzz/engine.rs` for a time budget
 //! (`VOUSSOIR_FUZZ_SECONDS` per target, default 1 s; `.ci/run` gives 20 s).
 //!
@@ -10,6 +11,7 @@
 mod engine;
 
 use voussoir::io::scene::Scene;
+use voussoir::loading::{BaseMotion, MotionKind, TimeHistory};
 use voussoir::prelude::*;
 
 /// Steps a loaded model a few times: `Err` only for a wrong answer (a panic is caught by the
@@ -68,15 +70,16 @@ fn fuzz_scene_files() {
 }
 
 /// Checkpoints of the scene seeds after 20 steps: the checkpoint seeds (generated from the
-/// scene corpus, so that they follow the format of the build under test).
+/// scene corpus, so that they follow the format of the build under test). Seeds kept for the
+/// errors they give (e.g. `overflow-stiffness.json`) make no checkpoint.
 fn checkpoint_seeds() -> Vec<String> {
     engine::corpus("scene")
         .iter()
-        .map(|text| {
+        .filter_map(|text| {
             let scene = Scene::<CoulombSlip>::from_json(text).expect("scene seed");
             let mut model = scene.build().expect("build");
-            model.run_steps(20).expect("steps");
-            model.to_checkpoint_string().expect("checkpoint")
+            model.run_steps(20).ok()?;
+            Some(model.to_checkpoint_string().expect("checkpoint"))
         })
         .collect()
 }
@@ -115,4 +118,56 @@ fn fuzz_checkpoints() {
     let seeds = checkpoint_seeds();
     let outcome = engine::fuzz("checkpoint", &seeds, check_checkpoint);
     assert!(outcome.inputs > seeds.len() as u64);
+}
+
+/// A base-motion record read from CSV text (columns 0 and 1, and 1 and 2, scaled as a record
+/// in g): a history with finite values at strictly increasing finite times, whose motions of
+/// every kind give finite displacements and velocities, or a typed error with a message.
+fn check_csv(text: &str) -> Result<bool, String> {
+    let mut accepted = false;
+    for (t, v) in [(0, 1), (1, 2)] {
+        let h = match TimeHistory::from_csv(text, t, v, 9.81) {
+            Ok(h) => h,
+            Err(e) => {
+                message(e)?;
+                continue;
+            }
+        };
+        let (times, values) = (h.times(), h.values());
+        if times.len() < 2 || times.len() != values.len() {
+            return Err(format!("{} times and {} values", times.len(), values.len()));
+        }
+        if !times.windows(2).all(|w| w[0] < w[1]) || !times.iter().chain(values).all(|x| x.is_finite()) {
+            return Err(format!(
+                "times not increasing or values not finite: {times:?} {values:?}"
+            ));
+        }
+        for kind in [MotionKind::Acceleration, MotionKind::Velocity, MotionKind::Displacement] {
+            let motion = match BaseMotion::new(kind, [Some(h.clone()), None, None]) {
+                Ok(m) => m,
+                Err(e) => {
+                    message(e)?;
+                    continue;
+                }
+            };
+            let end = h.end();
+            for at in [times[0], 0.5 * (times[0] + end), end, end + 1.0] {
+                let (u, v) = (motion.displacement(at), motion.mean_velocity(at, 1e-3));
+                // Finite unless the record's own integral overflows (values near f64::MAX).
+                if !(u.is_finite() && v.is_finite()) && values.iter().all(|x| x.abs() < 1e150) {
+                    return Err(format!("{kind:?} at {at}: displacement {u}, velocity {v}"));
+                }
+            }
+        }
+        accepted = true;
+    }
+    Ok(accepted)
+}
+
+#[test]
+fn fuzz_time_history_csv() {
+    let seeds = engine::corpus("csv");
+    let outcome = engine::fuzz("csv", &seeds, check_csv);
+    assert!(outcome.inputs > seeds.len() as u64);
+    assert!(outcome.accepted > 0, "some records are read");
 }

@@ -100,10 +100,10 @@ fn the_setup_names_are_the_scenarios() {
 #[test]
 fn static_servo_and_friction_are_checked_when_parsed() {
     for (flag, value, range) in [
-        ("--servo-increment", "0", "(0, 0.001]"),
-        ("--servo-increment", "-2e-5", "(0, 0.001]"),
-        ("--servo-increment", "inf", "(0, 0.001]"),
-        ("--servo-increment", "0.01", "(0, 0.001]"),
+        ("--servo-increment", "0", "(0, 5e-4]"),
+        ("--servo-increment", "-2e-5", "(0, 5e-4]"),
+        ("--servo-increment", "inf", "(0, 5e-4]"),
+        ("--servo-increment", "0.01", "(0, 5e-4]"),
         ("--servo-ratio", "0", "(0, 0.1]"),
         ("--servo-ratio", "nan", "(0, 0.1]"),
         ("--servo-ratio", "0.5", "(0, 0.1]"),
@@ -119,14 +119,14 @@ fn static_servo_and_friction_are_checked_when_parsed() {
     }
     let (_, o) = statics(&[
         "--servo-increment",
-        "1e-3",
+        "5e-4",
         "--servo-ratio",
         "0.1",
         "--friction",
         "0.5,89.5",
     ])
     .expect("parses");
-    assert_eq!((o.servo_increment, o.servo_ratio), (1e-3, 0.1));
+    assert_eq!((o.servo_increment, o.servo_ratio), (5e-4, 0.1));
 }
 
 #[test]

@@ -3,23 +3,94 @@
 
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
+use pyo3::exceptions::{PyMemoryError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyDict, PyInt, PyString};
 use voussoir::block::{Dof, Fixity};
 use voussoir::math::Vector;
 
 use crate::errors::bad;
 
-/// Three numbers from any iterable (tuple, list, numpy array).
+/// Three numbers from any iterable (tuple, list, numpy array). At most four items are read, so
+/// that an endless iterable is an error, not an endless loop.
 pub fn vec3(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector> {
     let mut v = Vec::with_capacity(3);
     for item in obj.try_iter()? {
+        if v.len() == 3 {
+            return Err(bad(format!("{what}: expected 3 numbers (x, y, z), got more")));
+        }
         v.push(item?.extract::<f64>()?);
     }
     if v.len() != 3 {
         return Err(bad(format!("{what}: expected 3 numbers (x, y, z), got {}", v.len())));
     }
     Ok(Vector::new(v[0], v[1], v[2]))
+}
+
+/// The most items read from an iterable of points or blocks: an endless iterable raises
+/// `MemoryError` there instead of growing until the allocator aborts the process.
+pub const MAX_ITEMS: usize = 1_000_000;
+
+/// `MemoryError` for an iterable longer than [`MAX_ITEMS`].
+pub fn too_many(what: &str) -> PyErr {
+    PyMemoryError::new_err(format!(
+        "{what}: more than {MAX_ITEMS} items (an endless iterable?); give a list of at most {MAX_ITEMS}"
+    ))
+}
+
+/// A whole-number argument kept whole (any Python int), so that the function can say which
+/// argument is out of range instead of PyO3's `OverflowError` naming none.
+pub struct Int(Result<i64, String>);
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Int {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if !obj.is_instance_of::<PyInt>() && !obj.hasattr("__index__")? {
+            return Err(PyTypeError::new_err(format!(
+                "expected an int, got {}",
+                obj.get_type().name()?
+            )));
+        }
+        Ok(Self(obj.extract::<i64>().map_err(|_| obj.to_string())))
+    }
+}
+
+impl Int {
+    /// A block index among `count` blocks (`VoussoirError`, a `ValueError`, naming `what`
+    /// otherwise: negative, beyond the blocks, or beyond any int the model holds).
+    pub fn block(&self, what: &str, count: usize) -> PyResult<voussoir::block::BlockId> {
+        match self.0 {
+            Ok(k) if k >= 0 && (k as u64) < count as u64 => Ok(voussoir::block::BlockId(k as u32)),
+            Ok(k) if k < 0 => Err(bad(format!(
+                "{what} {k} is negative: block indices run from 0 (negative indices are not counted from the end)"
+            ))),
+            Ok(k) if k <= i64::from(u32::MAX) => Err(bad(format!(
+                "{what} {k}: {}",
+                voussoir::Error::UnknownBlock {
+                    id: voussoir::block::BlockId(k as u32),
+                    count
+                }
+            ))),
+            Ok(k) => Err(bad(format!("{what} {k} is out of range: the model has {count} blocks"))),
+            Err(ref big) => Err(bad(format!(
+                "{what} {big} is out of range: the model has {count} blocks"
+            ))),
+        }
+    }
+
+    /// A whole number in `[0, max]` (`ValueError` naming `what` otherwise).
+    pub fn at_most(&self, what: &str, max: u64) -> PyResult<u64> {
+        match self.0 {
+            Ok(k) if k >= 0 && k as u64 <= max => Ok(k as u64),
+            Ok(k) => Err(PyValueError::new_err(format!(
+                "{what} = {k}: must be a whole number in [0, {max}]"
+            ))),
+            Err(ref big) => Err(PyValueError::new_err(format!(
+                "{what} = {big}: must be a whole number in [0, {max}]"
+            ))),
+        }
+    }
 }
 
 /// An optional vector, zero when `None`.
@@ -29,10 +100,14 @@ pub fn vec3_or_zero(obj: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vect
 
 /// A list of points from an iterable of 3-iterables or an (n, 3) array.
 pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<Vector>> {
-    obj.try_iter()?
-        .enumerate()
-        .map(|(k, item)| vec3(&item?, &format!("{what}[{k}]")))
-        .collect()
+    let mut out = Vec::new();
+    for (k, item) in obj.try_iter()?.enumerate() {
+        if k == MAX_ITEMS {
+            return Err(too_many(what));
+        }
+        out.push(vec3(&item?, &format!("{what}[{k}]"))?);
+    }
+    Ok(out)
 }
 
 fn dof(obj: &Bound<'_, PyAny>) -> PyResult<Dof> {
@@ -52,7 +127,8 @@ fn dof(obj: &Bound<'_, PyAny>) -> PyResult<Dof> {
 }
 
 fn dofs(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<[Dof; 3]> {
-    let v: Vec<Dof> = obj.try_iter()?.map(|d| dof(&d?)).collect::<PyResult<_>>()?;
+    // At most four read: an endless iterable is an error.
+    let v: Vec<Dof> = obj.try_iter()?.take(4).map(|d| dof(&d?)).collect::<PyResult<_>>()?;
     v.try_into()
         .map_err(|v: Vec<Dof>| bad(format!("{what}: expected 3 degrees of freedom, got {}", v.len())))
 }

@@ -1,7 +1,7 @@
 //! Rust errors as Python exceptions, with the Rust messages.
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyOSError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyOSError, PyValueError};
 use pyo3::PyErr;
 
 create_exception!(
@@ -19,12 +19,13 @@ create_exception!(
 );
 
 /// The exception for a Rust error: [`VoussoirIOError`] for [`voussoir::Error::Io`],
+/// `MemoryError` for [`voussoir::Error::TooLarge`] (a size beyond the library's limits),
 /// [`VoussoirError`] for the others, with the same message.
 pub fn to_py(e: voussoir::Error) -> PyErr {
-    if matches!(e, voussoir::Error::Io { .. }) {
-        VoussoirIOError::new_err(e.to_string())
-    } else {
-        VoussoirError::new_err(e.to_string())
+    match e {
+        voussoir::Error::Io { .. } => VoussoirIOError::new_err(e.to_string()),
+        voussoir::Error::TooLarge { .. } => PyMemoryError::new_err(e.to_string()),
+        _ => VoussoirError::new_err(e.to_string()),
     }
 }
 

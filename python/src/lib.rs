@@ -6,10 +6,12 @@
 
 mod blocks;
 mod convert;
+mod documents;
 mod errors;
 mod laws;
 mod model;
 mod scenarios;
+mod series;
 
 use pyo3::prelude::*;
 
@@ -23,13 +25,13 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<laws::PyLinearElastic>()?;
     m.add_class::<blocks::PyBlock>()?;
     m.add_class::<model::PyModel>()?;
-    m.add_class::<model::PySeries>()?;
+    m.add_class::<series::PySeries>()?;
     m.add_function(wrap_pyfunction!(blocks::arch, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::running_bond_wall, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::multi_leaf_wall, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::barrel_vault, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::dome, m)?)?;
-    m.add_function(wrap_pyfunction!(model::benchmark_wall, m)?)?;
+    m.add_function(wrap_pyfunction!(series::benchmark_wall, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_static, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_impact, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::impact_setups, m)?)?;

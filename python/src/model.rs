@@ -14,14 +14,15 @@ use voussoir::contact::DisplacementMode;
 use voussoir::geometry::SubcontactDensity;
 use voussoir::integrate::{Damping, TimeStep};
 use voussoir::io::scene::Scene;
-use voussoir::law::{AnyLaw, CoulombSlip, JointStatus, MaterialId};
+use voussoir::law::{AnyLaw, JointStatus, MaterialId};
 use voussoir::math::Vector;
 use voussoir::model::{Model, ModelParameters};
 use voussoir::monitor::{Component, EnergyTerm, Monitor, Recorder};
 use voussoir::Error;
 
 use crate::blocks::PyBlock;
-use crate::convert::{array1, array_n3, array_n33, array_nk, vec3, vec3_or_zero, vector};
+use crate::convert::{array1, array_n3, array_n33, array_nk, vec3, vec3_or_zero, vector, Int};
+use crate::documents::{normalised, read, scene_json};
 use crate::errors::{bad, OrPy};
 use crate::laws::{law_from_py, law_to_py};
 
@@ -58,10 +59,23 @@ impl Samples {
         }
     }
 
-    fn add(&mut self, name: &str, monitor: Monitor) {
+    /// Adds a monitor; its name must be new and not `step` or `time` (the columns of
+    /// `history()` that every history has).
+    fn add(&mut self, name: &str, monitor: Monitor) -> PyResult<()> {
+        if name == "step" || name == "time" {
+            return Err(bad(format!(
+                "monitor name {name:?} is taken by the history's own {name:?} column: choose another"
+            )));
+        }
+        if self.monitors.iter().any(|(n, _)| n == name) {
+            return Err(bad(format!(
+                "a monitor named {name:?} exists already: names must differ"
+            )));
+        }
         self.monitors.push((name.to_owned(), monitor));
         // A monitor added late has NaN for the samples it missed, as in a Recorder.
         self.columns.push(vec![f64::NAN; self.steps.len()]);
+        Ok(())
     }
 
     /// As a `voussoir::monitor::Recorder` (monitors and interval; no samples).
@@ -111,7 +125,7 @@ enum Goal {
 /// rows of the arrays that ``positions()``, ``velocities()`` etc. return.
 #[pyclass(name = "Model", module = "voussoir")]
 pub struct PyModel {
-    model: Model<AnyLaw>,
+    pub(crate) model: Model<AnyLaw>,
     samples: Samples,
 }
 
@@ -123,10 +137,9 @@ impl PyModel {
         }
     }
 
-    fn id(&self, block: usize) -> PyResult<BlockId> {
-        let id = BlockId(u32::try_from(block).map_err(|_| bad(format!("block index {block} is too large")))?);
-        self.model.block(id).py()?;
-        Ok(id)
+    /// The block of index `block` (`VoussoirError` naming the argument `what` when out of range).
+    fn id(&self, block: &Int, what: &str) -> PyResult<BlockId> {
+        block.block(what, self.model.blocks().len())
     }
 
     /// Runs to `goal`, in chunks: the GIL is released during a chunk; between chunks Ctrl-C is
@@ -254,107 +267,9 @@ fn status_name(s: JointStatus) -> &'static str {
     }
 }
 
-/// A scene or checkpoint document of a model with one law type, as one of `Model<AnyLaw>`: a
-/// law without its kind (`{"normal_stiffness": ..}` of a `Scene<CoulombSlip>`) is named
-/// (`{"Coulomb": ..}`, or `{"Elastic": ..}` without a friction angle), and so is a
-/// sub-contact's law state.
-fn as_any_law(doc: &mut serde_json::Value) {
-    use serde_json::Value;
-    fn wrap_law(law: &mut Value) {
-        if let Value::Object(map) = law {
-            if !map.contains_key("Coulomb") && !map.contains_key("Elastic") {
-                let kind = if map.contains_key("friction_deg") {
-                    "Coulomb"
-                } else {
-                    "Elastic"
-                };
-                *law = serde_json::json!({ kind: law.take() });
-            }
-        }
-    }
-    // Scenes: joints[k].law.
-    if let Some(Value::Array(joints)) = doc.get_mut("joints") {
-        for j in joints {
-            if let Some(law) = j.get_mut("law") {
-                wrap_law(law);
-            }
-        }
-    }
-    // Checkpoints: joints.laws[k], contacts[k].subcontacts[j].state.
-    if let Some(Value::Array(laws)) = doc.get_mut("joints").and_then(|j| j.get_mut("laws")) {
-        for law in laws {
-            wrap_law(law);
-        }
-    }
-    if let Some(Value::Array(contacts)) = doc.get_mut("contacts") {
-        for c in contacts {
-            if let Some(Value::Array(subs)) = c.get_mut("subcontacts") {
-                for s in subs {
-                    if let Some(state) = s.get_mut("state") {
-                        match state {
-                            Value::Null => *state = serde_json::json!({}),
-                            Value::Object(m) if !m.contains_key("coulomb") && m.contains_key("failed") => {
-                                *state = serde_json::json!({ "coulomb": state.take() });
-                            }
-                            _ => {}
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Parses JSON text for [`as_any_law`]; on a syntax error, `None` (the typed parser then
-/// reports it with its own message).
-fn normalised(text: &str) -> Option<String> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let mut doc: serde_json::Value = serde_json::from_str(text).ok()?;
-    as_any_law(&mut doc);
-    serde_json::to_string(&doc).ok()
-}
-
-fn read(path: &PathBuf) -> PyResult<String> {
-    std::fs::read_to_string(path)
-        .map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })
-        .py()
-}
-
-/// A scene of `Model<AnyLaw>` as JSON, written as a `Scene<CoulombSlip>` when every law is
-/// Coulomb's (what a Rust program with the default `Model` reads).
-fn scene_json(scene: &Scene<AnyLaw>) -> voussoir::Result<String> {
-    let laws: Option<Vec<CoulombSlip>> = scene
-        .joints
-        .iter()
-        .map(|j| match j.law {
-            AnyLaw::Coulomb(c) => Some(c),
-            _ => None,
-        })
-        .collect();
-    let text = scene.to_json()?;
-    if laws.is_none() {
-        return Ok(text);
-    }
-    let mut doc: serde_json::Value = serde_json::from_str(&text).map_err(|e| Error::Io {
-        path: "(scene)".into(),
-        message: e.to_string(),
-    })?;
-    if let Some(serde_json::Value::Array(joints)) = doc.get_mut("joints") {
-        for j in joints {
-            if let Some(law) = j.get_mut("law") {
-                if let Some(inner) = law.get_mut("Coulomb").map(serde_json::Value::take) {
-                    *law = inner;
-                }
-            }
-        }
-    }
-    serde_json::to_string_pretty(&doc).map_err(|e| Error::Io {
-        path: "(scene)".into(),
-        message: e.to_string(),
-    })
+/// A material id from a Python int (`ValueError` naming `what` outside [0, 65535]).
+fn material(k: &Int, what: &str) -> PyResult<MaterialId> {
+    Ok(MaterialId(k.at_most(what, u64::from(u16::MAX))? as u16))
 }
 
 #[pymethods]
@@ -401,16 +316,17 @@ impl PyModel {
 
     /// Sets the joint law between two materials (ints, either order): a ``CoulombSlip`` or a
     /// ``LinearElastic``.
-    fn set_joint_law(&mut self, a: u16, b: u16, law: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set_joint_law(&mut self, a: Int, b: Int, law: &Bound<'_, PyAny>) -> PyResult<()> {
+        let (a, b) = (material(&a, "material a")?, material(&b, "material b")?);
         let law = law_from_py(law)?;
-        self.model.set_joint_law(MaterialId(a), MaterialId(b), law).py()
+        self.model.set_joint_law(a, b, law).py()
     }
 
     /// The joint law between two materials, or None.
-    fn joint_law<'py>(&self, py: Python<'py>, a: u16, b: u16) -> PyResult<Option<Bound<'py, PyAny>>> {
+    fn joint_law<'py>(&self, py: Python<'py>, a: Int, b: Int) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.model
             .law_table()
-            .get(MaterialId(a), MaterialId(b))
+            .get(material(&a, "material a")?, material(&b, "material b")?)
             .map(|l| law_to_py(py, l))
             .transpose()
     }
@@ -506,8 +422,17 @@ impl PyModel {
         Ok(self.model.add_block(block.inner.clone()).py()?.index())
     }
 
-    /// Adds blocks (a list from ``voussoir.build``, say); returns their indices.
+    /// Adds blocks (a list from ``voussoir.build``, say); returns their indices. All or nothing:
+    /// when one is refused, none is added (the error names the first refused, by its position
+    /// in the list).
     fn add_blocks(&mut self, blocks: Vec<PyRef<'_, PyBlock>>) -> PyResult<Vec<usize>> {
+        // The checks of `add_block` depend on the parameters only: tried on an empty model first.
+        let mut trial = Model::<AnyLaw>::new(*self.model.parameters()).py()?;
+        for (k, b) in blocks.iter().enumerate() {
+            trial
+                .add_block(b.inner.clone())
+                .map_err(|e| bad(format!("blocks[{k}] ({:?}): {e}; no block was added", b.inner.name())))?;
+        }
         blocks
             .iter()
             .map(|b| Ok(self.model.add_block(b.inner.clone()).py()?.index()))
@@ -565,8 +490,8 @@ impl PyModel {
 
     /// Sets a block's fixity: ``"fixed"``, ``"free"``, a bool, or ``{"translation": [d, d, d],
     /// "rotation": [d, d, d]}`` with each ``d`` ``"free"``, ``"fixed"`` or a velocity.
-    fn set_fixity(&mut self, block: usize, fixity: &Bound<'_, PyAny>) -> PyResult<()> {
-        let id = self.id(block)?;
+    fn set_fixity(&mut self, block: Int, fixity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let id = self.id(&block, "block index")?;
         let f = crate::convert::fixity(Some(fixity))?;
         self.model.set_fixity(id, f).py()
     }
@@ -575,11 +500,11 @@ impl PyModel {
     #[pyo3(signature = (block, force=None, moment=None))]
     fn set_load(
         &mut self,
-        block: usize,
+        block: Int,
         force: Option<&Bound<'_, PyAny>>,
         moment: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let id = self.id(block)?;
+        let id = self.id(&block, "block index")?;
         let w = Wrench {
             force: vec3_or_zero(force, "force")?,
             moment: vec3_or_zero(moment, "moment")?,
@@ -591,11 +516,11 @@ impl PyModel {
     #[pyo3(signature = (block, velocity, angular_velocity=None))]
     fn set_velocity(
         &mut self,
-        block: usize,
+        block: Int,
         velocity: &Bound<'_, PyAny>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let id = self.id(block)?;
+        let id = self.id(&block, "block index")?;
         self.model
             .set_velocity(
                 id,
@@ -608,8 +533,8 @@ impl PyModel {
     /// Changes the values of a block's prescribed translation velocities (m/s): each
     /// translation that its fixity prescribes (a number in ``set_fixity``) takes the matching
     /// component; free and fixed ones stay. Cheap enough to call between every step.
-    fn set_prescribed_velocity(&mut self, block: usize, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
-        let id = self.id(block)?;
+    fn set_prescribed_velocity(&mut self, block: Int, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let id = self.id(&block, "block index")?;
         self.model.set_prescribed_velocity(id, vec3(velocity, "velocity")?).py()
     }
 
@@ -714,8 +639,8 @@ impl PyModel {
     }
 
     /// A copy of block ``i`` as it is now (a ``Block``).
-    fn block(&self, i: usize) -> PyResult<PyBlock> {
-        let id = self.id(i)?;
+    fn block(&self, i: Int) -> PyResult<PyBlock> {
+        let id = self.id(&i, "block index")?;
         Ok(PyBlock {
             inner: self.model.block(id).py()?.clone(),
         })
@@ -881,15 +806,15 @@ impl PyModel {
 
     /// The force (N) and moment (N·m) that supports and prescribed velocities applied to a
     /// block in the last step: ``{"force": (3,), "moment": (3,)}``.
-    fn reaction<'py>(&self, py: Python<'py>, block: usize) -> PyResult<Bound<'py, PyDict>> {
-        let w = self.model.reaction(self.id(block)?).py()?;
+    fn reaction<'py>(&self, py: Python<'py>, block: Int) -> PyResult<Bound<'py, PyDict>> {
+        let w = self.model.reaction(self.id(&block, "block index")?).py()?;
         wrench(py, w)
     }
 
     /// The total contact force (N) and moment (N·m, about the centroid) on a block:
     /// ``{"force": (3,), "moment": (3,)}``.
-    fn contact_wrench<'py>(&self, py: Python<'py>, block: usize) -> PyResult<Bound<'py, PyDict>> {
-        let w = self.model.contact_wrench(self.id(block)?).py()?;
+    fn contact_wrench<'py>(&self, py: Python<'py>, block: Int) -> PyResult<Bound<'py, PyDict>> {
+        let w = self.model.contact_wrench(self.id(&block, "block index")?).py()?;
         wrench(py, w)
     }
 
@@ -908,17 +833,19 @@ impl PyModel {
         &mut self,
         name: &str,
         kind: &str,
-        block: Option<usize>,
+        block: Option<Int>,
         point: Option<&Bound<'_, PyAny>>,
         component: &str,
-        a: Option<usize>,
-        b: Option<usize>,
+        a: Option<Int>,
+        b: Option<Int>,
         term: Option<&str>,
     ) -> PyResult<()> {
         let c = self::component(component)?;
         let need_block = || -> PyResult<BlockId> {
-            let k = block.ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give block=")))?;
-            self.id(k)
+            let k = block
+                .as_ref()
+                .ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give block=")))?;
+            self.id(k, "block index")
         };
         let monitor = match kind.to_ascii_lowercase().as_str() {
             "displacement" | "velocity" => {
@@ -953,8 +880,8 @@ impl PyModel {
                     )));
                 };
                 Monitor::ContactResultant {
-                    a: self.id(a)?,
-                    b: self.id(b)?,
+                    a: self.id(&a, "block index a")?,
+                    b: self.id(&b, "block index b")?,
                     component: c,
                 }
             }
@@ -973,8 +900,7 @@ contact_resultant, energy or unbalanced_ratio"
         Recorder::<AnyLaw>::new(1)
             .add_monitor(&self.model, name, monitor)
             .py()?;
-        self.samples.add(name, monitor);
-        Ok(())
+        self.samples.add(name, monitor)
     }
 
     /// Steps between monitor samples (default 1).
@@ -1055,28 +981,17 @@ contact_resultant, energy or unbalanced_ratio"
         scene_json(&Scene::from_model(&self.model).with_recorder(&recorder)).py()
     }
 
-    /// Writes ``to_scene_json()`` to a file.
+    /// Writes ``to_scene_json()`` to a file, atomically: into a temporary file beside it, then
+    /// renamed over it (a failed write leaves the previous file whole). A symbolic link is
+    /// written through (its target is replaced, the link kept).
     fn save_scene(&self, path: PathBuf) -> PyResult<()> {
         let text = self.to_scene_json()?;
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir)
-                .map_err(|e| Error::Io {
-                    path: dir.display().to_string(),
-                    message: e.to_string(),
-                })
-                .py()?;
-        }
-        std::fs::write(&path, text)
-            .map_err(|e| Error::Io {
-                path: path.display().to_string(),
-                message: e.to_string(),
-            })
-            .py()
+        voussoir::io::write_atomically(&path, text.as_bytes()).py()
     }
 
     /// A model from scene JSON, with its monitors (laws with or without their kind).
     #[staticmethod]
-    fn from_scene_json(text: &str) -> PyResult<Self> {
+    pub(crate) fn from_scene_json(text: &str) -> PyResult<Self> {
         let scene = match normalised(text) {
             Some(t) => Scene::<AnyLaw>::from_json(&t),
             None => Scene::<AnyLaw>::from_json(text),
@@ -1087,7 +1002,7 @@ contact_resultant, energy or unbalanced_ratio"
         let mut m = Self::wrap(model);
         m.samples.interval = recorder.interval();
         for (name, monitor) in recorder.monitors() {
-            m.samples.add(name, *monitor);
+            m.samples.add(name, *monitor)?;
         }
         Ok(m)
     }
@@ -1142,55 +1057,4 @@ fn wrench<'py>(py: Python<'py>, w: Wrench) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("force", vector(py, w.force))?;
     d.set_item("moment", vector(py, w.moment))?;
     Ok(d)
-}
-
-/// A ParaView series: ``ParaviewSeries(folder, name)``; ``write_frame(model)`` writes the
-/// blocks and sub-contacts of the model as a frame and rewrites the ``.pvd`` collections
-/// (``blocks_pvd``), which ParaView opens as a time series.
-#[pyclass(name = "ParaviewSeries", module = "voussoir")]
-pub struct PySeries {
-    inner: voussoir::io::vtk::Series,
-}
-
-#[pymethods]
-impl PySeries {
-    #[new]
-    #[pyo3(signature = (folder, name="model"))]
-    fn new(folder: PathBuf, name: &str) -> Self {
-        Self {
-            inner: voussoir::io::vtk::Series::new(folder, name),
-        }
-    }
-
-    /// Writes a frame of the model.
-    fn write_frame(&mut self, model: PyRef<'_, PyModel>) -> PyResult<()> {
-        self.inner.write_frame(&model.model).py()
-    }
-
-    /// The blocks' ``.pvd`` collection.
-    #[getter]
-    fn blocks_pvd(&self) -> PathBuf {
-        self.inner.blocks_pvd()
-    }
-
-    fn __len__(&self) -> usize {
-        self.inner.len()
-    }
-}
-
-/// The benchmarks' wall (``voussoir::scenes::benchmark_wall``): about ``blocks`` bricks in
-/// running bond on a fixed base, dry Coulomb joints (kn 1 GPa/m, ks 0.4 GPa/m, φ 30°),
-/// sub-contacts at most ``spacing`` m apart (default 0.025), local damping; not yet stepped.
-#[pyfunction]
-#[pyo3(signature = (blocks, *, spacing=None))]
-pub fn benchmark_wall(blocks: usize, spacing: Option<f64>) -> PyResult<PyModel> {
-    let model = match spacing {
-        Some(h) => voussoir::scenes::benchmark_wall_with_spacing(blocks, h),
-        None => voussoir::scenes::benchmark_wall(blocks),
-    }
-    .py()?;
-    // A Model<CoulombSlip> as a Model<AnyLaw>, through its scene.
-    let scene = Scene::from_model(&model);
-    let text = scene.to_json().py()?;
-    PyModel::from_scene_json(&text)
 }

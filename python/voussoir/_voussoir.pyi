@@ -18,7 +18,8 @@ FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
 class VoussoirError(ValueError):
-    """Bad input, divergence, no convergence, a corrupt scene or checkpoint."""
+    """Bad input (block indices out of range name the argument), divergence, no convergence,
+    a corrupt scene or checkpoint. Sizes beyond the library's limits raise MemoryError."""
 
 class VoussoirIOError(OSError):
     """Reading or writing a file failed."""
@@ -138,6 +139,7 @@ class Model:
     @gravity.setter
     def gravity(self, g: Vec3) -> None: ...
     def add_block(self, block: Block) -> int: ...
+    # All or nothing: when one block is refused, none is added.
     def add_blocks(self, blocks: Iterable[Block]) -> List[int]: ...
     def add_cuboid(
         self,
@@ -243,6 +245,8 @@ class Model:
     def write_vtk_blocks(self, path: Path) -> None: ...
     def write_vtk_subcontacts(self, path: Path) -> None: ...
     def to_scene_json(self) -> str: ...
+    # Atomic: a temporary file beside the target, renamed over it; a symbolic link is written
+    # through.
     def save_scene(self, path: Path) -> None: ...
     @staticmethod
     def from_scene_json(text: str) -> "Model": ...
@@ -255,6 +259,8 @@ class Model:
     @staticmethod
     def load_checkpoint(path: Path) -> "Model": ...
 
+# One series per name and folder at a time (lock file); VoussoirIOError otherwise, or when the
+# folder was deleted mid-run.
 class ParaviewSeries:
     def __init__(self, folder: Path, name: str = "model") -> None: ...
     def write_frame(self, model: Model) -> None: ...
@@ -315,6 +321,7 @@ def dome(
 ) -> List[Block]: ...
 
 # voussoir.scenes
+# MemoryError above voussoir's MAX_GENERATED_BLOCKS (10 million blocks), as the generators.
 def benchmark_wall(blocks: int, *, spacing: Optional[float] = None) -> Model: ...
 
 # voussoir.scenarios

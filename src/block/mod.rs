@@ -47,6 +47,7 @@ impl Dof {
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Fixity {
     /// Translations along world x, y, z.
     pub translation: [Dof; 3],
@@ -119,6 +120,7 @@ pub struct BlockState {
 /// A force and a moment about the block centroid, world frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Wrench {
     /// Force (N).
     pub force: Vector,

@@ -115,6 +115,7 @@ impl ArchSpec {
         positive("arch.density", self.density)?;
         positive("arch.abutment.outer_width", self.abutment.outer_width)?;
         positive("arch.abutment.depth", self.abutment.depth)?;
+        super::check_block_count("arch.voussoirs", &[self.voussoirs as u128])?;
         if self.voussoirs < 2 {
             return Err(Error::InvalidParameter {
                 name: "arch.voussoirs".into(),
@@ -177,7 +178,8 @@ impl Arch {
     /// Builds the blocks. Abutments are fixed.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] naming the bad dimension.
+    /// [`Error::InvalidParameter`] naming the bad dimension; [`Error::TooLarge`] for more than
+    /// [`super::MAX_GENERATED_BLOCKS`] voussoirs.
     pub fn new(spec: &ArchSpec) -> Result<Self> {
         spec.validate()?;
         let n = spec.voussoirs;

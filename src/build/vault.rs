@@ -65,6 +65,10 @@ pub fn barrel_vault(spec: &BarrelVaultSpec) -> Result<Vec<RigidBlock>> {
     positive("vault.rings", spec.rings as Real)?;
     positive("vault.density", spec.density)?;
     at_least("vault.voussoirs", spec.voussoirs, 3)?;
+    super::check_block_count(
+        "vault.rings × vault.voussoirs blocks",
+        &[spec.rings as u128, spec.voussoirs as u128],
+    )?;
     let (ri, re) = (spec.radius, spec.radius + spec.thickness);
     let length = spec.ring_length * spec.rings as Real;
     let mut blocks = Vec::new();
@@ -180,6 +184,10 @@ pub fn dome(spec: &DomeSpec) -> Result<Vec<RigidBlock>> {
         1e-3,
         std::f64::consts::FRAC_PI_2,
         "must lie in (0, π/2) rad",
+    )?;
+    super::check_block_count(
+        "dome.per_course (sum) blocks",
+        &[spec.per_course.iter().map(|&n| n as u128).sum()],
     )?;
     for (c, &n) in spec.per_course.iter().enumerate() {
         at_least(&format!("dome.per_course[{c}]"), n, 3)?;

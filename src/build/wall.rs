@@ -63,7 +63,8 @@ impl WallSpec {
 /// ```
 ///
 /// # Errors
-/// [`crate::Error::InvalidParameter`] for non-positive sizes, density or counts.
+/// [`crate::Error::InvalidParameter`] for non-positive sizes, density or counts;
+/// [`crate::Error::TooLarge`] for more than [`super::MAX_GENERATED_BLOCKS`] blocks.
 pub fn running_bond_wall(spec: &WallSpec) -> Result<Vec<RigidBlock>> {
     positive("wall.bricks_per_course", spec.bricks_per_course as Real)?;
     positive("wall.courses", spec.courses as Real)?;
@@ -71,6 +72,10 @@ pub fn running_bond_wall(spec: &WallSpec) -> Result<Vec<RigidBlock>> {
     positive("wall.brick.y", spec.brick.y)?;
     positive("wall.brick.z", spec.brick.z)?;
     positive("wall.density", spec.density)?;
+    super::check_block_count(
+        "wall.courses × (wall.bricks_per_course + 1) blocks",
+        &[spec.courses as u128, spec.bricks_per_course as u128 + 1],
+    )?;
     let (l, w, h) = (spec.brick.x, spec.brick.y, spec.brick.z);
     let length = l * spec.bricks_per_course as Real;
     let mut blocks = Vec::with_capacity(1 + spec.courses * (spec.bricks_per_course + 1));

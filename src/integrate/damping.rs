@@ -15,6 +15,7 @@ use crate::math::Real;
 ///   sub-contact in contact.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub enum Damping {
     /// No damping.
     None,

@@ -9,6 +9,7 @@ use crate::math::Real;
 /// How the model chooses its time step.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub enum TimeStep {
     /// `safety × critical step`, re-evaluated whenever contacts are re-detected.
     Auto {

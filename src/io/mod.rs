@@ -10,10 +10,9 @@ pub mod vtk;
 
 use std::path::Path;
 
-pub(crate) use crate::error::io_error;
 use crate::error::Error;
 /// Writes bytes so that a failure never leaves a half-written file (see the function).
-pub use crate::file::write_atomically;
+pub use crate::file::{read_text, write_atomically, MAX_TEXT_BYTES};
 
 /// Writes any serialisable value as pretty JSON (for example an example's `summary.json`),
 /// creating the folder. Non-finite numbers become `null`.

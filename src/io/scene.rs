@@ -11,7 +11,6 @@ use serde::{Deserialize, Serialize};
 use crate::block::{Block, Fixity, RigidBlock, Wrench};
 use crate::error::{Error, Result};
 use crate::integrate::Damping;
-use crate::io::io_error;
 use crate::law::{ConstitutiveLaw, MaterialId};
 use crate::math::Vector;
 use crate::model::{Model, ModelParameters};
@@ -157,7 +156,7 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
     /// # Errors
     /// [`Error::Io`] naming the file; otherwise as [`Scene::from_json`].
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| io_error(path, &e))?;
+        let text = crate::file::read_text(path)?;
         Self::from_json(&text)
     }
 

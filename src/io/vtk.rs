@@ -8,7 +8,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::block::Block;
-use crate::error::{Error, Result};
+use crate::error::{io_error, Error, Result};
 use crate::law::{ConstitutiveLaw, JointStatus};
 use crate::math::Real;
 use crate::model::Model;
@@ -247,11 +247,58 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
 /// }
 /// # Ok(()) }
 /// ```
-#[derive(Debug, Clone)]
+///
+/// One series writes a name in a folder at a time: the first frame takes a lock file
+/// (`.<name>.lock`, holding the process id), which the series removes when dropped; a second
+/// series (in this process or another one still running) writing the same name into the same
+/// folder is refused with [`crate::Error::Io`] naming the lock file, instead of both
+/// overwriting each other's frames. A lock left by a process that no longer runs (Linux:
+/// checked in `/proc`) is taken over. Before each frame the earlier frames' files must still
+/// be there: a folder deleted or emptied mid-run is an error naming the missing file, not a
+/// collection listing frames that do not exist.
+#[derive(Debug)]
 pub struct Series {
     dir: PathBuf,
     name: String,
     frames: Vec<(Real, String, String)>,
+    /// The lock file this series holds (from its first frame).
+    lock: Option<PathBuf>,
+    /// This series' number in the process, written in its lock file.
+    id: u64,
+}
+
+/// Numbers the series of this process (their lock files tell them apart).
+static SERIES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+impl Clone for Series {
+    /// A copy with the frames written so far, holding no lock: its next frame takes the lock,
+    /// which is refused while the original holds it.
+    fn clone(&self) -> Self {
+        Self {
+            dir: self.dir.clone(),
+            name: self.name.clone(),
+            frames: self.frames.clone(),
+            lock: None,
+            id: SERIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+        }
+    }
+}
+
+impl Drop for Series {
+    fn drop(&mut self) {
+        if let Some(lock) = self.lock.take() {
+            let _ = std::fs::remove_file(lock);
+        }
+    }
+}
+
+/// Whether the process `pid` runs (Linux: its `/proc` entry; elsewhere assumed running).
+fn process_runs(pid: u32) -> bool {
+    if cfg!(target_os = "linux") {
+        Path::new("/proc").join(pid.to_string()).exists()
+    } else {
+        true
+    }
 }
 
 /// Longest series name accepted, in bytes: with `_contacts_00000.vtu` and the temporary file's
@@ -332,7 +379,70 @@ impl Series {
             dir: dir.into(),
             name: name.to_owned(),
             frames: Vec::new(),
+            lock: None,
+            id: SERIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
+    }
+
+    /// Takes the series' lock file in its folder (see [`Series`]).
+    fn take_lock(&mut self) -> Result<()> {
+        std::fs::create_dir_all(&self.dir).map_err(|e| io_error(&self.dir, &e))?;
+        let lock = self.dir.join(format!(".{}.lock", self.name));
+        let me = format!("{} {}\n", std::process::id(), self.id);
+        for _ in 0..2 {
+            match std::fs::OpenOptions::new().write(true).create_new(true).open(&lock) {
+                Ok(mut f) => {
+                    use std::io::Write;
+                    f.write_all(me.as_bytes()).map_err(|e| io_error(&lock, &e))?;
+                    self.lock = Some(lock);
+                    return Ok(());
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let held = std::fs::read_to_string(&lock).unwrap_or_default();
+                    let pid = held.split_whitespace().next().and_then(|p| p.parse::<u32>().ok());
+                    match pid {
+                        Some(pid) if pid == std::process::id() || process_runs(pid) => {
+                            return Err(Error::Io {
+                                path: lock.display().to_string(),
+                                message: format!(
+                                    "series {:?} in this folder is being written by another series (process {pid}): \
+                                     write into another folder or under another name (remove this file if no \
+                                     process writes the series)",
+                                    self.name
+                                ),
+                            });
+                        }
+                        // A lock left by a process that ended (or unreadable): taken over.
+                        _ => {
+                            let _ = std::fs::remove_file(&lock);
+                        }
+                    }
+                }
+                Err(e) => return Err(io_error(&lock, &e)),
+            }
+        }
+        Err(Error::Io {
+            path: lock.display().to_string(),
+            message: "could not take the series' lock file".into(),
+        })
+    }
+
+    /// The earlier frames' files must still be there.
+    fn check_frames(&self) -> Result<()> {
+        for (_, b, c) in &self.frames {
+            for file in [b, c] {
+                let path = self.dir.join(file);
+                if !path.is_file() {
+                    return Err(Error::Io {
+                        path: path.display().to_string(),
+                        message: "a frame this series wrote is gone (the folder was deleted or emptied \
+                                  mid-run): its collection would list a missing file; start a new series"
+                            .into(),
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 
     /// A new, empty series written into `dir`, its name checked by [`check_series_name`].
@@ -348,9 +458,14 @@ impl Series {
     ///
     /// # Errors
     /// [`Error::InvalidName`] (nothing written) if the series name is not a portable file name
-    /// (see [`check_series_name`]); [`crate::Error::Io`] naming the file.
+    /// (see [`check_series_name`]); [`crate::Error::Io`] naming the file, the lock file held by
+    /// another series, or an earlier frame's file that is gone.
     pub fn write_frame<L: ConstitutiveLaw>(&mut self, model: &Model<L>) -> Result<()> {
         check_series_name(&self.name)?;
+        if self.lock.is_none() {
+            self.take_lock()?;
+        }
+        self.check_frames()?;
         let k = self.frames.len();
         let blocks = format!("{}_blocks_{k:05}.vtu", self.name);
         let contacts = format!("{}_contacts_{k:05}.vtu", self.name);

@@ -60,6 +60,7 @@ use crate::math::Real;
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 #[non_exhaustive]
 pub enum AnyLaw {
     /// Coulomb slip with tension cut-off, cohesion and residual friction.

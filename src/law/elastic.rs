@@ -9,6 +9,7 @@ use crate::error::{positive, Result};
 /// Linear normal and shear springs with no limit: `σ = -kn·u_n`, `τ̇ = -ks·u̇_s`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct LinearElastic {
     /// Normal stiffness (Pa/m).
     pub normal_stiffness: f64,

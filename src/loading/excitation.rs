@@ -44,6 +44,7 @@ pub struct TimeHistory {
 /// The serialised form, validated into a [`TimeHistory`] on load.
 #[cfg(feature = "serde")]
 #[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 struct TimeHistoryData {
     times: Vec<Real>,
     values: Vec<Real>,
@@ -115,6 +116,20 @@ impl TimeHistory {
                 u,
             );
             integrals.push((v, u));
+            let slope = (values[k + 1] - values[k]) / (times[k + 1] - times[k]);
+            if !(slope.is_finite() && v.is_finite() && u.is_finite()) {
+                return Err(Error::InvalidParameter {
+                    name: format!(
+                        "time history: samples {k} and {} (times {} and {})",
+                        k + 1,
+                        times[k],
+                        times[k + 1]
+                    ),
+                    value: slope,
+                    expected: "samples whose slope and integrals are finite (times this close, or values this \
+                               large, overflow f64)",
+                });
+            }
         }
         Ok(Self {
             times,
@@ -160,31 +175,63 @@ impl TimeHistory {
     /// A history from two columns of CSV text (comma, semicolon, tab or blank separated; lines
     /// that do not parse as numbers in both columns, such as a header, are skipped, as are
     /// blank lines and lines starting with `#`), its values multiplied by `scale` (9.81 for a
-    /// record in g).
+    /// record in g). Numbers may be quoted (`"0.5"`); lines may end in LF, CR LF or CR alone.
+    /// The decimal point is `.`: a line with both `;` (or a tab) and `,` is refused as written
+    /// with decimal commas (`1,5;0,3`), which would otherwise read as other numbers.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] naming the line of a row that has the columns but a value
-    /// that is not a number after the first numeric row, and as [`TimeHistory::new`].
+    /// that is not a number after the first numeric row, a line with decimal commas, text
+    /// holding NUL characters (UTF-16), fewer than two numeric rows (saying how many lines were
+    /// read and skipped, and the first one skipped), and as [`TimeHistory::new`].
     pub fn from_csv(text: &str, time_column: usize, value_column: usize, scale: Real) -> Result<Self> {
         if !scale.is_finite() {
             return Err(Error::NonFinite {
                 what: "time history scale".into(),
             });
         }
+        if text.contains('\0') {
+            return Err(Error::InvalidParameter {
+                name: "time history CSV".into(),
+                value: text.find('\0').unwrap_or(0) as Real,
+                expected: "text without NUL characters (a UTF-16 file? save it as UTF-8); \
+                           the value is the position of the first NUL",
+            });
+        }
+        // Lines ended by CR alone (old Mac files) are split at CR.
+        let text: std::borrow::Cow<'_, str> = if text.contains('\n') {
+            text.into()
+        } else {
+            text.replace('\r', "\n").into()
+        };
         let (mut times, mut values) = (Vec::new(), Vec::new());
+        let (mut read, mut skipped, mut first_skipped) = (0usize, 0usize, None);
         for (line_no, line) in text.lines().enumerate() {
             let line = line.trim().trim_start_matches('\u{feff}');
             if line.is_empty() || line.starts_with('#') {
                 continue;
             }
+            read += 1;
+            if line.contains(',') && line.contains([';', '\t']) {
+                return Err(Error::InvalidParameter {
+                    name: format!("time history CSV line {}: `{line}`", line_no + 1),
+                    value: (line_no + 1) as Real,
+                    expected: "numbers with a decimal point `.`: this line has both `,` and `;` or a tab, \
+                               as numbers written with decimal commas (1,5;0,3) do",
+                });
+            }
             let fields: Vec<&str> = line.split([',', ';', '\t', ' ']).filter(|f| !f.is_empty()).collect();
-            let parse = |c: usize| fields.get(c).map(|f| f.trim().parse::<Real>());
+            let parse = |c: usize| fields.get(c).map(|f| unquote(f.trim()).parse::<Real>());
             match (parse(time_column), parse(value_column)) {
                 (Some(Ok(t)), Some(Ok(v))) => {
                     times.push(t);
                     values.push(v * scale);
                 }
-                _ if times.is_empty() => {} // a header
+                _ if times.is_empty() => {
+                    // a header
+                    skipped += 1;
+                    first_skipped.get_or_insert_with(|| (line_no + 1, line.chars().take(60).collect::<String>()));
+                }
                 _ => {
                     return Err(Error::InvalidParameter {
                         name: format!("time history CSV line {}: `{line}`", line_no + 1),
@@ -194,18 +241,29 @@ impl TimeHistory {
                 }
             }
         }
+        if times.len() < 2 {
+            let first =
+                first_skipped.map_or_else(String::new, |(n, l)| format!("; the first skipped, line {n}: `{l}`"));
+            return Err(Error::InvalidParameter {
+                name: format!(
+                    "time history CSV: {} numeric rows in columns {time_column} and {value_column} of {read} lines \
+                     read ({skipped} skipped as not numbers{first})",
+                    times.len()
+                ),
+                value: times.len() as Real,
+                expected: "at least two rows with a number in the time and the value column",
+            });
+        }
         Self::new(times, values)
     }
 
-    /// Reads [`TimeHistory::from_csv`] from a file.
+    /// Reads [`TimeHistory::from_csv`] from a file (UTF-8, with or without a byte-order mark).
     ///
     /// # Errors
-    /// [`Error::Io`] naming the file, and as [`TimeHistory::from_csv`].
+    /// [`Error::Io`] naming the file (also for a UTF-16 or other non-UTF-8 file, saying so),
+    /// and as [`TimeHistory::from_csv`].
     pub fn from_csv_file(path: &std::path::Path, time_column: usize, value_column: usize, scale: Real) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = crate::file::read_text(path)?;
         Self::from_csv(&text, time_column, value_column, scale)
     }
 
@@ -277,6 +335,7 @@ pub enum MotionKind {
 /// ```
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(try_from = "BaseMotionData"))]
 pub struct BaseMotion {
     /// What the histories are.
     pub kind: MotionKind,
@@ -284,11 +343,35 @@ pub struct BaseMotion {
     pub axes: [Option<TimeHistory>; 3],
 }
 
+/// The serialised form, validated by [`BaseMotion::new`] on load.
+#[cfg(feature = "serde")]
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BaseMotionData {
+    kind: MotionKind,
+    axes: [Option<TimeHistory>; 3],
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<BaseMotionData> for BaseMotion {
+    type Error = Error;
+    fn try_from(d: BaseMotionData) -> Result<Self> {
+        Self::new(d.kind, d.axes)
+    }
+}
+
 impl BaseMotion {
     /// A motion from its histories.
     ///
+    /// A displacement history ([`MotionKind::Displacement`]) must start at 0 (the block's
+    /// position when the motion is set: a first value of 10 mm would move the block 10 mm in
+    /// one step) and holds its last value after its end (the block stays where the record
+    /// leaves it rather than snapping back). Velocity and acceleration histories are zero
+    /// outside their samples: the block keeps the displacement it reached.
+    ///
     /// # Errors
-    /// [`Error::InvalidParameter`] when no axis has a history.
+    /// [`Error::InvalidParameter`] when no axis has a history, or a displacement history
+    /// whose first value is not 0.
     pub fn new(kind: MotionKind, axes: [Option<TimeHistory>; 3]) -> Result<Self> {
         if axes.iter().all(Option::is_none) {
             return Err(Error::InvalidParameter {
@@ -296,6 +379,21 @@ impl BaseMotion {
                 value: 0.0,
                 expected: "a history on at least one axis",
             });
+        }
+        if kind == MotionKind::Displacement {
+            for (axis, h) in axes.iter().enumerate() {
+                if let Some(h) = h.as_ref().filter(|h| h.values[0] != 0.0) {
+                    return Err(Error::InvalidParameter {
+                        name: format!(
+                            "first value of the displacement history along {}",
+                            ["x", "y", "z"][axis]
+                        ),
+                        value: h.values[0],
+                        expected: "0: a displacement history starts at the block's position when the motion is set \
+                                   (subtract the first value from the record)",
+                    });
+                }
+            }
         }
         Ok(Self { kind, axes })
     }
@@ -307,6 +405,8 @@ impl BaseMotion {
         for (u, h) in u.iter_mut().zip(&self.axes) {
             if let Some(h) = h {
                 *u = match self.kind {
+                    // Held at its last value after the end.
+                    MotionKind::Displacement if t > h.end() => h.values[h.values.len() - 1],
                     MotionKind::Displacement => h.value_at(t),
                     MotionKind::Velocity => integral(h, t).0,
                     MotionKind::Acceleration => integral(h, t).1,
@@ -325,6 +425,14 @@ impl BaseMotion {
     pub fn driven_axes(&self) -> [bool; 3] {
         self.axes.each_ref().map(Option::is_some)
     }
+}
+
+/// A CSV field without the double quotes around it.
+fn unquote(field: &str) -> &str {
+    field
+        .strip_prefix('"')
+        .and_then(|f| f.strip_suffix('"'))
+        .map_or(field, str::trim)
 }
 
 /// The integrals `(v, u)` after `s` into a segment of length `length` whose values go from

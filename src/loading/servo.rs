@@ -19,7 +19,8 @@ pub struct Servo {
     /// Unit direction of the advance.
     pub direction: Vector,
     /// The advance per advancing step (m): small against the displacements of interest (the
-    /// answer is read every many increments) and against the contact tolerance.
+    /// answer is read every many increments) and against the contact tolerance (at most half
+    /// of it, checked by [`Servo::run`]).
     pub increment: Real,
     /// The unbalanced-force ratio at or below which the block advances (1e-3 is a common
     /// choice): the tighter, the closer to equilibrium each advance starts, and the longer the
@@ -108,14 +109,20 @@ impl Servo {
     /// whose ratio and step are not known).
     ///
     /// # Errors
-    /// As [`Model::set_prescribed_velocity`] (a block without a prescribed translation), and as
-    /// [`Model::run_observed`].
+    /// Before the first step: [`Error::UnknownBlock`]; [`Error::InvalidParameter`] when a
+    /// translation the servo drives along is not prescribed ([`crate::block::Dof::Velocity`]:
+    /// the servo would run its steps without moving the block), or when the increment is above
+    /// half the contact tolerance (an advance that drives the block into its neighbours
+    /// faster than the contacts can push back: 1 mm a step drove a cube 66 mm into its base);
+    /// [`Error::Unsupported`] when the block has a base motion (which sets its velocity every
+    /// step, overriding the servo). Then as [`Model::run_observed`].
     pub fn run<L: ConstitutiveLaw>(
         &self,
         model: &mut Model<L>,
         max_steps: u64,
         observer: &mut impl Observer<L>,
     ) -> Result<bool> {
+        self.check(model)?;
         let mut velocity = None;
         for _ in 0..max_steps {
             // The advance over the coming step is `increment` (the step is `dt`, or shorter
@@ -137,6 +144,47 @@ impl Servo {
         Ok(false)
     }
 }
+
+impl Servo {
+    /// The checks of [`Servo::run`] against the model.
+    fn check<L: ConstitutiveLaw>(&self, model: &Model<L>) -> Result<()> {
+        let fixity = *crate::block::Block::fixity(model.block(self.block)?);
+        if model.base_motions().any(|(b, _, _)| b == self.block) {
+            return Err(Error::Unsupported {
+                what: format!(
+                    "servo on block {}: the block has a base motion, which sets its velocity every step and \
+                     would override the servo; remove the motion first",
+                    self.block
+                ),
+            });
+        }
+        for (axis, d) in self.direction.to_array().into_iter().enumerate() {
+            if d != 0.0 && !matches!(fixity.translation[axis], crate::block::Dof::Velocity(_)) {
+                return Err(Error::InvalidParameter {
+                    name: format!(
+                        "servo direction of block {} along {}",
+                        self.block,
+                        ["x", "y", "z"][axis]
+                    ),
+                    value: d,
+                    expected: "a prescribed translation (Dof::Velocity) on every axis the servo drives along",
+                });
+            }
+        }
+        let limit = SERVO_TRAVEL * model.parameters().contact.tolerance;
+        if self.increment > limit {
+            return Err(Error::InvalidParameter {
+                name: format!("servo increment (at most {limit} m, half the contact tolerance)"),
+                value: self.increment,
+                expected: "an advance per step of at most half the contact tolerance",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The largest servo advance per step, as a fraction of the contact tolerance.
+const SERVO_TRAVEL: Real = 0.5;
 
 /// A quantity from a quasi-static run and from the same run refined (half the increment and
 /// threshold of a servo, or half the rate of a rate-loaded run): how far the answer is from

@@ -13,13 +13,13 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use super::detection::TestedPair;
+use super::checkpoint_tested::{check_slacks, tested_pairs, TestedEntry};
 use super::{Model, ModelParameters};
 use crate::block::{Block, RigidBlock, Wrench};
 use crate::contact::{
     AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
 };
-use crate::error::{io_error, Error, Result};
+use crate::error::{Error, Result};
 use crate::geometry::{ContactKind, SubKey};
 use crate::ids::BlockId;
 use crate::integrate::{CentralDifference, CriticalStep, Damping, TimeStep};
@@ -107,17 +107,6 @@ struct Snapshot<L: ConstitutiveLaw> {
     motions: Vec<super::excitation::AppliedMotion>,
 }
 
-/// A pair the narrow phase tested, as checkpoints store it.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TestedEntry {
-    blocks: (u32, u32),
-    /// The pose of the smaller block in the body frame of the other at the test.
-    relative: Pose,
-    /// The separation beyond the tolerance of a pair found apart (m).
-    slack: Real,
-}
-
 /// A joint as checkpoints store it: its geometry, law, the step's running sums and its
 /// sub-contacts, independent of how the step lays them out in memory.
 #[derive(Serialize, Deserialize)]
@@ -200,42 +189,6 @@ impl<L: ConstitutiveLaw> Model<L> {
                 .collect(),
         }
     }
-}
-
-/// The tested pairs of a checkpoint of `n` blocks, checked: pairs `a < b < n` in strictly
-/// increasing order, finite poses with unit rotations, finite slacks not below zero.
-fn tested_pairs(entries: &[TestedEntry], n: usize) -> Result<Vec<TestedPair>> {
-    let corrupt = |path: &str, message: &str| Error::Checkpoint {
-        path: path.into(),
-        message: message.into(),
-    };
-    let mut tested = Vec::with_capacity(entries.len());
-    for (k, e) in entries.iter().enumerate() {
-        let (a, b) = e.blocks;
-        let ordered = tested.last().is_none_or(|t: &TestedPair| (t.a, t.b) < (a, b));
-        if !(a < b && (b as usize) < n && ordered) {
-            return Err(corrupt(
-                &format!("tested[{k}].blocks"),
-                "block pairs a < b < block count, in increasing order, expected",
-            ));
-        }
-        if !pose_ok(&e.relative) {
-            return Err(corrupt(
-                &format!("tested[{k}].relative"),
-                "not a finite pose with a unit rotation",
-            ));
-        }
-        if !(e.slack.is_finite() && e.slack >= 0.0) {
-            return Err(corrupt(&format!("tested[{k}].slack"), "a finite length ≥ 0 expected"));
-        }
-        tested.push(TestedPair {
-            a,
-            b,
-            relative: e.relative,
-            slack: e.slack,
-        });
-    }
-    Ok(tested)
 }
 
 /// The step's storage rebuilt from checkpointed joints: contacts, their references and
@@ -378,6 +331,18 @@ where
             message: e.to_string(),
         };
         let mut value = serde_json::to_value(&snap).map_err(io)?;
+        // A non-finite energy is written as null, which would not load: what saves must load.
+        if let Some((term, _)) = value["energy"]
+            .as_object()
+            .and_then(|m| m.iter().find(|(_, v)| v.is_null()))
+        {
+            return Err(Error::NonFinite {
+                what: format!(
+                    "energy term `{term}` of the model (a velocity, load or force beyond f64's range): a checkpoint \
+                     of it would not load"
+                ),
+            });
+        }
         let checksum = checksum_of(&value);
         if let serde_json::Value::Object(map) = &mut value {
             map.insert(CHECKSUM.into(), checksum.into());
@@ -691,6 +656,7 @@ where
             return Err(corrupt("contacts", "the joints' elastic energy is not finite"));
         }
         model.state.ref_poses = snap.ref_poses;
+        check_slacks(&model.state.blocks, &tested, &model.state.params.contact)?;
         model.state.tested = tested;
         model.state.drift = if snap.drift > 0.0 && snap.started {
             snap.drift
@@ -788,7 +754,7 @@ where
     /// # Errors
     /// [`Error::Io`] naming the file; [`Error::Checkpoint`] for corrupt content.
     pub fn load_checkpoint(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| io_error(path, &e))?;
+        let text = crate::file::read_text(path)?;
         Self::from_checkpoint_str(&text)
     }
 }
@@ -802,7 +768,7 @@ fn orthonormal(a: Vector, b: Vector) -> bool {
 }
 
 /// Whether a pose is finite with a unit rotation (to 1e-9, as blocks are checked).
-fn pose_ok(p: &Pose) -> bool {
+pub(super) fn pose_ok(p: &Pose) -> bool {
     is_finite_vector(p.translation) && p.rotation.is_finite() && (p.rotation.length() - 1.0).abs() <= 1e-9
 }
 

@@ -2,16 +2,19 @@
 //! prescribed velocity that carries them to the motion's displacement at the end of the step.
 
 use super::{Model, ModelState};
-use crate::block::{Block, Dof};
+use crate::block::{Block, Dof, Fixity};
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::law::ConstitutiveLaw;
 use crate::loading::BaseMotion;
 use crate::math::Real;
 
+const AXES: [&str; 3] = ["x", "y", "z"];
+
 /// A motion applied to a block, with the model time its history starts at.
 #[derive(Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub(crate) struct AppliedMotion {
     pub block: u32,
     pub motion: BaseMotion,
@@ -41,8 +44,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
 
 impl<L: ConstitutiveLaw> Model<L> {
     /// Makes a block's translations follow `motion` from now on (its history's `t = 0` is the
-    /// model's current time), replacing any motion the block had; `None` removes it (the
-    /// driven axes then keep the velocity of the last step: set the fixity to stop them).
+    /// model's current time), replacing any motion the block had; `None` removes it and stops
+    /// the block: the axes the removed motion drove become [`Dof::Fixed`] (they used to keep
+    /// the velocity of the last step; set the fixity afterwards to let them move again).
     ///
     /// The driven axes of the block must be fixed or prescribed
     /// ([`Dof::Fixed`] or [`Dof::Velocity`]); every step they get the velocity that carries the
@@ -75,9 +79,19 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// [`Error::UnknownBlock`]; [`Error::InvalidParameter`] when a driven axis of the block
     /// is free.
     pub fn set_base_motion(&mut self, id: BlockId, motion: Option<BaseMotion>) -> Result<()> {
-        let fixity = *self.block(id)?.fixity();
-        self.state.motions.retain(|m| m.block != id.0);
-        let Some(motion) = motion else { return Ok(()) };
+        let mut fixity = *self.block(id)?.fixity();
+        let Some(motion) = motion else {
+            let Some(k) = self.state.motions.iter().position(|m| m.block == id.0) else {
+                return Ok(());
+            };
+            let removed = self.state.motions.remove(k);
+            for (axis, driven) in removed.motion.driven_axes().into_iter().enumerate() {
+                if driven {
+                    fixity.translation[axis] = Dof::Fixed;
+                }
+            }
+            return self.set_fixity(id, fixity);
+        };
         for (axis, driven) in motion.driven_axes().into_iter().enumerate() {
             if driven && matches!(fixity.translation[axis], Dof::Free) {
                 return Err(Error::InvalidParameter {
@@ -87,12 +101,38 @@ impl<L: ConstitutiveLaw> Model<L> {
                 });
             }
         }
+        self.state.motions.retain(|m| m.block != id.0);
         self.state.motions.push(AppliedMotion {
             block: id.0,
             motion,
             start: self.state.time,
         });
         self.state.motions.sort_by_key(|m| m.block);
+        Ok(())
+    }
+
+    /// [`Error::DrivenAxisFreed`] when `fixity` frees a translation of block `id` that its base
+    /// motion drives.
+    pub(super) fn check_driven_axes(&self, id: BlockId, fixity: &Fixity) -> Result<()> {
+        let Some(m) = self.state.motions.iter().find(|m| m.block == id.0) else {
+            return Ok(());
+        };
+        let driven = m.motion.driven_axes();
+        for axis in 0..3 {
+            if driven[axis] && matches!(fixity.translation[axis], Dof::Free) {
+                let axes: Vec<&str> = (0..3).filter(|&a| driven[a]).map(|a| AXES[a]).collect();
+                return Err(Error::DrivenAxisFreed {
+                    block: id,
+                    axis: AXES[axis],
+                    motion: format!(
+                        "{:?} on {}, started at t = {} s",
+                        m.motion.kind,
+                        axes.join(", "),
+                        m.start
+                    ),
+                });
+            }
+        }
         Ok(())
     }
 

@@ -3,6 +3,8 @@
 mod changes;
 #[cfg(feature = "serde")]
 mod checkpoint;
+#[cfg(feature = "serde")]
+mod checkpoint_tested;
 mod contact_pass;
 mod detection;
 mod energy;
@@ -249,6 +251,13 @@ struct BlockSums {
     kinetic: Real,
     /// First block of the chunk that diverged.
     diverged: Option<usize>,
+    /// The largest squared speeds of translation and of rotation at the radius of the
+    /// chunk's blocks after the move (m²/s², see [`motion::move_speeds2`]).
+    max_v2: Real,
+    max_w2: Real,
+    /// First block of the chunk that the step moved further than the contact tolerance, and
+    /// how far (m).
+    too_far: Option<(usize, Real)>,
     /// Whether a block of the chunk moved beyond the re-detection trigger (fused pass only).
     moved: bool,
 }
@@ -337,6 +346,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.state.records.push(StepRecord::default());
         self.pipeline.bounds.push(StiffnessBound::default());
         self.state.changes.insert(Changes::BLOCKS);
+        self.pipeline.max_speed = None;
         Ok(id)
     }
 
@@ -437,9 +447,17 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// block's pairs as if it had moved (a released block meets the fixed blocks it had no
     /// contact with; a fixed one drops its contacts with fixed blocks).
     ///
+    /// A translation driven by a base motion ([`Model::set_base_motion`]) cannot be set free
+    /// while the motion applies (the motion would put it back at the next step, and a model
+    /// saved in between would not load): remove the motion first. Setting it fixed or
+    /// prescribed is accepted; the motion sets its velocity at every step.
+    ///
     /// # Errors
-    /// [`Error::UnknownBlock`], [`Error::NonFinite`] for a NaN prescribed velocity.
+    /// [`Error::UnknownBlock`], [`Error::NonFinite`] for a NaN prescribed velocity,
+    /// [`Error::DrivenAxisFreed`] naming the block, the axis and the motion.
     pub fn set_fixity(&mut self, id: BlockId, fixity: Fixity) -> Result<()> {
+        self.block(id)?;
+        self.check_driven_axes(id, &fixity)?;
         let b = self.block_mut(id)?;
         let old = b.fixity().to_owned();
         b.replace_fixity(fixity);
@@ -500,7 +518,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// kinetic energy counts as energy put in ([`Energies::initial_kinetic`]).
     ///
     /// # Errors
-    /// [`Error::UnknownBlock`], [`Error::NonFinite`].
+    /// [`Error::UnknownBlock`], [`Error::NonFinite`] (also for a kinetic energy that overflows).
     pub fn set_velocity(&mut self, id: BlockId, velocity: Vector, angular_velocity: Vector) -> Result<()> {
         if !is_finite_vector(velocity) || !is_finite_vector(angular_velocity) {
             return Err(Error::NonFinite {
@@ -509,8 +527,16 @@ impl<L: ConstitutiveLaw> Model<L> {
         }
         let b = self.block_mut(id)?;
         let before = b.kinetic_energy();
+        let (v0, w0) = (b.state.velocity, b.state.angular_velocity);
         b.replace_velocity(velocity, angular_velocity);
         let after = b.kinetic_energy();
+        if !after.is_finite() {
+            // 1e308 m/s: the kinetic energy overflows (and a checkpoint would not load).
+            b.replace_velocity(v0, w0);
+            return Err(Error::NonFinite {
+                what: format!("kinetic energy of block {id} at the velocity given (beyond f64's range)"),
+            });
+        }
         // Kinetic energy given by the user counts as energy put in.
         if self.state.started {
             self.state.energy.initial_kinetic += after - before;
@@ -521,6 +547,8 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     fn block_mut(&mut self, id: BlockId) -> Result<&mut RigidBlock> {
         let count = self.state.blocks.len();
+        // A velocity or fixity may change: the next step measures the speeds afresh.
+        self.pipeline.max_speed = None;
         self.state
             .blocks
             .get_mut(id.index())

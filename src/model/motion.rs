@@ -13,11 +13,19 @@ use rayon::prelude::*;
 use super::detection::prepare_chunk;
 use super::pipeline::Pipeline;
 use super::{diverged, BlockSums, ModelState, BLOCK_CHUNK};
-use crate::block::{Block, RigidBlock, Wrench};
+use crate::block::{Block, Dof, RigidBlock, Wrench};
 use crate::contact::{ContactWrench, DisplacementMode};
-use crate::integrate::{Integrator, StepDurations, StepRecord};
+use crate::error::Error;
+use crate::ids::BlockId;
+use crate::integrate::{Integrator, StepDurations, StepRecord, TimeStep};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real, Vector};
+
+/// The fraction of the contact tolerance that an automatic step lets the fastest block move
+/// (estimated from the speeds at the end of the last step and gravity): half, so that a speed
+/// that doubles within a step still moves no block further than the tolerance, beyond which a
+/// contact could be missed and the run stops ([`Error::StepTooLong`]).
+pub(super) const STEP_TRAVEL: Real = 0.5;
 
 /// What the per-block stages read besides the block itself.
 #[derive(Clone, Copy)]
@@ -41,6 +49,36 @@ struct BlockPass<'a> {
     /// The re-detection trigger (m) in large-displacement mode, for the next step's movement
     /// check.
     trigger: Option<Real>,
+    /// This step's drift `Δt_{n+½}` (s), over which the blocks move, and its square.
+    drift: Real,
+    drift2: Real,
+    /// The contact tolerance (m): no block may move further in one step; and its square.
+    tolerance: Real,
+    tolerance2: Real,
+}
+
+/// The squared speeds of a block for its next move: of its translation, with prescribed
+/// velocities ([`Dof::Velocity`]) in place of the state's on those axes, and of its fastest
+/// point in rotation (angular speed times radius). After a step the state's velocity on a
+/// prescribed axis is the prescribed one, so these are what the block just moved at, as the
+/// block pass measures them from the state alone.
+#[inline]
+pub(super) fn move_speeds2(b: &RigidBlock) -> (Real, Real) {
+    let mut v = b.state.velocity.to_array();
+    for (v, d) in v.iter_mut().zip(b.fixity().translation) {
+        if let Dof::Velocity(p) = d {
+            *v = p;
+        }
+    }
+    let w2 = b.state.angular_velocity.length_squared() * b.radius * b.radius;
+    (Vector::from_array(v).length_squared(), w2)
+}
+
+/// The speed bound of the step length from the largest squared speeds of translation and of
+/// rotation at the radius (m/s): at least the largest speed of any point of any block.
+#[inline]
+pub(super) fn speed_bound(max_v2: Real, max_w2: Real) -> Real {
+    max_v2.sqrt() + max_w2.sqrt()
 }
 
 /// `total` plus the wrenches of a block's contacts, in index order: `entries` are the block's
@@ -119,13 +157,28 @@ impl BlockPass<'_> {
             if sums.diverged.is_none() && diverged(b, self.max_speed2) {
                 sums.diverged = Some(first_block + j);
             }
+            // The move of this step: `v_{n+½} Δt_{n+½}` (and the rotation's at the radius),
+            // with square roots only for a block that may have moved past the tolerance
+            // (`(a + b)² ≤ 2 (a² + b²)`).
+            let v2 = b.state.velocity.length_squared();
+            let w2 = b.state.angular_velocity.length_squared() * b.radius * b.radius;
+            sums.max_v2 = sums.max_v2.max(v2);
+            sums.max_w2 = sums.max_w2.max(w2);
+            if sums.too_far.is_none() && 2.0 * (v2 + w2) * self.drift2 > self.tolerance2 {
+                let distance = (v2.sqrt() + w2.sqrt()) * self.drift;
+                if distance > self.tolerance {
+                    sums.too_far = Some((first_block + j, distance));
+                }
+            }
         }
     }
 }
 
 impl<L: ConstitutiveLaw> ModelState<L> {
     /// Gathers every block's forces, moves the blocks and books the energy; returns the first
-    /// block whose state is no longer finite or faster than `max_speed`.
+    /// block whose state is no longer finite or faster than `max_speed`, and the first block
+    /// moved further than the contact tolerance with the distance (the largest speed is left in
+    /// `pipeline.max_speed`).
     ///
     /// Every force `F` is booked with the trapezoidal rule over the displacement of the step,
     /// `½(F_{n−1} + F_n)·v_{n−½}·Δt` (a force that did not exist before the first step counts as
@@ -138,7 +191,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         pipeline: &mut Pipeline<L::State>,
         kick: Real,
         drift: Real,
-    ) -> Option<usize> {
+    ) -> (Option<usize>, Option<(usize, Real)>) {
         let pass = BlockPass {
             wrenches: &self.wrenches,
             contacts: &pipeline.block_contacts,
@@ -150,6 +203,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             max_speed2: self.params.max_speed * self.params.max_speed,
             trigger: (self.params.mode == DisplacementMode::Large)
                 .then_some(self.params.contact.redetect_fraction * self.params.contact.tolerance),
+            drift,
+            drift2: drift * drift,
+            tolerance: self.params.contact.tolerance,
+            tolerance2: self.params.contact.tolerance * self.params.contact.tolerance,
         };
         pipeline.block_sums.clear();
         pipeline
@@ -184,11 +241,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     }
 
     /// Adds the chunk sums of the block pass to the energies in chunk order, sets the
-    /// unbalanced-force ratio, and returns the first diverged block.
-    fn gather_block_sums(&mut self, pipeline: &mut Pipeline<L::State>) -> Option<usize> {
+    /// unbalanced-force ratio and the largest speed, and returns the first diverged block and
+    /// the first block moved too far.
+    fn gather_block_sums(&mut self, pipeline: &mut Pipeline<L::State>) -> (Option<usize>, Option<(usize, Real)>) {
         let mut max_unbalanced: Real = 0.0;
         let mut kinetic = 0.0;
         let mut first_diverged = None;
+        let mut first_too_far = None;
+        let (mut max_v2, mut max_w2): (Real, Real) = (0.0, 0.0);
         let e = &mut self.energy;
         for s in &pipeline.block_sums {
             max_unbalanced = max_unbalanced.max(s.max_unbalanced);
@@ -198,7 +258,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             e.damping += s.damping;
             kinetic += s.kinetic;
             first_diverged = first_diverged.or(s.diverged);
+            first_too_far = first_too_far.or(s.too_far);
+            max_v2 = max_v2.max(s.max_v2);
+            max_w2 = max_w2.max(s.max_w2);
         }
+        pipeline.max_speed = Some(speed_bound(max_v2, max_w2));
         e.kinetic = kinetic;
         for s in &pipeline.pair_sums {
             e.joint_work += s.work;
@@ -216,6 +280,54 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         } else {
             Real::INFINITY
         };
-        first_diverged
+        (first_diverged, first_too_far)
+    }
+
+    /// `drift` cut, with an automatic step ([`TimeStep::Auto`]), so that the fastest block moves
+    /// at most [`STEP_TRAVEL`] of the contact tolerance: `d` with `v d + g d² = STEP_TRAVEL ×
+    /// tolerance`, `v` a bound of the largest speed at the end of the last step
+    /// ([`speed_bound`]), `g` the gravity (central difference moves a block by its velocity
+    /// after the kick, `(v + g d) d`). A fixed step is not cut (the block pass stops the run
+    /// instead).
+    pub(super) fn cap_drift(&self, pipeline: &mut Pipeline<L::State>, drift: Real) -> Real {
+        if !matches!(self.params.time_step, TimeStep::Auto { .. }) {
+            return drift;
+        }
+        let v = *pipeline.max_speed.get_or_insert_with(|| self.max_move_speed());
+        let c = STEP_TRAVEL * self.params.contact.tolerance;
+        let a = self.params.gravity.length();
+        let root = v + (v * v + 4.0 * a * c).sqrt();
+        if root > 0.0 {
+            drift.min(2.0 * c / root)
+        } else {
+            drift
+        }
+    }
+
+    /// [`Error::StepTooLong`] for block `i` moved `distance` by the step of length `drift` that
+    /// has just been booked.
+    pub(super) fn too_far_error(&self, i: usize, distance: Real, drift: Real) -> Error {
+        let tolerance = self.params.contact.tolerance;
+        let speed = distance / drift;
+        Error::StepTooLong {
+            step: self.step,
+            time: self.time - drift,
+            dt: drift,
+            block: BlockId(i as u32),
+            distance,
+            tolerance,
+            speed,
+            max_dt: tolerance / speed,
+        }
+    }
+
+    /// The [`speed_bound`] of the blocks' [`move_speeds2`] (m/s), as the block pass leaves it.
+    pub(super) fn max_move_speed(&self) -> Real {
+        let (v2, w2) = self
+            .blocks
+            .iter()
+            .map(move_speeds2)
+            .fold((0.0, 0.0), |(a, b): (Real, Real), (v, w)| (a.max(v), b.max(w)));
+        speed_bound(v2, w2)
     }
 }

@@ -7,7 +7,7 @@ use super::detection::DetectionScratch;
 use super::{BlockSums, Timings};
 use crate::block::Wrench;
 use crate::integrate::StiffnessBound;
-use crate::math::Matrix;
+use crate::math::{Matrix, Real};
 
 /// Scratch of the step's stages.
 #[derive(Debug, Clone)]
@@ -31,6 +31,10 @@ pub(super) struct Pipeline<S> {
     pub refresh_bounds: Vec<StiffnessBound>,
     /// Detection's buffers, and what the block pass prepared for the next step.
     pub detection: DetectionScratch<S>,
+    /// The largest speed of a point of a block at the end of the last step
+    /// ([`super::motion::speed_bound`], m/s), for the next step's length; `None` after a setter
+    /// touched a block or a load: the next step takes it in a pass of its own.
+    pub max_speed: Option<Real>,
     /// Wall-clock time per stage.
     pub timings: Timings,
     /// Asked at a long step's sequential points whether to stop ([`crate::Model::set_interrupt_check`]).
@@ -50,6 +54,7 @@ impl<S> Default for Pipeline<S> {
             refresh_blocks: Vec::new(),
             refresh_bounds: Vec::new(),
             detection: DetectionScratch::default(),
+            max_speed: None,
             timings: Timings::default(),
             interrupt: None,
         }

@@ -48,7 +48,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.changes.clear();
         }
         self.refixed.clear();
-        if self.drift == 0.0 {
+        let first = self.drift == 0.0;
+        if first {
             // The first step: the initial velocities stand for those of the half step before.
             self.drift = self.dt;
         }
@@ -56,9 +57,13 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let (impact, busy) = self.compute_forces(pipeline);
         let previous = self.drift;
         let drift = self.next_drift(pipeline, impact, busy);
+        // No block may move further than the contact tolerance in one step.
+        let drift = self.cap_drift(pipeline, drift);
+        // The first step's half step before is as long as the step itself (also when cut).
+        let previous = if first { previous.min(drift) } else { previous };
         self.apply_base_motions(drift);
         let forces = std::time::Instant::now();
-        let diverged = self.advance_blocks(pipeline, 0.5 * (previous + drift), drift);
+        let (diverged, too_far) = self.advance_blocks(pipeline, 0.5 * (previous + drift), drift);
         self.drift = drift;
         let t = &mut pipeline.timings;
         t.detection += (detected - started).as_secs_f64();
@@ -69,6 +74,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         self.time += drift;
         if let Some(i) = diverged {
             return Err(self.divergence_error(i));
+        }
+        if let Some((i, distance)) = too_far {
+            return Err(self.too_far_error(i, distance, drift));
         }
         Ok(())
     }

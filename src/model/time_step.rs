@@ -131,6 +131,17 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             }
             return Ok(());
         };
+        if !(crit.dt.is_finite() && crit.dt > 0.0) {
+            // Stiffnesses near f64's limit (a law of 1.7e308 Pa/m) overflow the bound: the step
+            // would be NaN or zero. (Found by the fuzzer.)
+            self.critical = None;
+            return Err(Error::InvalidParameter {
+                name: format!("critical time step (set by block {})", crit.block),
+                value: crit.dt,
+                expected: "positive and finite: the stiffness of the block's contacts overflows f64 \
+                           (lower the joint stiffness)",
+            });
+        }
         self.dt = match self.params.time_step {
             TimeStep::Auto { safety } => safety * crit.dt,
             TimeStep::Fixed(dt) => {

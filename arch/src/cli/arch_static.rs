@@ -54,8 +54,9 @@ pub struct StaticOptions {
     )]
     pub friction: Vec<f64>,
     /// Servo increment (m): the plate advances this far per step from settled states only
-    /// (every case but the rate study). In (0, 1e-3]: the peak is read from settled states, and
-    /// a step of a millimetre or more would pass it by
+    /// (every case but the rate study). In (0, 5e-4]: the peak is read from settled states, a
+    /// step of a millimetre or more would pass it by, and the servo advances at most half the
+    /// contact tolerance (1 mm) a step
     #[arg(
         long,
         value_name = "M",
@@ -87,10 +88,11 @@ pub const FRICTION_RANGE: Interval = Interval {
     lo: Excluded(0.0),
     hi: Excluded(90.0),
 };
-/// Range of `--servo-increment` (m).
+/// Range of `--servo-increment` (m): at most half the contact tolerance (1 mm), as
+/// `voussoir::loading::Servo::run` requires.
 pub const SERVO_INCREMENT_RANGE: Interval = Interval {
     lo: Excluded(0.0),
-    hi: Included(1e-3),
+    hi: Included(5e-4),
 };
 /// Range of `--servo-ratio`.
 pub const SERVO_RATIO_RANGE: Interval = Interval {

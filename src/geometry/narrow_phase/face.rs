@@ -248,8 +248,11 @@ pub(super) fn face_face_hosted(
 }
 
 /// The corners of a contact's polygon (world, counter-clockwise seen from outside the host):
-/// for a face-face contact the other face projected on the host face's plane and clipped by the
-/// host face — the polygon whose grid cells carry the sub-contacts (`face_face_hosted`); for a
+/// for a face-face contact the part of the other face within `tolerance` of the host face's
+/// plane (the whole face when the faces are parallel; a strip along the touching edge when they
+/// are at an angle, as for a block balanced on its edge), projected on that plane and clipped by
+/// the host face — where the grid cells that carry the sub-contacts can close
+/// (`face_face_hosted`); for a
 /// point contact, or a face-face polygon that came out degenerate, the 2-D hull of `points`
 /// (the sub-contacts) in the plane normal to `normal`: a polygon, a segment or a point.
 /// Corners closer than 1e-9 of the polygon's extent are merged, collinear ones dropped.
@@ -261,6 +264,7 @@ pub(crate) fn contact_polygon(
     host_is_a: bool,
     normal: Vector,
     points: &[Vector],
+    tolerance: Real,
 ) -> Vec<Vector> {
     if let ContactKind::FaceFace { face_a, face_b } = kind {
         let (fa, fb) = (face_a as usize, face_b as usize);
@@ -275,16 +279,28 @@ pub(crate) fn contact_polygon(
                 .map(|&i| to2d(host.shape.vertices()[i as usize]))
                 .collect();
             let rel = host.pose.inv_mul(other.pose);
-            let mut overlap: Vec<DVec2> = other
+            let other_loop: Vec<Vector> = other
                 .shape
                 .face_loop(fo)
                 .iter()
                 .rev()
-                .map(|&i| to2d(rel.transform_point(other.shape.vertices()[i as usize])))
+                .map(|&i| rel.transform_point(other.shape.vertices()[i as usize]))
                 .collect();
+            // The part of the other face within the tolerance of the host face's plane: only
+            // there can its sub-contacts close (a tilted face touches along a strip).
+            let n = host.shape.faces()[fh].normal;
+            let (near, cut) = clip_by_height(&other_loop, |p| n.dot(p - origin), tolerance);
+            let mut overlap: Vec<DVec2> = near.into_iter().map(to2d).collect();
             let mut tmp = Vec::new();
             clip_convex(&mut overlap, &host_loop, &mut tmp);
             let corners = hull2d(&overlap);
+            if cut && corners.len() < 3 {
+                // A strip thinner than round-off, a segment or nothing: what touches.
+                return corners
+                    .into_iter()
+                    .map(|q| host.pose.transform_point(origin + u * q.x + v * q.y))
+                    .collect();
+            }
             if corners.len() >= 3 {
                 return corners
                     .into_iter()
@@ -299,6 +315,28 @@ pub(crate) fn contact_polygon(
     let (u, v) = plane_basis(normal);
     let flat: Vec<DVec2> = points.iter().map(|&p| DVec2::new(u.dot(p - o), v.dot(p - o))).collect();
     hull2d(&flat).into_iter().map(|q| o + u * q.x + v * q.y).collect()
+}
+
+/// The polygon `points` clipped to `height(p) <= limit` (Sutherland–Hodgman on one plane),
+/// and whether anything was cut.
+#[cfg(feature = "limit")]
+fn clip_by_height(points: &[Vector], height: impl Fn(Vector) -> Real, limit: Real) -> (Vec<Vector>, bool) {
+    let h: Vec<Real> = points.iter().map(|&p| height(p) - limit).collect();
+    if h.iter().all(|&h| h <= 0.0) {
+        return (points.to_vec(), false);
+    }
+    let mut out = Vec::with_capacity(points.len() + 1);
+    for k in 0..points.len() {
+        let j = (k + 1) % points.len();
+        let (p, q, hp, hq) = (points[k], points[j], h[k], h[j]);
+        if hp <= 0.0 {
+            out.push(p);
+        }
+        if (hp <= 0.0) != (hq <= 0.0) {
+            out.push(p + (q - p) * (hp / (hp - hq)));
+        }
+    }
+    (out, true)
 }
 
 /// A material frame on face `f`: origin at its first vertex, `u` along its longest edge.

@@ -43,18 +43,21 @@
 //! # Ok::<(), voussoir::Error>(())
 //! ```
 
-use clarabel::algebra::CscMatrix;
-use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use clarabel::solver::{SolverStatus, SupportedConeT};
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
-use super::mechanism::{Hinge, HingeSide, JointRef, Mechanism};
+mod programme;
+mod result;
+
 use crate::block::{Block, BlockId, Dof, Fixity};
 use crate::error::{non_negative, Error, Result};
 use crate::geometry::{contact_polygon, BlockGeometry};
 use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, LinearElastic};
-use crate::math::{Pose, Real, Rotation, Vector};
+use crate::math::{Real, Vector};
 use crate::model::Model;
+use programme::{Corner, Programme, Scales, Solution, Triplets};
+pub use result::{BlockMotion, JointMotion, LimitContact, LimitResult, LimitVertex};
 
 /// The strength of a joint in limit analysis: the Coulomb cone `‖t‖ ≤ μ n + c A` over its area
 /// `A`, with no tension.
@@ -191,215 +194,6 @@ pub struct LiveLoad {
     pub force: Vector,
 }
 
-/// One corner of a contact polygon with its forces and the mechanism's relative motion there.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub struct LimitVertex {
-    /// The corner (m, world).
-    pub point: Vector,
-    /// Normal force (N, compression positive).
-    pub normal_force: Real,
-    /// Shear force on block `b` (N, world, in the joint plane).
-    pub shear_force: Vector,
-    /// Opening rate `n·(v_b − v_a)` in the mechanism (m/s on the mechanism's scale, ≥ 0 up to
-    /// the solver's tolerance).
-    pub opening: Real,
-    /// Sliding rate `|(v_b − v_a)_t|` in the mechanism.
-    pub sliding: Real,
-}
-
-/// A contact at collapse: its blocks, normal and polygon corners.
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub struct LimitContact {
-    /// The two blocks, `a < b`.
-    pub blocks: (BlockId, BlockId),
-    /// Unit normal from `a` to `b`.
-    pub normal: Vector,
-    /// The polygon's corners.
-    pub vertices: Vec<LimitVertex>,
-}
-
-impl LimitContact {
-    /// Sum of the corners' forces on block `b` (N).
-    pub fn resultant(&self) -> Vector {
-        self.vertices
-            .iter()
-            .map(|v| self.normal * v.normal_force + v.shear_force)
-            .sum()
-    }
-}
-
-/// A block's rigid motion in the collapse mechanism: velocity of its centroid and angular
-/// velocity (zero for supports and constrained degrees of freedom).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub struct BlockMotion {
-    /// Centroid (m, world).
-    pub centroid: Vector,
-    /// Velocity of the centroid.
-    pub velocity: Vector,
-    /// Angular velocity (rad per unit of the mechanism's time).
-    pub angular_velocity: Vector,
-}
-
-/// How a joint moves in the mechanism, at its two edge points.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub struct JointMotion {
-    /// Joint label.
-    pub joint: usize,
-    /// Opening rate at the intrados point (relative normal velocity, positive = opening).
-    pub opening_intrados: Real,
-    /// Opening rate at the extrados point.
-    pub opening_extrados: Real,
-    /// Sliding rate at the edge that opens less (where a hinge turns).
-    pub sliding: Real,
-    /// Hinge, if any.
-    pub hinge: Option<HingeSide>,
-    /// Whether the joint slides.
-    pub is_sliding: bool,
-}
-
-/// The answer of [`LimitProblem::solve`].
-#[derive(Debug, Clone, PartialEq)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub struct LimitResult {
-    /// The collapse multiplier `λ`: the live loads at collapse are `λ` times theirs.
-    pub multiplier: Real,
-    /// The contacts with their corner forces at collapse (a statically admissible set; it is
-    /// not unique where the structure is hyperstatic at collapse).
-    pub contacts: Vec<LimitContact>,
-    /// Per block of the model, in order: its motion in the mechanism, scaled so that the live
-    /// loads' power is `Σ |force|` (one live load of unit direction: its point moves at unit
-    /// speed along it).
-    pub blocks: Vec<BlockMotion>,
-    /// Clarabel's status (`Solved` or `AlmostSolved`).
-    pub status: String,
-    /// Interior-point iterations.
-    pub iterations: u32,
-}
-
-impl LimitResult {
-    /// Velocity and angular velocity of `block` in the mechanism, `None` for an unknown id.
-    pub fn block_velocity(&self, block: BlockId) -> Option<(Vector, Vector)> {
-        self.blocks.get(block.index()).map(|m| (m.velocity, m.angular_velocity))
-    }
-
-    /// Velocity of the material point of `block` at `point` (world) in the mechanism.
-    pub fn point_velocity(&self, block: BlockId, point: Vector) -> Option<Vector> {
-        self.blocks
-            .get(block.index())
-            .map(|m| m.velocity + m.angular_velocity.cross(point - m.centroid))
-    }
-
-    /// The rigid motion of `block` after advancing the mechanism by `t`: a turn by `ω t` about
-    /// its centroid and a translation by `v t`, to put on top of the block's pose (a frame of
-    /// the mechanism for ParaView). The identity for an unknown id.
-    pub fn displacement(&self, block: BlockId, t: Real) -> Pose {
-        let Some(m) = self.blocks.get(block.index()) else {
-            return Pose::IDENTITY;
-        };
-        let rotation = Rotation::from_scaled_axis(m.angular_velocity * t);
-        // x ↦ c + v t + R (x − c)
-        Pose::from_parts(m.centroid + m.velocity * t - rotation * m.centroid, rotation)
-    }
-
-    /// The contact between `a` and `b` (either order).
-    pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<&LimitContact> {
-        let key = (a.min(b), a.max(b));
-        self.contacts.iter().find(|c| c.blocks == key)
-    }
-
-    /// Names the mechanism's hinges and sliding joints at `joints`, as
-    /// [`classify_joints`](super::classify_joints) does for the DEM's states, from the relative
-    /// velocity `v_rel = v_b − v_a` of the joint's blocks at its intrados and extrados points
-    /// (mapped from the blocks' initial poses to where they were analysed, like
-    /// `classify_joints`):
-    ///
-    /// * a joint moves when `|v_rel|` at either point exceeds `tolerance` times the largest
-    ///   relative speed at any contact corner;
-    /// * it is a **hinge** when the opening rates at its two points differ by more than that
-    ///   (a relative rotation about an axis in the joint), about the edge that opens less;
-    /// * it **slides** when the tangential relative speed at the edge that opens less exceeds
-    ///   it (about a hinge edge the relative velocity vanishes). Sliding is dilatant
-    ///   (associative flow): the joint opens at `μ` times the slip rate as well.
-    ///
-    /// `tolerance` 1e-3 suits a converged interior-point answer (duals to ~1e-8); where the
-    /// mechanism is not unique the duals are a blend of the admissible ones.
-    pub fn classify<L: ConstitutiveLaw>(
-        &self,
-        model: &Model<L>,
-        joints: &[JointRef],
-        tolerance: Real,
-    ) -> (Vec<JointMotion>, Mechanism) {
-        let scale = self
-            .contacts
-            .iter()
-            .flat_map(|c| c.vertices.iter().map(|v| v.opening.hypot(v.sliding)))
-            .fold(0.0, Real::max);
-        let tol = tolerance * scale;
-        let mut motions = Vec::with_capacity(joints.len());
-        let mut mechanism = Mechanism::default();
-        for j in joints {
-            let (a, b) = j.blocks;
-            let normal = match self.contact_between(a, b) {
-                Some(c) if c.blocks.0 == a => c.normal,
-                Some(c) => -c.normal,
-                None => {
-                    motions.push(JointMotion {
-                        joint: j.index,
-                        opening_intrados: 0.0,
-                        opening_extrados: 0.0,
-                        sliding: 0.0,
-                        hinge: None,
-                        is_sliding: false,
-                    });
-                    continue;
-                }
-            };
-            // Edge points move with the first block, as in `classify_joints`.
-            let here = |p: Vector| match model.blocks().get(a.index()) {
-                Some(block) => block.world_point(block.initial_pose().inverse_transform_point(p)),
-                None => p,
-            };
-            let rel = |p: Vector| {
-                let vb = self.point_velocity(b, p).unwrap_or(Vector::ZERO);
-                let va = self.point_velocity(a, p).unwrap_or(Vector::ZERO);
-                vb - va
-            };
-            let (pi, pe) = (here(j.intrados), here(j.extrados));
-            let (ri, re) = (rel(pi), rel(pe));
-            let (oi, oe) = (normal.dot(ri), normal.dot(re));
-            let tangential = |r: Vector, o: Real| (r - normal * o).length();
-            let (si, se) = (tangential(ri, oi), tangential(re, oe));
-            let moving = ri.length().max(re.length()) > tol;
-            let hinge = (moving && (oe - oi).abs() > tol).then_some(if oi < oe {
-                HingeSide::Intrados
-            } else {
-                HingeSide::Extrados
-            });
-            let sliding = if oi <= oe { si } else { se };
-            let is_sliding = moving && sliding > tol;
-            if let Some(side) = hinge {
-                mechanism.hinges.push(Hinge { joint: j.index, side });
-            }
-            if is_sliding {
-                mechanism.sliding_joints.push(j.index);
-            }
-            motions.push(JointMotion {
-                joint: j.index,
-                opening_intrados: oi,
-                opening_extrados: oe,
-                sliding,
-                hinge,
-                is_sliding,
-            });
-        }
-        (motions, mechanism)
-    }
-}
-
 /// What the programme needs of one block.
 #[derive(Debug, Clone)]
 struct BlockData {
@@ -455,7 +249,8 @@ impl LimitProblem {
     /// joint law (e.g. a table of your own per pair of materials, or a law of your own).
     ///
     /// # Errors
-    /// [`Error::Unsupported`] naming the contact whose law `strength` gives no strength for;
+    /// [`Error::Unsupported`] for a model never stepped (no contact detected yet), or naming
+    /// the contact whose law `strength` gives no strength for;
     /// [`Error::InvalidParameter`] for a negative or non-finite strength.
     pub fn from_model_with<L: ConstitutiveLaw>(
         model: &Model<L>,
@@ -479,6 +274,13 @@ impl LimitProblem {
                 }
             })
             .collect();
+        if model.detection_count() == 0 {
+            return Err(Error::Unsupported {
+                what: "limit analysis of a model whose contacts were never detected (it was never stepped): \
+                       step it once (Model::step) so that its contacts are found"
+                    .into(),
+            });
+        }
         let mut contacts = Vec::new();
         for view in model.contacts() {
             let (a, b) = view.blocks();
@@ -510,11 +312,18 @@ impl LimitProblem {
                 view.host_is_a(),
                 view.normal(),
                 &points,
+                model.parameters().contact.tolerance,
             );
             if vertices.is_empty() {
                 continue;
             }
-            let area: Real = view.subcontacts().map(|s| s.area()).sum();
+            // Cohesion acts on the part of the joint that touches: at most the polygon's area
+            // (a tilted face touches along a strip).
+            let area: Real = view
+                .subcontacts()
+                .map(|s| s.area())
+                .sum::<Real>()
+                .min(polygon_area(&vertices));
             let axes = view.axes();
             contacts.push(ContactData {
                 a: ia,
@@ -599,12 +408,15 @@ impl LimitProblem {
                 })
             }
         }
-        let multiplier = solution.x[0] * scales.multiplier;
+        // A multiplier within round-off below zero is a zero capacity (e.g. a block on a joint
+        // without friction, pushed along it): reported as 0.
+        let multiplier = solution.x[0].max(0.0) * scales.multiplier;
         if solution.x[0] < -FEASIBILITY_TOLERANCE {
             return Err(Error::LimitInfeasible {
                 reason: format!(
-                    "the largest admissible multiplier of the live load is {multiplier:.6e} < 0: the dead loads are \
-                     carried only with a live load against its direction"
+                    "the largest admissible multiplier of the live load is {:.6e} < 0: the dead loads are \
+                     carried only with a live load against its direction",
+                    solution.x[0] * scales.multiplier
                 ),
             });
         }
@@ -661,12 +473,22 @@ impl LimitProblem {
                 });
             }
         }
-        let total: Real = live.iter().map(|l| l.force.length()).sum();
+        let total: Real = live.iter().map(|l| norm(l.force)).sum();
         if total <= 0.0 {
             return Err(Error::InvalidParameter {
                 name: "live load force".into(),
                 value: total,
                 expected: "must not be zero",
+            });
+        }
+        // λ is in units of the live load: the reference force over it must be a number.
+        let reference = self.scales(&[]).force;
+        if !(total.is_finite() && (reference / total).is_finite() && reference / total > 0.0) {
+            return Err(Error::InvalidParameter {
+                name: "live load force (sum of magnitudes, N)".into(),
+                value: total,
+                expected: "a size whose ratio to the blocks' weight is a finite, non-zero number \
+                           (scale the live load; λ is reported in its units)",
             });
         }
         Ok(())
@@ -682,7 +504,7 @@ impl LimitProblem {
         } else {
             free.iter().map(|b| b.radius).sum::<Real>() / free.len() as Real
         };
-        let live_total: Real = live.iter().map(|l| l.force.length()).sum();
+        let live_total: Real = live.iter().map(|l| norm(l.force)).sum();
         Scales {
             force,
             length,
@@ -700,6 +522,13 @@ impl LimitProblem {
                     name: "limit analysis pyramid facets".into(),
                     value: facets as Real,
                     expected: "at least 3",
+                });
+            }
+            if facets as u64 > MAX_PYRAMID_FACETS {
+                return Err(Error::TooLarge {
+                    what: "limit analysis pyramid facets".into(),
+                    requested: facets as u128,
+                    limit: MAX_PYRAMID_FACETS,
                 });
             }
         }
@@ -895,8 +724,33 @@ impl LimitProblem {
     }
 }
 
+/// The most facets of a friction pyramid ([`FrictionModel::Pyramid`]): each adds a row per
+/// contact corner; 4096 facets approximate the cone to 3e-7 of its friction, and ten million
+/// used to abort the process when memory ran out.
+pub const MAX_PYRAMID_FACETS: u64 = 4096;
+
 /// Below this (in units of the reference force) a negative multiplier is round-off.
 const FEASIBILITY_TOLERANCE: Real = 1e-7;
+
+/// `|v|` without overflow or underflow of the squares (a force of 1e-300 N or 1e300 N).
+fn norm(v: Vector) -> Real {
+    let m = v.abs().max_element();
+    if m > 0.0 && m.is_finite() {
+        m * (v / m).length()
+    } else {
+        m
+    }
+}
+
+/// The area of a planar polygon (m²; 0 for a segment or a point).
+fn polygon_area(vertices: &[Vector]) -> Real {
+    let Some(&o) = vertices.first() else { return 0.0 };
+    let mut twice = Vector::ZERO;
+    for k in 1..vertices.len().saturating_sub(1) {
+        twice += (vertices[k] - o).cross(vertices[k + 1] - o);
+    }
+    0.5 * twice.length()
+}
 
 fn free_dofs(f: &Fixity) -> [bool; 6] {
     let free = |d: &Dof| matches!(d, Dof::Free);
@@ -922,108 +776,4 @@ fn describe_live(live: &[LiveLoad], blocks: &[BlockData]) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Scales {
-    /// Reference force (N): the free blocks' weight.
-    force: Real,
-    /// Reference length (m): their mean radius.
-    length: Real,
-    /// Sum of the live loads' magnitudes (N).
-    live: Real,
-    /// `λ = multiplier × λ̂`.
-    multiplier: Real,
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Corner {
-    contact: usize,
-    point: Vector,
-    n: usize,
-    t: Option<(usize, usize)>,
-}
-
-#[derive(Debug, Default)]
-struct Triplets {
-    rows: Vec<usize>,
-    cols: Vec<usize>,
-    values: Vec<Real>,
-}
-
-impl Triplets {
-    fn push(&mut self, r: usize, c: usize, v: Real) {
-        if v != 0.0 {
-            self.rows.push(r);
-            self.cols.push(c);
-            self.values.push(v);
-        }
-    }
-    fn into_csc(self, m: usize, n: usize) -> CscMatrix<Real> {
-        CscMatrix::new_from_triplets(m, n, self.rows, self.cols, self.values)
-    }
-}
-
-struct Programme {
-    /// Number of equilibrium rows (the first rows).
-    equations: usize,
-    a: CscMatrix<Real>,
-    b: Vec<Real>,
-    q: Vec<Real>,
-    cones: Vec<SupportedConeT<Real>>,
-    row_of: Vec<Option<usize>>,
-    corners: Vec<Corner>,
-}
-
-struct Solution {
-    x: Vec<Real>,
-    z: Vec<Real>,
-}
-
-impl Programme {
-    fn run(&self, max_iterations: u32) -> Result<(Solution, SolverStatus, u32)> {
-        let n = self.q.len();
-        if n == 0 || self.equations == 0 {
-            // Nothing to solve: no contact forces, or no equation. With no equation the
-            // multiplier is unbounded (the programme's only cost) and the dead loads are carried.
-            let carried = self.b[..self.equations]
-                .iter()
-                .all(|v| v.abs() <= FEASIBILITY_TOLERANCE);
-            let status = match (carried, n > 0 && self.q[0] != 0.0 && self.equations == 0) {
-                (false, _) => SolverStatus::PrimalInfeasible,
-                (true, true) => SolverStatus::DualInfeasible,
-                (true, false) => SolverStatus::Solved,
-            };
-            return Ok((
-                Solution {
-                    x: vec![0.0; n],
-                    z: vec![0.0; self.b.len()],
-                },
-                status,
-                0,
-            ));
-        }
-        let p = CscMatrix::zeros((n, n));
-        let settings = DefaultSettings {
-            verbose: false,
-            max_iter: max_iterations,
-            ..DefaultSettings::default()
-        };
-        let mut solver = DefaultSolver::new(&p, &self.q, &self.a, &self.b, &self.cones, settings).map_err(|e| {
-            Error::LimitSolver {
-                status: format!("refused the programme: {e}"),
-                iterations: 0,
-            }
-        })?;
-        solver.solve();
-        let s = &solver.solution;
-        Ok((
-            Solution {
-                x: s.x.clone(),
-                z: s.z.clone(),
-            },
-            s.status,
-            s.iterations,
-        ))
-    }
 }

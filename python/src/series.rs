@@ -1,0 +1,63 @@
+//! ParaView series and the benchmarks' wall.
+
+use std::path::PathBuf;
+
+use pyo3::prelude::*;
+use voussoir::io::scene::Scene;
+
+use crate::errors::OrPy;
+use crate::model::PyModel;
+
+/// A ParaView series: ``ParaviewSeries(folder, name)``; ``write_frame(model)`` writes the
+/// blocks and sub-contacts of the model as a frame and rewrites the ``.pvd`` collections
+/// (``blocks_pvd``), which ParaView opens as a time series. One series writes a name in a
+/// folder at a time (a lock file ``.<name>.lock`` from the first frame until the series is
+/// freed): a second one, in this process or another, raises ``VoussoirIOError``; so does a
+/// frame after the folder was deleted or emptied mid-run.
+#[pyclass(name = "ParaviewSeries", module = "voussoir")]
+pub struct PySeries {
+    inner: voussoir::io::vtk::Series,
+}
+
+#[pymethods]
+impl PySeries {
+    #[new]
+    #[pyo3(signature = (folder, name="model"))]
+    fn new(folder: PathBuf, name: &str) -> Self {
+        Self {
+            inner: voussoir::io::vtk::Series::new(folder, name),
+        }
+    }
+
+    /// Writes a frame of the model.
+    fn write_frame(&mut self, model: PyRef<'_, PyModel>) -> PyResult<()> {
+        self.inner.write_frame(&model.model).py()
+    }
+
+    /// The blocks' ``.pvd`` collection.
+    #[getter]
+    fn blocks_pvd(&self) -> PathBuf {
+        self.inner.blocks_pvd()
+    }
+
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+}
+
+/// The benchmarks' wall (``voussoir::scenes::benchmark_wall``): about ``blocks`` bricks in
+/// running bond on a fixed base, dry Coulomb joints (kn 1 GPa/m, ks 0.4 GPa/m, φ 30°),
+/// sub-contacts at most ``spacing`` m apart (default 0.025), local damping; not yet stepped.
+#[pyfunction]
+#[pyo3(signature = (blocks, *, spacing=None))]
+pub fn benchmark_wall(blocks: usize, spacing: Option<f64>) -> PyResult<PyModel> {
+    let model = match spacing {
+        Some(h) => voussoir::scenes::benchmark_wall_with_spacing(blocks, h),
+        None => voussoir::scenes::benchmark_wall(blocks),
+    }
+    .py()?;
+    // A Model<CoulombSlip> as a Model<AnyLaw>, through its scene.
+    let scene = Scene::from_model(&model);
+    let text = scene.to_json().py()?;
+    PyModel::from_scene_json(&text)
+}
