@@ -4,7 +4,7 @@ use numpy::{PyArray1, PyArray2};
 use pyo3::prelude::*;
 use voussoir::block::{Block, RigidBlock};
 use voussoir::build::arch::{AbutmentShape, Arch, ArchSpec};
-use voussoir::build::{BarrelVaultSpec, DomeSpec, MultiLeafSpec, WallSpec};
+use voussoir::build::{BarrelVaultSpec, DomeSpec, MultiLeafSpec, RubbleWallSpec, WallSpec};
 use voussoir::law::MaterialId;
 
 use crate::convert::{array_n3, fixity, fixity_to_py, points, vec3, vec3_or_zero, vector};
@@ -264,6 +264,45 @@ pub fn multi_leaf_wall(
         material: MaterialId(material),
     };
     Ok(wrap(voussoir::build::multi_leaf_wall(&spec).py()?))
+}
+
+/// A rubble wall of irregular convex stones filling ``length`` (x) × ``thickness`` (y) ×
+/// ``height`` (z) m on a fixed base block (the first block): the cells of a grid of seeds about
+/// ``stone_size`` apart along the wall and ``leaves`` across, each seed moved at random by up to
+/// ``jitter`` of the spacing (0 gives boxes, at most 0.45); a share ``through_stones`` of the
+/// places along the face holds one through-stone spanning the thickness. Neighbouring stones
+/// share their faces exactly (no gap, no overlap); the same ``seed`` gives the same wall.
+/// Stones are named ``stone i j k`` (along, across, up) and ``through i k``.
+#[pyfunction]
+#[pyo3(signature = (*, length=2.0, thickness=0.5, height=1.2, stone_size=0.2, leaves=2, jitter=0.3, through_stones=0.1, seed=1, density=2200.0, material=0, base_material=0))]
+#[allow(clippy::too_many_arguments)]
+pub fn rubble_wall(
+    length: f64,
+    thickness: f64,
+    height: f64,
+    stone_size: f64,
+    leaves: usize,
+    jitter: f64,
+    through_stones: f64,
+    seed: u64,
+    density: f64,
+    material: u16,
+    base_material: u16,
+) -> PyResult<Vec<PyBlock>> {
+    let spec = RubbleWallSpec {
+        length,
+        thickness,
+        height,
+        stone_size,
+        leaves,
+        jitter,
+        through_stones,
+        seed,
+        density,
+        material: MaterialId(material),
+        base_material: MaterialId(base_material),
+    };
+    Ok(wrap(voussoir::build::rubble_wall(&spec).py()?))
 }
 
 /// A semicircular barrel vault: ``rings`` arch rings side by side along z, each of

@@ -29,6 +29,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(blocks::arch, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::running_bond_wall, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::multi_leaf_wall, m)?)?;
+    m.add_function(wrap_pyfunction!(blocks::rubble_wall, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::barrel_vault, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::dome, m)?)?;
     m.add_function(wrap_pyfunction!(series::benchmark_wall, m)?)?;

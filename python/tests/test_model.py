@@ -106,6 +106,30 @@ def test_blocks_and_generators():
     assert len(w) > 30 and isinstance(w.joint_law(0, 0), vs.CoulombSlip)
 
 
+def test_rubble_wall():
+    spec = dict(length=1.2, thickness=0.4, height=0.8, stone_size=0.2, through_stones=0.3, seed=7)
+    wall = vs.build.rubble_wall(**spec)
+    assert wall[0].is_fixed and not any(b.is_fixed for b in wall[1:])
+    # The stones fill the wall's box exactly.
+    volume = sum(b.volume for b in wall[1:])
+    assert abs(volume - 1.2 * 0.4 * 0.8) < 1e-9
+    assert any(b.name.startswith("through") for b in wall)
+    # Seeded: the same wall again.
+    again = vs.build.rubble_wall(**spec)
+    assert [b.name for b in again] == [b.name for b in wall]
+    assert [b.volume for b in again] == [b.volume for b in wall]
+    # It stands under gravity.
+    m = vs.Model(subcontacts_per_edge=4)
+    m.set_joint_law(0, 0, vs.CoulombSlip(kn=1e10, ks=4e9, friction_deg=35.0))
+    m.add_blocks(wall)
+    m.run_to_equilibrium(1e-4, 50_000)
+    assert np.abs(m.displacements()).max() < 1e-4
+    with pytest.raises(vs.VoussoirError, match="jitter"):
+        vs.build.rubble_wall(jitter=0.5)
+    with pytest.raises(MemoryError, match="limit"):
+        vs.build.rubble_wall(stone_size=1e-4)
+
+
 def test_arch_stands_under_gravity():
     m = vs.Model(gravity=(0, -9.81, 0), subcontacts_per_edge=5)
     m.set_joint_law(0, 0, vs.CoulombSlip.dry(4e9, 1.6e9, 30.5))

@@ -299,6 +299,20 @@ def multi_leaf_wall(
     density: float = 2000.0,
     material: int = 0,
 ) -> List[Block]: ...
+def rubble_wall(
+    *,
+    length: float = 2.0,
+    thickness: float = 0.5,
+    height: float = 1.2,
+    stone_size: float = 0.2,
+    leaves: int = 2,
+    jitter: float = 0.3,
+    through_stones: float = 0.1,
+    seed: int = 1,
+    density: float = 2200.0,
+    material: int = 0,
+    base_material: int = 0,
+) -> List[Block]: ...
 def barrel_vault(
     *,
     radius: float = 2.0,

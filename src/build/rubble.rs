@@ -93,8 +93,8 @@ pub const MAX_RUBBLE_STONES: usize = 100_000;
 ///
 /// # Errors
 /// [`Error::InvalidParameter`] for sizes, density or `leaves` that are not positive, `jitter` or
-/// `through_stones` out of range, or more than [`MAX_RUBBLE_STONES`] stones; a degenerate cell
-/// as [`RigidBlock::from_vertices`] reports it.
+/// `through_stones` out of range; [`Error::TooLarge`] for more than [`MAX_RUBBLE_STONES`]
+/// stones; a degenerate cell as [`RigidBlock::from_vertices`] reports it.
 pub fn rubble_wall(spec: &RubbleWallSpec) -> Result<Vec<RigidBlock>> {
     positive("rubble.length", spec.length)?;
     positive("rubble.thickness", spec.thickness)?;
@@ -112,12 +112,16 @@ pub fn rubble_wall(spec: &RubbleWallSpec) -> Result<Vec<RigidBlock>> {
     )?;
     let along = (spec.length / spec.stone_size).round().max(1.0);
     let up = (spec.height / spec.stone_size).round().max(1.0);
-    let places = along * up * spec.leaves as Real;
-    if places > MAX_RUBBLE_STONES as Real {
-        return Err(Error::InvalidParameter {
-            name: "rubble.stone_size".into(),
-            value: spec.stone_size,
-            expected: "must leave at most MAX_RUBBLE_STONES (100000) stones in the wall",
+    let stones = along * up * spec.leaves as Real;
+    if stones > MAX_RUBBLE_STONES as Real {
+        return Err(Error::TooLarge {
+            what: "rubble wall stones (length / stone_size × height / stone_size × leaves)".into(),
+            requested: if stones < u128::MAX as Real {
+                stones as u128
+            } else {
+                u128::MAX
+            },
+            limit: MAX_RUBBLE_STONES as u64,
         });
     }
     let (nx, nz, ny) = (along as usize, up as usize, spec.leaves);
@@ -430,7 +434,10 @@ mod tests {
         ];
         for spec in bad {
             assert!(
-                matches!(rubble_wall(&spec), Err(Error::InvalidParameter { .. })),
+                matches!(
+                    rubble_wall(&spec),
+                    Err(Error::InvalidParameter { .. } | Error::TooLarge { .. })
+                ),
                 "{spec:?}"
             );
         }
