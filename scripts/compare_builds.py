@@ -16,7 +16,9 @@ What it does:
 - prints, per scene and size, each build's median and range of the time per step, of the first
   step (the full detection of every contact) and of the peak memory per block, and the ratio
   working tree / base with its spread (the smallest and largest ratio of the runs paired round by
-  round).
+  round); and the ratio of the CPU time per step (user + system, `/proc/self/stat`, 10 ms
+  ticks), which other work on the machine disturbs less than the wall clock (with
+  `--threads 1` it is the work of the step; with more, idle workers spinning add to it).
 
 Scenes:
 - ``rest``: ``benchmark_wall`` settling with local damping, steps 20-70 timed (as
@@ -58,6 +60,24 @@ fn peak_rss() -> u64 {
         .map_or(0, |kb| kb * 1024)
 }
 
+/// CPU time of the process so far (s): user and system, from /proc/self/stat (Linux).
+fn cpu_seconds() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|s| {
+            let fields: Vec<f64> = s
+                .rsplit(')')
+                .next()?
+                .split_whitespace()
+                .skip(11)
+                .take(2)
+                .filter_map(|f| f.parse().ok())
+                .collect();
+            (fields.len() == 2).then(|| (fields[0] + fields[1]) / 100.0)
+        })
+        .unwrap_or(0.0)
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let (scene, blocks): (&str, usize) = (&args[1], args[2].parse().unwrap());
@@ -72,13 +92,14 @@ fn main() {
     for _ in 1..warmup {
         model.step().unwrap();
     }
-    let t = Instant::now();
+    let (t, cpu) = (Instant::now(), cpu_seconds());
     for _ in 0..steps {
         model.step().unwrap();
     }
     let per_step = t.elapsed().as_secs_f64() / steps as f64;
+    let cpu_per_step = (cpu_seconds() - cpu) / steps as f64;
     println!(
-        "{{\"blocks\": {}, \"first_step_s\": {first}, \"s_per_step\": {per_step}, \"peak_rss\": {}}}",
+        "{{\"blocks\": {}, \"first_step_s\": {first}, \"s_per_step\": {per_step}, \"cpu_s_per_step\": {cpu_per_step}, \"peak_rss\": {}}}",
         model.blocks().len(),
         peak_rss()
     );
@@ -224,11 +245,11 @@ def main():
     print(f"base {base_commit} against the working tree; {a.rounds} alternated rounds, {a.threads} threads;")
     print("median (range) of the runs; ratio = working tree / base, median (paired range)")
     print()
-    print("| scene | blocks | base ms/step | new ms/step | ratio | base first step s | new first step s | ratio | base kB/block | new kB/block | ratio |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| scene | blocks | base ms/step | new ms/step | ratio | CPU ratio | base first step s | new first step s | ratio | base kB/block | new kB/block | ratio |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for scene, blocks, runs in rows:
         if runs is None:
-            print(f"| {scene} | {blocks} | n/a (a build lacks shaking_wall) |" + " |" * 8)
+            print(f"| {scene} | {blocks} | n/a (a build lacks shaking_wall) |" + " |" * 9)
             continue
         b, n = runs["base"], runs["new"]
         get = lambda rs, k: [x[k] for x in rs]
@@ -237,6 +258,7 @@ def main():
             f"| {scene} | {b[0]['blocks']} "
             f"| {summary(get(b, 's_per_step'), 1e3, '{:.3f}')} | {summary(get(n, 's_per_step'), 1e3, '{:.3f}')} "
             f"| {ratio(get(n, 's_per_step'), get(b, 's_per_step'))} "
+            f"| {ratio(get(n, 'cpu_s_per_step'), get(b, 'cpu_s_per_step'))} "
             f"| {summary(get(b, 'first_step_s'), 1, '{:.3f}')} | {summary(get(n, 'first_step_s'), 1, '{:.3f}')} "
             f"| {ratio(get(n, 'first_step_s'), get(b, 'first_step_s'))} "
             f"| {summary(mem(b), 1e-3, '{:.1f}')} | {summary(mem(n), 1e-3, '{:.1f}')} | {ratio(mem(n), mem(b))} |"

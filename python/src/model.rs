@@ -3,6 +3,7 @@
 //! arrays, its monitors and its files.
 
 use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use numpy::IntoPyArray;
@@ -16,7 +17,7 @@ use voussoir::integrate::{Damping, TimeStep};
 use voussoir::io::scene::Scene;
 use voussoir::law::{AnyLaw, JointStatus, MaterialId};
 use voussoir::math::Vector;
-use voussoir::model::{Model, ModelParameters};
+use voussoir::model::{InterruptCheck, Model, ModelParameters};
 use voussoir::monitor::{Component, EnergyTerm, Monitor, Recorder};
 use voussoir::Error;
 
@@ -127,14 +128,39 @@ enum Goal {
 pub struct PyModel {
     pub(crate) model: Model<AnyLaw>,
     samples: Samples,
+    /// The KeyboardInterrupt the model's interrupt check took from Python within a step, to be
+    /// raised once the step has stopped.
+    interrupted: Arc<Mutex<Option<PyErr>>>,
 }
 
 impl PyModel {
-    fn wrap(model: Model<AnyLaw>) -> Self {
+    /// Wraps `model`, with an interrupt check that looks for Ctrl-C from within a long step
+    /// (between the batches of a contact detection: the first step of a 100k-block wall takes
+    /// seconds), taking the GIL back for the look.
+    fn wrap(mut model: Model<AnyLaw>) -> Self {
+        let interrupted = Arc::new(Mutex::new(None));
+        let seen = Arc::clone(&interrupted);
+        model.set_interrupt_check(Some(InterruptCheck::new(move || {
+            Python::attach(|py| match py.check_signals() {
+                Ok(()) => false,
+                Err(e) => {
+                    if let Ok(mut slot) = seen.lock() {
+                        *slot = Some(e);
+                    }
+                    true
+                }
+            })
+        })));
         Self {
             model,
             samples: Samples::new(),
+            interrupted,
         }
+    }
+
+    /// The KeyboardInterrupt an interrupted step took, if any.
+    fn take_interrupt(&self) -> Option<PyErr> {
+        self.interrupted.lock().ok().and_then(|mut slot| slot.take())
     }
 
     /// The block of index `block` (`VoussoirError` naming the argument `what` when out of range).
@@ -208,6 +234,9 @@ impl PyModel {
                     n += 1;
                 }
             });
+            if let Some(e) = self.take_interrupt() {
+                return Err(e);
+            }
             let (n, done) = outcome.py()?;
             taken += n;
             since_callback += n;

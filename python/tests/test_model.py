@@ -319,3 +319,30 @@ def test_ctrl_c_stops_a_run_cleanly():
     assert n > 0
     m.run_steps(1)
     assert m.step_count == n + 1 and np.isfinite(m.positions()).all()
+
+
+def test_ctrl_c_stops_a_long_first_step():
+    # The first step of a large wall detects every contact (about a second at 60k blocks on
+    # 2 cores): Ctrl-C is looked for between its detection batches, not only between steps.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    m = vs.scenes.benchmark_wall(60_000)
+    sent = []
+
+    def interrupt():
+        sent.append(time.perf_counter())
+        os.kill(os.getpid(), signal.SIGINT)
+
+    timer = threading.Timer(0.2, interrupt)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            m.step()
+        stopped = time.perf_counter()
+    finally:
+        timer.join()
+        signal.signal(signal.SIGINT, previous)
+    assert sent and stopped - sent[0] < 0.5, f"Ctrl-C seen {stopped - sent[0]:.2f} s after it was sent"
+    # The step did not happen; the next one runs.
+    assert m.step_count == 0
+    m.step()
+    assert m.step_count == 1
