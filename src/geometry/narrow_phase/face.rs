@@ -5,7 +5,9 @@ use glam::DVec2;
 use super::super::clip::{area_centroid, clip_convex, clip_rect};
 use super::super::polyhedron::Polyhedron;
 use super::*;
-use crate::math::{plane_basis, Real, Vector};
+#[cfg(feature = "limit")]
+use crate::math::plane_basis;
+use crate::math::{Real, Vector};
 
 /// Faces whose normals are opposite within this angle (rad, 1°) are parallel: the smaller face
 /// hosts the sub-contacts. Beyond it, the face whose edge or corner digs into the other does.

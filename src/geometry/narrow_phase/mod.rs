@@ -15,6 +15,7 @@ use crate::math::{Pose, Real, Vector};
 mod face;
 mod point;
 
+#[cfg(feature = "limit")]
 pub(crate) use face::contact_polygon;
 use face::*;
 use point::*;
