@@ -278,6 +278,27 @@ pub enum Error {
     /// A model with no blocks was asked to step (time could not advance: a run would never end).
     #[error("the model has no blocks: add one before stepping")]
     EmptyModel,
+    /// Two blocks overlap by more than half the smaller one's size (its radius): the joint
+    /// springs cannot carry what presses them together, and the blocks are passing through each
+    /// other. Found at a contact detection, which then stops the step: the model is as before
+    /// it.
+    #[error(
+        "step {step}: blocks {a} and {b} overlap by {depth:.4} m, more than half the smaller \
+         block's size ({limit:.4} m): the joints cannot carry what presses them together (stiffer \
+         joints, or a lighter load)"
+    )]
+    Overlap {
+        /// The step at whose detection the overlap was found.
+        step: u64,
+        /// The two blocks.
+        a: BlockId,
+        /// The two blocks.
+        b: BlockId,
+        /// Their overlap (m): the depth along the axis of least penetration.
+        depth: Real,
+        /// Half the smaller block's radius (m).
+        limit: Real,
+    },
     /// The interrupt check ([`crate::Model::set_interrupt_check`]) asked a step to stop. The
     /// step did not happen: the model is as before it, and its next step detects every contact
     /// afresh.

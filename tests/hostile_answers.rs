@@ -118,6 +118,63 @@ fn an_absurdly_dense_block_gets_a_short_step() {
     }
 }
 
+/// A block the joints cannot carry (1e13 kg/m³ on 1 GPa/m springs) sinks into its base step by
+/// short step: the run stops with `Error::Overlap` (naming both blocks) once they overlap by
+/// half the cube's size, instead of reporting success with the cube a metre below its base.
+#[test]
+fn a_block_sinking_through_its_base_stops_the_run() {
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
+    let base = model.add_block(common::fixed_slab("base")).expect("slab");
+    let h = 0.5 * common::CUBE_EDGE;
+    let cube = model
+        .add_block(
+            RigidBlock::cuboid(
+                "lead star",
+                Vector::new(-h, -h, 0.0),
+                Vector::new(h, h, common::CUBE_EDGE),
+                1e13,
+            )
+            .expect("cube"),
+        )
+        .expect("cube");
+    match model.run_until_time(1.0) {
+        Err(Error::Overlap {
+            a,
+            b,
+            depth,
+            limit,
+            step,
+        }) => {
+            assert_eq!((a, b), (base, cube));
+            assert!(
+                depth > limit && limit > 0.08 && limit < 0.09,
+                "depth {depth}, limit {limit}"
+            );
+            assert_eq!(step, model.step_count());
+            let z = model.block(cube).expect("cube").state().pose.translation.z;
+            assert!(z > 0.1 - 2.0 * limit, "stopped at z = {z}");
+        }
+        other => panic!("the sinking cube ran on: {other:?}"),
+    }
+    // The stiff joints a block of that weight needs hold it: 1e17 Pa/m.
+    let mut model = common::model(CoulombSlip::dry(1e17, 4e16, 30.0).expect("law"));
+    model.add_block(common::fixed_slab("base")).expect("slab");
+    let heavy = model
+        .add_block(
+            RigidBlock::cuboid(
+                "lead star",
+                Vector::new(-h, -h, 0.0),
+                Vector::new(h, h, common::CUBE_EDGE),
+                1e13,
+            )
+            .expect("cube"),
+        )
+        .expect("cube");
+    model.run_steps(300).expect("a carried block runs");
+    let z = model.block(heavy).expect("cube").state().pose.translation.z;
+    assert!((z - 0.1).abs() < 1e-2, "z = {z}");
+}
+
 /// A 0.2 m cube balanced on its edge (turned 45° about y) on a fixed slab, friction 40°,
 /// pushed horizontally at its centroid: only the strip of its face within the contact
 /// tolerance of the slab can carry force, so its capacity is that of a 1 mm wide base, about

@@ -393,6 +393,17 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 .zip(sc.plan[batch.clone()].par_chunks(chunk))
                 .zip(sc.chunks.par_iter_mut())
                 .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
+            if self.started {
+                // Blocks passing through each other (the joints overloaded): an error at the
+                // first such pair in plan order, before anything changes. (At the first
+                // detection, deep initial overlaps are `Error::InitialOverlap`.)
+                if let Some(e) = self.overlap_error(sc, batch.clone()) {
+                    // The moved blocks took their reference poses already: the next
+                    // detection is a full one.
+                    self.changes.insert(Changes::DETECTION);
+                    return Err(e);
+                }
+            }
             let tasks = batch.len().div_ceil(chunk);
             sc.place_staged(batch.clone(), chunk);
             let slices = sc.staging.grow();
@@ -478,6 +489,25 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         self.changes.clear();
         Ok(())
+    }
+
+    /// [`Error::Overlap`] for the first pair of `batch` (in plan order) whose overlap exceeds
+    /// half the smaller block's radius.
+    fn overlap_error(&self, sc: &DetectionScratch<L::State>, batch: std::ops::Range<usize>) -> Option<Error> {
+        sc.plan[batch.clone()]
+            .iter()
+            .zip(&sc.outcomes[batch])
+            .filter(|(_, o)| o.overlap > 0.0)
+            .find_map(|(p, o)| {
+                let limit = 0.5 * self.blocks[p.a as usize].radius.min(self.blocks[p.b as usize].radius);
+                (o.overlap > limit).then(|| Error::Overlap {
+                    step: self.step,
+                    a: BlockId(p.a),
+                    b: BlockId(p.b),
+                    depth: o.overlap,
+                    limit,
+                })
+            })
     }
 
     /// The index of the joint law between blocks `i` and `j`.

@@ -59,6 +59,9 @@ pub(super) struct Outcome {
     /// sub-contact.
     pub(super) staged: u32,
     pub(super) first_sub: u32,
+    /// The pair's overlap when tested (m, the depth along the axis of least penetration), or
+    /// 0 when they do not overlap.
+    pub(super) overlap: Real,
 }
 
 impl Default for Outcome {
@@ -76,6 +79,7 @@ impl Default for Outcome {
             seed_count: 0,
             staged: u32::MAX,
             first_sub: 0,
+            overlap: 0.0,
         }
     }
 }
@@ -149,6 +153,7 @@ impl PairTest<'_> {
                 seed_count: (scratch.seeds.len() - first) as u32,
                 staged: u32::MAX,
                 first_sub: 0,
+                overlap: (-separation).max(0.0),
                 contact: found,
             };
         }
