@@ -500,7 +500,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .filter(|(_, o)| o.overlap > 0.0)
             .find_map(|(p, o)| {
                 let limit = 0.5 * self.blocks[p.a as usize].radius.min(self.blocks[p.b as usize].radius);
-                (o.overlap > limit).then(|| Error::Overlap {
+                (o.overlap > limit).then_some(Error::Overlap {
                     step: self.step,
                     a: BlockId(p.a),
                     b: BlockId(p.b),
