@@ -110,9 +110,15 @@ fn an_absurdly_dense_block_gets_a_short_step() {
     assert!(critical > 1.0, "the critical step is long: {critical}");
     assert!(model.last_step() < 0.011, "{}", model.last_step());
     let tolerance = model.parameters().contact.tolerance;
+    // Every step moves the cube at most half the tolerance, until it has sunk so far into the
+    // slab that the run stops (`a_block_sinking_through_its_base_stops_the_run`).
     for _ in 0..200 {
         let before = model.block(cube).expect("cube").state().pose.translation;
-        model.step().expect("step");
+        match model.step() {
+            Ok(()) => {}
+            Err(Error::Overlap { .. }) => break,
+            Err(e) => panic!("{e}"),
+        }
         let moved = (model.block(cube).expect("cube").state().pose.translation - before).length();
         assert!(moved <= 0.5 * tolerance * 1.01, "moved {moved} m");
     }
