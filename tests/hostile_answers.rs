@@ -85,25 +85,29 @@ fn a_fixed_step_too_long_for_the_speed_is_an_error() {
     assert!(e.to_string().contains("contact tolerance"), "{e}");
 }
 
+/// A 0.2 m cube of 1e13 kg/m³ on the fixed slab, joints of normal stiffness `kn` (Pa/m, shear
+/// 0.4 kn, φ 30°): the model, the slab and the cube.
+fn dense_cube_on_slab(kn: f64) -> (Model, BlockId, BlockId) {
+    let mut model = common::model(CoulombSlip::dry(kn, 0.4 * kn, 30.0).expect("law"));
+    let base = model.add_block(common::fixed_slab("base")).expect("slab");
+    let h = 0.5 * common::CUBE_EDGE;
+    let cube = RigidBlock::cuboid(
+        "lead star",
+        Vector::new(-h, -h, 0.0),
+        Vector::new(h, h, common::CUBE_EDGE),
+        1e13,
+    )
+    .expect("cube");
+    let cube = model.add_block(cube).expect("cube");
+    (model, base, cube)
+}
+
 /// A block of absurd density has a critical step of seconds (its springs are weak for its
 /// mass): the step is cut to what keeps its fall within half the tolerance a step, and it
 /// lands on its base instead of falling 1,928 m in one step of 9.45 s.
 #[test]
 fn an_absurdly_dense_block_gets_a_short_step() {
-    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
-    model.add_block(common::fixed_slab("base")).expect("slab");
-    let h = 0.5 * common::CUBE_EDGE;
-    let cube = model
-        .add_block(
-            RigidBlock::cuboid(
-                "lead star",
-                Vector::new(-h, -h, 0.0),
-                Vector::new(h, h, common::CUBE_EDGE),
-                1e13,
-            )
-            .expect("cube"),
-        )
-        .expect("cube");
+    let (mut model, _, cube) = dense_cube_on_slab(1e9);
     model.step().expect("step");
     let critical = model.critical_step().expect("critical").dt;
     println!("critical step {critical} s, step taken {} s", model.last_step());
@@ -129,20 +133,7 @@ fn an_absurdly_dense_block_gets_a_short_step() {
 /// half the cube's size, instead of reporting success with the cube a metre below its base.
 #[test]
 fn a_block_sinking_through_its_base_stops_the_run() {
-    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
-    let base = model.add_block(common::fixed_slab("base")).expect("slab");
-    let h = 0.5 * common::CUBE_EDGE;
-    let cube = model
-        .add_block(
-            RigidBlock::cuboid(
-                "lead star",
-                Vector::new(-h, -h, 0.0),
-                Vector::new(h, h, common::CUBE_EDGE),
-                1e13,
-            )
-            .expect("cube"),
-        )
-        .expect("cube");
+    let (mut model, base, cube) = dense_cube_on_slab(1e9);
     match model.run_until_time(1.0) {
         Err(Error::Overlap {
             a,
@@ -163,19 +154,7 @@ fn a_block_sinking_through_its_base_stops_the_run() {
         other => panic!("the sinking cube ran on: {other:?}"),
     }
     // The stiff joints a block of that weight needs hold it: 1e17 Pa/m.
-    let mut model = common::model(CoulombSlip::dry(1e17, 4e16, 30.0).expect("law"));
-    model.add_block(common::fixed_slab("base")).expect("slab");
-    let heavy = model
-        .add_block(
-            RigidBlock::cuboid(
-                "lead star",
-                Vector::new(-h, -h, 0.0),
-                Vector::new(h, h, common::CUBE_EDGE),
-                1e13,
-            )
-            .expect("cube"),
-        )
-        .expect("cube");
+    let (mut model, _, heavy) = dense_cube_on_slab(1e17);
     model.run_steps(300).expect("a carried block runs");
     let z = model.block(heavy).expect("cube").state().pose.translation.z;
     assert!((z - 0.1).abs() < 1e-2, "z = {z}");
