@@ -117,7 +117,7 @@ fn a_stuck_edge_contact_keeps_its_shear_force_through_redetection() -> Result<()
     assert!(
         kinds(&model)
             .iter()
-            .all(|k| matches!(k, Some(voussoir::geometry::ContactKind::Point { .. }))),
+            .all(|k| matches!(k, Some(voussoir::geometry::ContactKind::Nodes))),
         "edge contacts: {:?}",
         kinds(&model)
     );

@@ -360,7 +360,7 @@ fn turned_tangent(previous: JointAxes, normal: Vector) -> Vector {
 /// `c = a·b`); for `s·a = 0` it reduces to the above. It keeps the magnitude of `s` and its
 /// direction relative to the plane.
 #[inline]
-fn plane_turn(from: Vector, to: Vector) -> Option<Vector> {
+pub(super) fn plane_turn(from: Vector, to: Vector) -> Option<Vector> {
     if from == to {
         return None;
     }

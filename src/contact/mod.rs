@@ -5,6 +5,7 @@ mod kernel;
 mod lanes;
 mod law_update;
 mod moments;
+mod nodes;
 mod view;
 
 #[cfg(feature = "serde")]
@@ -12,6 +13,8 @@ use serde::{Deserialize, Serialize};
 
 pub(crate) use kernel::{update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
+pub(crate) use nodes::{node_frame, stored_node_frame, update_nodes};
+pub(crate) use view::NodeGeometry;
 pub use view::{Contact, ContactView, SubContactSample, SubContactView};
 
 pub use crate::ids::ContactId;
@@ -171,12 +174,10 @@ impl ContactPair {
                 self.plane_normal = face.normal;
                 self.plane_offset = face.offset;
             }
-            ContactKind::Point {
-                plane_normal,
-                plane_offset,
-            } => {
-                self.plane_normal = plane_normal;
-                self.plane_offset = plane_offset;
+            // Each node finds its own face of the other block (`nodes.rs`).
+            ContactKind::Nodes => {
+                self.plane_normal = Vector::ZERO;
+                self.plane_offset = 0.0;
             }
         }
     }
@@ -214,7 +215,16 @@ impl ContactPair {
     /// Recomputes [`ContactPair::springs`] from the contact's own sub-contacts (`own`: those
     /// of its range).
     pub(crate) fn refresh_springs<S>(&mut self, own: &[SubContact<S>]) {
-        self.springs = ForceMoments::of_springs(&self.axes(), own);
+        self.springs = self.springs_of(own);
+    }
+
+    /// The spring moments of `own` (the contact's sub-contacts) on its anchor plane; none for
+    /// a node contact, whose step books each node's work by itself.
+    pub(crate) fn springs_of<S>(&self, own: &[SubContact<S>]) -> ForceMoments {
+        match self.kind {
+            ContactKind::Nodes => ForceMoments::default(),
+            ContactKind::FaceFace { .. } => ForceMoments::of_springs(&self.axes(), own),
+        }
     }
 
     pub(crate) fn range(&self) -> std::ops::Range<usize> {

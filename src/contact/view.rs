@@ -6,11 +6,33 @@
 //! through [`SubContactView`]; code that does not need the law's own state reads either through
 //! the law-free [`Contact`] trait.
 
-use super::{AnchorPlane, ContactPair, ContactWrench, SubContact, SubContactRecord};
-use crate::geometry::{ContactKind, SubKey};
+use super::{stored_node_frame, AnchorPlane, ContactPair, ContactWrench, SubContact, SubContactRecord};
+use crate::block::BlockState;
+use crate::geometry::{ContactKind, NodeId, Polyhedron, SubKey};
 use crate::ids::BlockId;
 use crate::law::{JointAxes, JointStatus};
-use crate::math::{Pose, Real, Vector, Vector2};
+use crate::math::{Matrix, Pose, Real, Vector, Vector2};
+
+/// The two blocks of a node contact as its views need them: a node's point and axes follow
+/// from its key, the blocks' poses and shapes (`contact/nodes.rs`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NodeGeometry<'a> {
+    pub states: [&'a BlockState; 2],
+    pub rotations: [Matrix; 2],
+    pub shapes: [&'a Polyhedron; 2],
+}
+
+impl NodeGeometry<'_> {
+    /// The world point of a node sub-contact and the axes its forces are composed in.
+    fn frame<S>(&self, sub: &SubContact<S>, record: &SubContactRecord) -> (Vector, JointAxes) {
+        stored_node_frame(
+            NodeId::from_key(record.key),
+            sub.plane.x as usize,
+            (self.states[0], &self.rotations[0], self.shapes[0]),
+            (self.states[1], &self.rotations[1], self.shapes[1]),
+        )
+    }
+}
 
 /// A law-free read interface of a contact between two blocks: what outputs and analyses need,
 /// whatever the joint law.
@@ -95,6 +117,7 @@ pub struct ContactView<'a, S> {
     /// small-displacement mode).
     frame: Pose,
     wrench: ContactWrench,
+    nodes: Option<NodeGeometry<'a>>,
 }
 
 impl<'a, S> ContactView<'a, S> {
@@ -104,6 +127,7 @@ impl<'a, S> ContactView<'a, S> {
         records: &'a [SubContactRecord],
         frame: Pose,
         wrench: ContactWrench,
+        nodes: Option<NodeGeometry<'a>>,
     ) -> Self {
         debug_assert_eq!(subs.len(), records.len());
         Self {
@@ -112,6 +136,7 @@ impl<'a, S> ContactView<'a, S> {
             records,
             frame,
             wrench,
+            nodes,
         }
     }
 
@@ -164,7 +189,7 @@ impl<'a, S> ContactView<'a, S> {
     }
     /// The sub-contacts, in order.
     pub fn subcontacts(&self) -> impl ExactSizeIterator<Item = SubContactView<'a, S>> + 'a {
-        let (pair, frame) = (self.pair, self.frame);
+        let (pair, frame, nodes) = (self.pair, self.frame, self.nodes);
         self.subs
             .iter()
             .zip(self.records)
@@ -173,6 +198,7 @@ impl<'a, S> ContactView<'a, S> {
                 frame,
                 sub,
                 record,
+                nodes,
             })
     }
     /// The sub-contact at `index`, if any.
@@ -182,6 +208,7 @@ impl<'a, S> ContactView<'a, S> {
             frame: self.frame,
             sub: self.subs.get(index)?,
             record: &self.records[index],
+            nodes: self.nodes,
         })
     }
     /// World positions of the sub-contacts, in order (m).
@@ -228,6 +255,7 @@ pub struct SubContactView<'a, S> {
     frame: Pose,
     sub: &'a SubContact<S>,
     record: &'a SubContactRecord,
+    nodes: Option<NodeGeometry<'a>>,
 }
 
 impl<'a, S> SubContactView<'a, S> {
@@ -235,17 +263,42 @@ impl<'a, S> SubContactView<'a, S> {
     pub fn key(&self) -> SubKey {
         self.record.key
     }
-    /// Coordinates of the anchor on the contact's [`AnchorPlane`] (m).
+    /// Coordinates of the anchor on the contact's [`AnchorPlane`] (m). For a node of a
+    /// [`ContactKind::Nodes`] contact: the index of the other block's face it was last pressed
+    /// out of, and 0.
     pub fn plane_coordinates(&self) -> Vector2 {
         self.sub.plane
     }
-    /// Material point on the host block, in its body frame (m).
+    /// Material point on the host block, in its body frame (m); for a node, on the block its
+    /// key names ([`SubContactView::node_on_b`]).
     pub fn anchor(&self) -> Vector {
-        self.pair.anchors.point(self.sub.plane)
+        match &self.nodes {
+            Some(g) => {
+                let id = NodeId::from_key(self.record.key);
+                id.point(g.shapes[id.on_b as usize])
+            }
+            None => self.pair.anchors.point(self.sub.plane),
+        }
+    }
+    /// For a node of a [`ContactKind::Nodes`] contact, whether it is a point of block `b`
+    /// (else of `a`); `None` for a sub-contact of a face–face joint.
+    pub fn node_on_b(&self) -> Option<bool> {
+        self.nodes.map(|_| NodeId::from_key(self.record.key).on_b)
+    }
+    /// The joint axes this sub-contact's forces are composed in: the contact's, or for a node
+    /// those of the face it is pressed out of.
+    pub fn axes(&self) -> JointAxes {
+        match &self.nodes {
+            Some(g) => g.frame(self.sub, self.record).1,
+            None => self.pair.axes(),
+        }
     }
     /// World position (m).
     pub fn point(&self) -> Vector {
-        self.frame.transform_point(self.anchor())
+        match &self.nodes {
+            Some(g) => g.frame(self.sub, self.record).0,
+            None => self.frame.transform_point(self.anchor()),
+        }
     }
     /// Tributary area (m²).
     pub fn area(&self) -> Real {
@@ -270,7 +323,7 @@ impl<'a, S> SubContactView<'a, S> {
     }
     /// Shear spring force on block `b` (N, world, in the joint plane).
     pub fn shear_force(&self) -> Vector {
-        self.pair.axes().shear(self.sub.force.shear)
+        self.axes().shear(self.sub.force.shear)
     }
     /// Stiffness-proportional (Rayleigh) dashpot force on block `b` (N, world); zero without
     /// Rayleigh damping.
@@ -279,7 +332,7 @@ impl<'a, S> SubContactView<'a, S> {
     }
     /// Spring plus dashpot force on block `b` (N, world).
     pub fn total_force(&self) -> Vector {
-        self.pair.axes().force(&self.sub.force) + self.record.dashpot
+        self.axes().force(&self.sub.force) + self.record.dashpot
     }
     /// Slip accumulated while sliding (m): the sum of the shear displacement increments of the
     /// steps that ended sliding.

@@ -9,8 +9,10 @@ mod polyhedron;
 pub use broad_phase::BroadPhase;
 #[cfg(feature = "limit")]
 pub(crate) use narrow_phase::contact_polygon;
+pub(crate) use narrow_phase::nodes::{deepest_two, NodeId};
+pub(crate) use narrow_phase::PARALLEL_ANGLE;
 pub use narrow_phase::{
-    detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, SubKey,
-    SubcontactDensity, SubcontactSeed, MAX_SUBCONTACTS_PER_EDGE,
+    detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact,
+    SubKey, SubcontactDensity, SubcontactSeed, MAX_SUBCONTACTS_PER_EDGE,
 };
 pub use polyhedron::{Face, MassProperties, PlacedPolyhedron, Polyhedron, MAX_HULL_VERTICES};

@@ -518,7 +518,16 @@ where
                         && (face_a as usize) < snap.blocks[p.a as usize].shape_face_count()
                         && (face_b as usize) < snap.blocks[p.b as usize].shape_face_count()
                 }
-                crate::geometry::ContactKind::Point { .. } => true,
+                crate::geometry::ContactKind::Nodes => {
+                    (p.a as usize) < n
+                        && (p.b as usize) < n
+                        && (p.first as usize + p.count as usize) <= subs.len().min(sub_records.len())
+                        && nodes_fit(
+                            (snap.blocks[p.a as usize].shape(), snap.blocks[p.b as usize].shape()),
+                            &subs[p.range()],
+                            &sub_records[p.range()],
+                        )
+                }
             };
             if !orthonormal(p.normal, p.tangent) {
                 return Err(corrupt(&format!("contacts[{k}].tangent"), "joint axes not orthonormal"));
@@ -627,10 +636,7 @@ where
                 .iter()
                 .any(|r| r.dashpot != Vector::ZERO);
             // The stored spring moments are those of the stored forces, up to summation order.
-            if !p
-                .springs
-                .matches(&ForceMoments::of_springs(&p.axes(), &model.state.subs[p.range()]))
-            {
+            if !p.springs.matches(&p.springs_of(&model.state.subs[p.range()])) {
                 return Err(corrupt(
                     &format!("contacts[{k}].springs"),
                     "inconsistent with the sub-contact forces",
@@ -1021,4 +1027,20 @@ impl<'de> serde::Deserializer<'de> for NameOnly {
         bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf option
         unit seq tuple map identifier ignored_any
     }
+}
+
+/// Whether the sub-contacts of a node contact between blocks of shapes `shapes` name nodes of
+/// those shapes (their keys) and faces of the other block (the face each was last pressed out
+/// of, `plane.x`).
+fn nodes_fit<S>(
+    shapes: (&crate::geometry::Polyhedron, &crate::geometry::Polyhedron),
+    subs: &[SubContact<S>],
+    records: &[SubContactRecord],
+) -> bool {
+    subs.iter().zip(records).all(|(s, r)| {
+        let id = crate::geometry::NodeId::from_key(r.key);
+        let (host, other) = if id.on_b { (shapes.1, shapes.0) } else { shapes };
+        let face = s.plane.x;
+        id.fits(host) && face >= 0.0 && face.fract() == 0.0 && (face as usize) < other.faces().len() && s.plane.y == 0.0
+    })
 }

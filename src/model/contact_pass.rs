@@ -9,10 +9,12 @@
 //! needed. Sums are kept per chunk of [`CONTACT_CHUNK`] contacts and added in chunk order
 //! afterwards, so that they do not depend on the number of threads.
 
-use crate::block::RigidBlock;
+use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    update_contact, ContactPair, ContactReference, ContactWrench, KernelContext, SubContact, SubContactRecord,
+    update_contact, update_nodes, ContactPair, ContactReference, ContactWrench, KernelContext, SubContact,
+    SubContactRecord,
 };
+use crate::geometry::ContactKind;
 use crate::integrate::StiffnessBound;
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real};
@@ -157,18 +159,32 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let (ra, rb) = (&self.rotations[p.a as usize], &self.rotations[p.b as usize]);
             let range = p.first as usize - base..p.first as usize - base + p.count as usize;
-            let step = update_contact(
-                p,
-                reference,
-                &mut subs[range.clone()],
-                &mut records[range],
-                (&a.state, ra),
-                (&b.state, rb),
-                &self.laws[p.law as usize],
-                self.ctx,
-                if p.host_is_a { a.radius } else { b.radius },
-                !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok(),
-            );
+            let watch = !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok();
+            let step = if matches!(p.kind, ContactKind::Nodes) {
+                update_nodes(
+                    p,
+                    &mut subs[range.clone()],
+                    &mut records[range],
+                    (&a.state, ra, a.shape()),
+                    (&b.state, rb, b.shape()),
+                    &self.laws[p.law as usize],
+                    self.ctx,
+                    watch,
+                )
+            } else {
+                update_contact(
+                    p,
+                    reference,
+                    &mut subs[range.clone()],
+                    &mut records[range],
+                    (&a.state, ra),
+                    (&b.state, rb),
+                    &self.laws[p.law as usize],
+                    self.ctx,
+                    if p.host_is_a { a.radius } else { b.radius },
+                    watch,
+                )
+            };
             *w = step.wrench;
             sums.force_magnitude += step.wrench.force.length();
             sums.work += step.work;

@@ -294,7 +294,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             return drift;
         }
         let v = *pipeline.max_speed.get_or_insert_with(|| self.max_move_speed());
-        let c = STEP_TRAVEL * self.params.contact.tolerance;
+        // While an impact is being resolved, the travel too: a kink of a node's potential
+        // inside the other block (its normal turning to another face) is crossed by steps as
+        // short as its spring's kink is.
+        let refine = match self.params.impact_step {
+            Some(r) if self.refine_omega2 > 0.0 => r,
+            _ => 1.0,
+        };
+        let c = STEP_TRAVEL * refine * self.params.contact.tolerance;
         let a = self.params.gravity.length();
         let root = v + (v * v + 4.0 * a * c).sqrt();
         if root > 0.0 {

@@ -6,9 +6,12 @@ use super::ModelState;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 
+use crate::block::Block;
+use crate::contact::stored_node_frame;
+use crate::geometry::{ContactKind, NodeId};
 use crate::integrate::{block_bound, contact_eigenvalues, AreaMoments, ContactStiffness, StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
-use crate::math::{Real, Vector};
+use crate::math::{Matrix, Real, Vector};
 
 impl<L: ConstitutiveLaw> ModelState<L> {
     /// Re-evaluates the critical step from the current contacts and each block's potential
@@ -200,19 +203,44 @@ impl<L: ConstitutiveLaw> BoundSources<'_, L> {
         let (p, reference) = (&s.pairs[k], &s.references[k]);
         let subs = &s.subs[p.range()];
         let (sa, sb) = (&s.blocks[p.a as usize].state, &s.blocks[p.b as usize].state);
-        let frame = p.frame(reference, &sa.pose, &sb.pose, s.params.mode);
-        let origin = subs
-            .first()
-            .map_or(Vector::ZERO, |s| frame.transform_point(p.anchor(s)));
+        let mut stiffness = s.laws.laws()[p.law as usize].stiffness();
         let mut moments = AreaMoments::default();
-        for sub in subs {
-            moments.add(frame.transform_point(p.anchor(sub)) - origin, sub.area);
+        let origin;
+        if matches!(p.kind, ContactKind::Nodes) {
+            // Every listed node, pressed or not, each along its own normal: bounded by the
+            // stiffer spring in every direction.
+            let (ba, bb) = (&s.blocks[p.a as usize], &s.blocks[p.b as usize]);
+            let (ra, rb) = (Matrix::from_quat(sa.pose.rotation), Matrix::from_quat(sb.pose.rotation));
+            let records = &s.sub_records[p.range()];
+            let point = |k: usize| {
+                stored_node_frame(
+                    NodeId::from_key(records[k].key),
+                    subs[k].plane.x as usize,
+                    (sa, &ra, ba.shape()),
+                    (sb, &rb, bb.shape()),
+                )
+                .0
+            };
+            origin = if subs.is_empty() { Vector::ZERO } else { point(0) };
+            for (k, sub) in subs.iter().enumerate() {
+                moments.add(point(k) - origin, sub.area);
+            }
+            let k = stiffness.normal.max(stiffness.shear);
+            (stiffness.normal, stiffness.shear) = (k, k);
+        } else {
+            let frame = p.frame(reference, &sa.pose, &sb.pose, s.params.mode);
+            origin = subs
+                .first()
+                .map_or(Vector::ZERO, |s| frame.transform_point(p.anchor(s)));
+            for sub in subs {
+                moments.add(frame.transform_point(p.anchor(sub)) - origin, sub.area);
+            }
         }
         ContactStiffness {
             a: p.a as usize,
             b: p.b as usize,
             normal: p.normal,
-            stiffness: s.laws.laws()[p.law as usize].stiffness(),
+            stiffness,
             origin,
             moments,
         }

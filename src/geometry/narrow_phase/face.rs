@@ -11,7 +11,7 @@ use crate::math::{Real, Vector};
 
 /// Faces whose normals are opposite within this angle (rad, 1°) are parallel: the smaller face
 /// hosts the sub-contacts. Beyond it, the face whose edge or corner digs into the other does.
-pub(super) const PARALLEL_ANGLE: Real = 0.017_453_292_519_943_295;
+pub(crate) const PARALLEL_ANGLE: Real = 0.017_453_292_519_943_295;
 
 /// A face-face contact between face `fa` of `a` and face `fb` of `b`; with `require_cover`,
 /// only if the larger face covers the smaller one whole; hosted by `kept_host` when given (the

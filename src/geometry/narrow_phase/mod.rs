@@ -13,12 +13,15 @@ use crate::error::{in_range, positive, Result};
 use crate::math::{Pose, Real, Vector};
 
 mod face;
-mod point;
+mod hull;
+pub(crate) mod nodes;
 
 #[cfg(feature = "limit")]
 pub(crate) use face::contact_polygon;
+pub(crate) use face::PARALLEL_ANGLE;
 use face::*;
-use point::*;
+use hull::hull2d;
+use nodes::node_contact;
 
 /// How densely joint faces are covered with sub-contacts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -157,9 +160,6 @@ impl SubKey {
     fn cell(face_host: u32, face_other: u32, i: u32, j: u32) -> Self {
         Self(((face_host as u64) << 48) | ((face_other as u64 & 0xffff) << 32) | ((i as u64) << 16) | j as u64)
     }
-    fn point(feature: u32, i: u32) -> Self {
-        Self((0xffffu64 << 48) | ((feature as u64 & 0xffff) << 32) | i as u64)
-    }
 }
 
 /// The kind of a detected contact.
@@ -174,31 +174,35 @@ pub enum ContactKind {
         /// Face of block `b`.
         face_b: u32,
     },
-    /// Edge–face, edge–edge or vertex–face beyond the face angle tolerance: sub-contacts on a
-    /// segment or at a point, anchored to the host (the block whose feature has the lower
-    /// dimension), their gaps measured to a plane fixed in the other block: its face, or for
-    /// an edge or vertex the plane through it normal to the contact normal at detection.
-    Point {
-        /// Outward unit normal of the plane, in the other block's body frame.
-        plane_normal: Vector,
-        /// Offset of the plane along `plane_normal` (m): the plane is `plane_normal·x = offset`
-        /// in the other block's body frame.
-        plane_offset: Real,
-    },
+    /// Vertex–face, edge–edge, edge–face and partly overlapping faces beyond the face angle
+    /// tolerance: fixed material nodes on the vertices and edges of both blocks, each pressed
+    /// out of the other block by its depth inside it (see `docs/theory.md` §2.2, "Node
+    /// contacts"). A node's key names its block, vertex or edge and place on the edge.
+    Nodes,
 }
 
 impl ContactKind {
     /// Whether a contact re-detected as `other` is the same joint, whose sub-contacts may carry
-    /// their history over by key: the same pair of faces, or a point contact again. A point
-    /// contact's plane is set afresh at each detection, so it is not compared; the keys (which
-    /// name the features) decide which sub-contacts carry on.
+    /// their history over by key: the same pair of faces, or a node contact again (its keys
+    /// name material nodes of the two blocks).
     pub(crate) fn same_joint(&self, other: &ContactKind) -> bool {
         match (self, other) {
             (ContactKind::FaceFace { .. }, ContactKind::FaceFace { .. }) => self == other,
-            (ContactKind::Point { .. }, ContactKind::Point { .. }) => true,
+            (ContactKind::Nodes, ContactKind::Nodes) => true,
             _ => false,
         }
     }
+}
+
+/// The contact a pair had before a detection, as [`detect`] takes it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreviousContact {
+    /// Its kind.
+    pub kind: ContactKind,
+    /// Whether its sub-contacts were anchored to block `a`.
+    pub host_is_a: bool,
+    /// Whether it carried a normal force.
+    pub loaded: bool,
 }
 
 /// A sub-contact as created by detection.
@@ -264,11 +268,12 @@ pub struct BlockGeometry<'a> {
 /// `previous` is the contact the pair had before, if any: a face-face contact between the same
 /// two faces keeps its host, so that its sub-contacts keep their keys and history (the host of
 /// a new face-face contact between tilted faces is chosen by where the overlap is deepest, see
-/// `face_face`).
+/// `face_face`); a loaded contact keeps its kind while it can (see `docs/theory.md` §2.2, "Node
+/// contacts").
 pub fn detect(
     a: BlockGeometry<'_>,
     b: BlockGeometry<'_>,
-    previous: Option<(ContactKind, bool)>,
+    previous: Option<PreviousContact>,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
     seeds: &mut Vec<SubcontactSeed>,
@@ -279,28 +284,70 @@ pub fn detect(
         return None;
     }
     let n = axis.normal;
+    // Faces opposite within `cos`: a joint within the tolerance (any overlap), else up to
+    // `COVERED_FACE_ANGLE` where the larger face covers the smaller one whole.
+    let tolerance = params.face_angle_tolerance.cos();
+    let opposite = |fa: usize, fb: usize| {
+        let na = a.pose.rotation * a.shape.faces()[fa].normal;
+        let nb = b.pose.rotation * b.shape.faces()[fb].normal;
+        -na.dot(nb)
+    };
+    // A loaded contact keeps its kind while it can: a face-face joint while its two faces stay
+    // within the tolerance (or covered within `COVERED_FACE_ANGLE`), a node contact always.
+    // The two store different energies for the same overlap, and a change under load would
+    // make or destroy the difference.
+    if let Some(p) = previous.filter(|p| p.loaded) {
+        let start = seeds.len();
+        let kept = match p.kind {
+            ContactKind::FaceFace { face_a, face_b } => {
+                let cos = opposite(face_a as usize, face_b as usize);
+                (cos >= tolerance || cos >= COVERED_FACE_ANGLE.cos())
+                    .then(|| {
+                        face_face(
+                            a,
+                            face_a as usize,
+                            b,
+                            face_b as usize,
+                            cos < tolerance,
+                            Some(p.host_is_a),
+                            params,
+                            scratch,
+                            seeds,
+                        )
+                    })
+                    .flatten()
+            }
+            ContactKind::Nodes => node_contact(a, b, n, params, seeds),
+        };
+        if kept.is_some() {
+            return kept;
+        }
+        seeds.truncate(start);
+    }
     let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
     let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
-    let na = a.pose.rotation * a.shape.faces()[fa].normal;
-    let nb = b.pose.rotation * b.shape.faces()[fb].normal;
-    let cos = -na.dot(nb);
-    if cos >= params.face_angle_tolerance.cos() || cos >= COVERED_FACE_ANGLE.cos() {
+    let cos = opposite(fa, fb);
+    // A new joint needs its faces parallel (within `PARALLEL_ANGLE` and the tolerance), or the
+    // smaller face covered: two tilted faces that overlap in part meet along an edge, which
+    // the grid of one face against the plane of the other does not see whole (the other
+    // face's edge can dig into the host unresisted), and nodes do.
+    let parallel = cos >= tolerance && cos >= PARALLEL_ANGLE.cos();
+    if parallel || cos >= COVERED_FACE_ANGLE.cos() {
         let start = seeds.len();
-        let require_cover = cos < params.face_angle_tolerance.cos();
         let kept_host = match previous {
-            Some((ContactKind::FaceFace { face_a, face_b }, host_is_a))
-                if face_a as usize == fa && face_b as usize == fb =>
-            {
-                Some(host_is_a)
-            }
+            Some(PreviousContact {
+                kind: ContactKind::FaceFace { face_a, face_b },
+                host_is_a,
+                ..
+            }) if face_a as usize == fa && face_b as usize == fb => Some(host_is_a),
             _ => None,
         };
-        if let Some(found) = face_face(a, fa, b, fb, require_cover, kept_host, params, scratch, seeds) {
+        if let Some(found) = face_face(a, fa, b, fb, !parallel, kept_host, params, scratch, seeds) {
             return Some(found);
         }
         seeds.truncate(start);
     }
-    point_contact(a, b, n, axis.separation, params, seeds)
+    node_contact(a, b, n, params, seeds)
 }
 
 /// The common-plane normal from the separating axis theorem.

@@ -3,7 +3,9 @@
 
 use crate::block::{Block, RigidBlock};
 use crate::contact::ContactPair;
-use crate::geometry::{detect, BlockGeometry, ContactParameters, DetectedContact, NarrowPhaseScratch, SubcontactSeed};
+use crate::geometry::{
+    detect, BlockGeometry, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact, SubcontactSeed,
+};
 use crate::math::{Pose, Real};
 
 /// A block pair the narrow phase tested, with the relative pose it was tested at: its verdict
@@ -121,7 +123,11 @@ impl PairTest<'_> {
                 }
             }
             let first = scratch.seeds.len();
-            let previous = p.old_contact().map(|c| (self.pairs[c].kind, self.pairs[c].host_is_a));
+            let previous = p.old_contact().map(|c| PreviousContact {
+                kind: self.pairs[c].kind,
+                host_is_a: self.pairs[c].host_is_a,
+                loaded: self.pairs[c].normal_force > 0.0,
+            });
             let found = detect(
                 BlockGeometry {
                     shape: bi.shape(),

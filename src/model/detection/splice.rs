@@ -4,11 +4,14 @@
 
 use super::super::ModelState;
 use super::*;
-use crate::block::RigidBlock;
-use crate::contact::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
+use crate::block::{Block, RigidBlock};
+use crate::contact::{
+    stored_node_frame, ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord,
+};
 use crate::error::Result;
+use crate::geometry::{ContactKind, NodeId};
 use crate::law::ConstitutiveLaw;
-use crate::math::{Real, Vector};
+use crate::math::{Matrix, Real, Vector};
 
 /// A contact after detection: an old one kept (its index), or one detected afresh (its index
 /// in the staging lists, and the old contact of the same pair it replaces or `u32::MAX`).
@@ -303,15 +306,31 @@ pub(super) fn add_dropped_work<S>(
     let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
     let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
     let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
+    let nodes = matches!(p.kind, ContactKind::Nodes);
+    let (ba, bb) = (&blocks[p.a as usize], &blocks[p.b as usize]);
+    let rotations = if nodes {
+        (Matrix::from_quat(sa.pose.rotation), Matrix::from_quat(sb.pose.rotation))
+    } else {
+        (Matrix::IDENTITY, Matrix::IDENTITY)
+    };
     for (s, r) in old.subs[p.range()].iter().zip(&old.records[p.range()]) {
-        let spring = p.axes().force(&s.force);
+        let (pt, axes) = if nodes {
+            stored_node_frame(
+                NodeId::from_key(r.key),
+                s.plane.x as usize,
+                (sa, &rotations.0, ba.shape()),
+                (sb, &rotations.1, bb.shape()),
+            )
+        } else {
+            (frame.transform_point(p.anchor(s)), p.axes())
+        };
+        let spring = axes.force(&s.force);
         if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
             continue;
         }
         if carried.is_some_and(|records| records.binary_search_by_key(&r.key, |t| t.key).is_ok()) {
             continue;
         }
-        let pt = frame.transform_point(p.anchor(s));
         let v_rel =
             (sb.velocity + sb.angular_velocity.cross(pt - xb)) - (sa.velocity + sa.angular_velocity.cross(pt - xa));
         let du = v_rel * dt;

@@ -7,12 +7,12 @@ use super::super::ModelState;
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
+    node_frame, AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
 };
 use crate::error::Result;
-use crate::geometry::{DetectedContact, SubKey, SubcontactSeed};
+use crate::geometry::{ContactKind, DetectedContact, NodeId, SubKey, SubcontactSeed, PARALLEL_ANGLE};
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
-use crate::math::{Vector, Vector2};
+use crate::math::{Matrix, Real, Vector, Vector2};
 
 /// A sub-contact and a record to fill dead room with (never read).
 pub(super) fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord) {
@@ -34,10 +34,7 @@ pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
     let pair = ContactPair {
         a: 0,
         b: 0,
-        kind: crate::geometry::ContactKind::Point {
-            plane_normal: Vector::ZERO,
-            plane_offset: 0.0,
-        },
+        kind: crate::geometry::ContactKind::Nodes,
         host_is_a: true,
         law: 0,
         first: 0,
@@ -205,15 +202,43 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             _ => JointAxes::from_normal(dc.normal),
         };
         let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
+        let old_anchors = k_old.map_or(AnchorPlane::default(), |k| old.pairs[k].anchors);
         let anchors = AnchorPlane::through(seeds.iter().map(|s| s.anchor));
         let at = first as usize - self.sub_base;
         let (subs, records) = (
             &mut self.subs[at..at + seeds.len()],
             &mut self.records[at..at + seeds.len()],
         );
+        let nodes = matches!(dc.kind, ContactKind::Nodes);
+        // Faces tilted beyond `PARALLEL_ANGLE` meet along the edge that digs in, where the
+        // loaded cells are and their gaps vary steeply.
+        let tilted = match dc.kind {
+            ContactKind::FaceFace { face_a, face_b } => {
+                let na = bi.state.pose.rotation * bi.shape().faces()[face_a as usize].normal;
+                let nb = bj.state.pose.rotation * bj.shape().faces()[face_b as usize].normal;
+                -na.dot(nb) < PARALLEL_ANGLE.cos()
+            }
+            ContactKind::Nodes => false,
+        };
+        let rotations = (
+            Matrix::from_quat(bi.state.pose.rotation),
+            Matrix::from_quat(bj.state.pose.rotation),
+        );
         for ((seed, sub_slot), record_slot) in seeds.iter().zip(subs.iter_mut()).zip(records.iter_mut()) {
+            let plane = if nodes {
+                // A node's plane coordinates hold the face of the other block it lies deepest
+                // under (`contact/nodes.rs`).
+                let frame = node_frame(
+                    NodeId::from_key(seed.key),
+                    (&bi.state, &rotations.0, bi.shape()),
+                    (&bj.state, &rotations.1, bj.shape()),
+                );
+                Vector2::new(frame.face as Real, 0.0)
+            } else {
+                anchors.coordinates(seed.anchor)
+            };
             let mut sub = SubContact {
-                plane: anchors.coordinates(seed.anchor),
+                plane,
                 area: seed.area,
                 gap: seed.gap,
                 force: JointForce::default(),
@@ -224,6 +249,19 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             let mut record = SubContactRecord::new(seed.key);
             if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
                 let o = &old_subs[k];
+                if nodes {
+                    // Its shear force is stored along the tangents of that face.
+                    sub.plane = o.plane;
+                } else if tilted && o.force.normal != 0.0 {
+                    // A loaded cell of a tilted joint keeps its place and area until it
+                    // unloads: its spring energy `½ k A g²` stays a function of the poses,
+                    // where a refresh of a partly covered cell under load would make or
+                    // destroy `½ k ΔA g²` at the deepest gaps (`docs/theory.md` §2.3). Faces
+                    // parallel within `PARALLEL_ANGLE` are refreshed: their gaps are nearly
+                    // uniform, and a face sliding over a larger one takes its support along.
+                    sub.plane = anchors.coordinates(old_anchors.point(o.plane));
+                    sub.area = o.area;
+                }
                 sub.force = o.force;
                 sub.slip = o.slip;
                 sub.status = o.status;

@@ -1,0 +1,207 @@
+//! The step of a node contact (vertex–face, edge–edge, edge–face, partly overlapping faces):
+//! every node of both blocks pressed out of the other block along the normal of the face it lies
+//! deepest under, with the laws' shear and friction on top (`docs/theory.md` §2.2 and §3, "Node
+//! contacts").
+//!
+//! A node is a material point of its block (its key names it, [`NodeId`]); its gap is its signed
+//! distance from the other block, `g = max_f (m_f·q − d_f)` ([`deepest_face`]). The normal force
+//! `k_n A (−g)` along that face's outward normal, applied at the node (and its opposite to the
+//! other block at the same point), is the gradient of `½ k_n A min(g, 0)²`, a function of the two
+//! poses alone: the work of the normal forces around any closed path is zero, whichever face a
+//! node lies under and whichever contact kind the pair had before.
+//!
+//! Shear forces are stored as components along tangents fixed in the other block's body frame
+//! for that face (`plane_basis` of its normal), so that they turn with the block; when a node
+//! passes under another face, its shear force is turned onto the new plane by the smallest
+//! rotation, which keeps its magnitude.
+
+use super::kernel::{plane_turn, ContactStep, KernelContext};
+use super::law_update::{stays_separated, update_with_law};
+use super::{ContactPair, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
+use crate::block::BlockState;
+use crate::geometry::{deepest_two, NodeId, Polyhedron};
+use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
+use crate::math::{plane_basis, Matrix, Real, Vector, Vector2};
+
+/// One block of a node contact as the step sees it: its state, rotation matrix and shape.
+pub(crate) type NodeBlock<'a> = (&'a BlockState, &'a Matrix, &'a Polyhedron);
+
+/// Where a node is and how it is pressed: its world point, the face of the other block it lies
+/// deepest under, its gap to it (m, positive = out) and the joint axes there (normal from `a` to
+/// `b`, tangent fixed in the other block).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NodeFrame {
+    pub point: Vector,
+    pub face: usize,
+    pub gap: Real,
+    /// The signed distance from the plane of the next deepest face (m): the node turns to
+    /// that face where it reaches `gap`.
+    pub next_gap: Real,
+    pub axes: JointAxes,
+}
+
+/// The joint axes of a node on `b` (`on_b`) or `a` under the face of outward normal
+/// `face_normal` (body frame of the other block, rotated by `rotation`).
+#[inline]
+fn node_axes(on_b: bool, rotation: &Matrix, face_normal: Vector) -> JointAxes {
+    let m = *rotation * face_normal;
+    JointAxes {
+        // The other block's outward normal points at the node's block: from a to b when the
+        // node is on b.
+        normal: if on_b { m } else { -m },
+        tangent: *rotation * plane_basis(face_normal).0,
+    }
+}
+
+/// The frame of node `id` of the contact between `a` and `b` at their current poses.
+#[inline]
+pub(crate) fn node_frame(id: NodeId, a: NodeBlock<'_>, b: NodeBlock<'_>) -> NodeFrame {
+    let (host, other) = if id.on_b { (b, a) } else { (a, b) };
+    let point = host.0.pose.translation + *host.1 * id.point(host.2);
+    let q = other.1.transpose() * (point - other.0.pose.translation);
+    let (face, gap, next_gap) = deepest_two(other.2, q);
+    NodeFrame {
+        point,
+        face,
+        gap,
+        next_gap,
+        axes: node_axes(id.on_b, other.1, other.2.faces()[face].normal),
+    }
+}
+
+/// The world point of node `id` and the joint axes its stored forces are composed in: those of
+/// face `face` of the other block (the face it was pressed out of at its last step).
+pub(crate) fn stored_node_frame(id: NodeId, face: usize, a: NodeBlock<'_>, b: NodeBlock<'_>) -> (Vector, JointAxes) {
+    let (host, other) = if id.on_b { (b, a) } else { (a, b) };
+    let point = host.0.pose.translation + *host.1 * id.point(host.2);
+    (point, node_axes(id.on_b, other.1, other.2.faces()[face].normal))
+}
+
+/// The shear components `shear` of a node on `b` (`on_b`) or `a`, stored along the tangents of
+/// face `from` of the other block (`shape`), turned onto face `to` by the smallest rotation
+/// (body frame of the other block: the turn does not depend on its pose).
+pub(crate) fn turned_shear(shear: Vector2, on_b: bool, shape: &Polyhedron, from: usize, to: usize) -> Vector2 {
+    let (old, new) = (
+        node_axes(on_b, &Matrix::IDENTITY, shape.faces()[from].normal),
+        node_axes(on_b, &Matrix::IDENTITY, shape.faces()[to].normal),
+    );
+    let s = old.shear(shear);
+    let s = match plane_turn(old.normal, new.normal) {
+        Some(m) => s - m * new.normal.dot(s),
+        None => s,
+    };
+    new.components(s)
+}
+
+/// Updates one node contact for one step (see the module): every node's gap, axes and forces,
+/// and returns the contact's wrench on the two blocks and its energy increments. Sums run in
+/// node order. The node geometry follows the blocks in either displacement mode; in
+/// small-displacement mode the gap is carried incrementally.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn update_nodes<L: ConstitutiveLaw>(
+    pair: &mut ContactPair,
+    subs: &mut [SubContact<L::State>],
+    records: &mut [SubContactRecord],
+    a: NodeBlock<'_>,
+    b: NodeBlock<'_>,
+    law: &L,
+    ctx: KernelContext,
+    watch: bool,
+) -> ContactStep {
+    let (sa, sb) = (a.0, b.0);
+    let (xa, xb) = (sa.pose.translation, sb.pose.translation);
+    let dt = ctx.dt;
+    let k = law.stiffness();
+    let damped = ctx.stiffness_damping > 0.0;
+    let (cn, cs) = if damped {
+        (
+            ctx.stiffness_damping * k.normal / dt,
+            ctx.stiffness_damping * k.shear / dt,
+        )
+    } else {
+        (0.0, 0.0)
+    };
+    let dashpots = damped || pair.dashpots;
+    let threshold = ctx.impact_speed * dt;
+    let reach = ctx.impact_horizon / dt;
+    let mut step = ContactStep::default();
+    let (mut force, mut moment_a, mut moment_b) = (Vector::ZERO, Vector::ZERO, Vector::ZERO);
+    let (mut spring_sum, mut dashpot_sum, mut normal_force) = (0.0, 0.0, 0.0);
+    let mut fastest: Real = 0.0;
+    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
+        let id = NodeId::from_key(record.key);
+        let frame = node_frame(id, a, b);
+        let other_shape = if id.on_b { a.2 } else { b.2 };
+        let last_face = sub.plane.x as usize;
+        if frame.face != last_face && sub.force.shear != Vector2::ZERO {
+            sub.force.shear = turned_shear(sub.force.shear, id.on_b, other_shape, last_face, frame.face);
+        }
+        sub.plane.x = frame.face as Real;
+        let axes = frame.axes;
+        let p = frame.point;
+        let v_rel =
+            (sb.velocity + sb.angular_velocity.cross(p - xb)) - (sa.velocity + sa.angular_velocity.cross(p - xa));
+        let du = v_rel * dt;
+        let du_n = axes.normal.dot(du);
+        let du_s = axes.components(du);
+        fastest = fastest.max(v_rel.length_squared());
+        let gap = match ctx.mode {
+            DisplacementMode::Large => frame.gap,
+            DisplacementMode::Small => sub.gap + du_n,
+        };
+        // The impact probe: the spring's kink (closing or opening fast), and, for a loaded
+        // node, the turn of its normal to another face (a kink of the potential inside the
+        // other block), approached fast: `gap − next_gap` changes by at most `2|Δu|` a step.
+        let moved = du.length();
+        step.impact |= (du_n.abs() > threshold
+            && (gap > 0.0) != (du_n > 0.0)
+            && gap.abs() < reach * du_n.abs()
+            && law.stays_open(sub.area, gap.abs(), &sub.state))
+            || (frame.gap < 0.0 && moved > threshold && frame.gap - frame.next_gap < 2.0 * reach * moved);
+        if (!dashpots || record.dashpot == Vector::ZERO) && stays_separated(law, sub, gap) {
+            sub.gap = gap;
+            continue;
+        }
+        let before = axes.force(&sub.force);
+        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        step.dissipated += lost;
+        let spring = axes.force(&sub.force);
+        spring_sum += (before + spring).dot(du);
+        normal_force += sub.force.normal;
+        let mut total = spring;
+        if dashpots {
+            let mut dashpot = Vector::ZERO;
+            if damped && status != JointStatus::Open {
+                dashpot -= axes.normal * (cn * sub.area * du_n);
+                if status != JointStatus::Sliding {
+                    dashpot -= axes.shear(du_s) * (cs * sub.area);
+                }
+            }
+            dashpot_sum += (record.dashpot + dashpot).dot(du);
+            record.dashpot = dashpot;
+            total += dashpot;
+        }
+        // The force on b at the node, its opposite on a.
+        force += total;
+        moment_b += (p - xb).cross(total);
+        moment_a -= (p - xa).cross(total);
+    }
+    pair.dashpots = damped;
+    pair.normal_force = normal_force;
+    // The contact's normal for its views: along its resultant while it carries one.
+    let length = force.length();
+    if length > 0.0 && length.is_finite() {
+        let axes = JointAxes::from_normal(force / length);
+        (pair.normal, pair.tangent) = (axes.normal, axes.tangent);
+    }
+    step.impact &= fastest > ctx.impact_speed * ctx.impact_speed;
+    step.busy = watch && normal_force > 0.0 && fastest > ctx.impact_speed * ctx.impact_speed;
+    step.wrench = ContactWrench {
+        force,
+        moment_a,
+        moment_b,
+    };
+    step.work = -0.5 * spring_sum;
+    step.dashpot_work = -0.5 * dashpot_sum;
+    step
+}

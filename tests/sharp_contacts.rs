@@ -1,0 +1,257 @@
+//! Sharp blocks: vertex, edge and partly overlapping face contacts (node contacts,
+//! `docs/theory.md` §2.2), through the public API only.
+//!
+//! Tetrahedra, wedges and random convex stones (hulls of random points) dropped in random
+//! orientations onto a slab and onto fixed blocks of those kinds meet at vertices, edges and
+//! tilted faces, and tumble from one to the other. A node's normal spring derives from a
+//! potential of the two poses, so that with no damping and no friction the mechanical energy
+//! `kinetic + elastic − work of gravity` must stay at its release value whatever the contacts
+//! do; with friction the laws' dissipation must never be negative and the balance must close.
+//!
+//! Tolerances: 2 % of `m g h` for the mechanical energy between impacts (the integrator's own
+//! error at the kinks of the springs, `docs/theory.md` §5.4, is a fraction of that with the
+//! impact-resolving step), 1 % for the balance with friction.
+
+mod common;
+
+use voussoir::prelude::*;
+
+const RHO: Real = 2500.0;
+
+/// A deterministic pseudo-random stream in [0, 1) (64-bit LCG), for reproducible drops.
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> Real {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as Real) / ((1u64 << 53) as Real)
+    }
+
+    fn rotation(&mut self) -> Rotation {
+        let axis = Vector::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5);
+        Rotation::from_scaled_axis(axis * 6.0)
+    }
+}
+
+/// A regular tetrahedron (0), a triangular wedge (1) or a random convex stone (2) of half-size
+/// `s`: the stone is the hull of 14 points at 0.6–1 `s` from its centre in random directions.
+fn sharp_block(kind: usize, s: Real, rng: &mut Lcg) -> RigidBlock {
+    let v = |x, y, z| Vector::new(x, y, z);
+    match kind {
+        0 => RigidBlock::from_vertices(
+            "tetrahedron",
+            &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
+            RHO,
+        ),
+        1 => RigidBlock::from_vertices(
+            "wedge",
+            &[
+                v(-s, -s, -s),
+                v(s, -s, -s),
+                v(0.0, -s, s),
+                v(-s, s, -s),
+                v(s, s, -s),
+                v(0.0, s, s),
+            ],
+            RHO,
+        ),
+        _ => {
+            let points: Vec<Vector> = (0..14)
+                .map(|_| {
+                    let d = Vector::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5).normalize();
+                    d * s * (0.6 + 0.4 * rng.next())
+                })
+                .collect();
+            RigidBlock::from_vertices("stone", &points, RHO)
+        }
+    }
+    .expect("block")
+}
+
+/// The lowest and highest world `z` of a block's vertices (m).
+fn z_range(block: &RigidBlock) -> (Real, Real) {
+    block
+        .shape()
+        .vertices()
+        .iter()
+        .map(|v| block.world_point(*v).z)
+        .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), z| {
+            (lo.min(z), hi.max(z))
+        })
+}
+
+/// What one drop did, relative to `m g h`.
+#[derive(Debug)]
+struct DropRecord {
+    case: usize,
+    impacts: usize,
+    /// Largest |mechanical energy − released| between impacts and at the end.
+    mechanical: Real,
+    /// Largest |input − accounted| between impacts and at the end.
+    balance: Real,
+    /// Smallest friction term over every step, and at the end.
+    friction: (Real, Real),
+    /// Steps that ended with a node contact.
+    node_steps: usize,
+}
+
+/// Drop `case` with `law`: a block (tetrahedron, wedge, stone by `case / 4`) of half-size 0.1 m
+/// in a random orientation, released 5–10 cm above a fixed base (slab, tetrahedron, wedge,
+/// stone by `case % 4`, half-size 0.15 m, also turned at random), offset by up to 5 cm, and
+/// followed for 0.8 s.
+fn drop(case: usize, law: CoulombSlip, rng: &mut Lcg) -> DropRecord {
+    let mut model = common::model(law);
+    model.set_damping(Damping::None).expect("damping");
+    let base = if case % 4 == 0 {
+        common::fixed_slab("slab")
+    } else {
+        let base = sharp_block(case % 4 - 1, 0.15, rng).transformed(Pose::from_rotation(rng.rotation()));
+        let top = z_range(&base).1;
+        base.transformed(Pose::from_translation(Vector::new(0.0, 0.0, -top)))
+            .with_fixity(Fixity::FIXED)
+    };
+    model.add_block(base).expect("base");
+    let block = sharp_block((case / 4) % 3, 0.1, rng).transformed(Pose::from_rotation(rng.rotation()));
+    let low = z_range(&block).0;
+    let height = 0.05 + 0.05 * rng.next();
+    let offset = Vector::new((rng.next() - 0.5) * 0.1, (rng.next() - 0.5) * 0.1, height - low);
+    let id = model
+        .add_block(block.transformed(Pose::from_translation(offset)))
+        .expect("block");
+    let mgh = model.block(id).expect("block").mass_properties().mass * 9.81 * height;
+    let mut r = DropRecord {
+        case,
+        impacts: 0,
+        mechanical: 0.0,
+        balance: 0.0,
+        friction: (0.0, 0.0),
+        node_steps: 0,
+    };
+    let mut was_loaded = false;
+    let mut sample = |model: &Model, r: &mut DropRecord| {
+        let e = model.energies();
+        let mechanical = e.kinetic + e.elastic + e.friction - e.gravity_work - e.initial_kinetic;
+        r.mechanical = r.mechanical.max(mechanical.abs() / mgh);
+        r.balance = r.balance.max((e.input() - e.accounted()).abs() / mgh);
+    };
+    while model.time() < 0.8 {
+        model.step().expect("step");
+        let e = model.energies();
+        r.friction.0 = r.friction.0.min(e.friction / mgh);
+        let loaded = model
+            .contacts()
+            .any(|c| c.subcontacts().any(|s| s.normal_force() > 0.0));
+        if model
+            .contacts()
+            .any(|c| matches!(c.kind(), voussoir::geometry::ContactKind::Nodes))
+        {
+            r.node_steps += 1;
+        }
+        if loaded && !was_loaded {
+            r.impacts += 1;
+        }
+        was_loaded = loaded;
+        if !loaded {
+            sample(&model, &mut r);
+        }
+    }
+    sample(&model, &mut r);
+    r.friction.1 = model.energies().friction / mgh;
+    r
+}
+
+/// **Sharp blocks keep their energy**: 48 frictionless, undamped drops of tetrahedra, wedges
+/// and random stones onto a slab and onto fixed blocks of those kinds, each through at least
+/// three impacts: the mechanical energy within 2 % of `m g h` between impacts and at the end,
+/// and the friction term exactly zero.
+///
+/// Measured (default parameters): worst 1.7 % of `m g h`, median 0.05 %. Before node contacts
+/// (point contacts with a plane fixed at detection and a discretisation that changed while
+/// loaded) 33 of 40 such drops ended beyond 1 %, the worst at 8.8 `m g h`.
+#[test]
+fn frictionless_drops_of_sharp_blocks_keep_their_energy() {
+    let mut rng = Lcg(12345);
+    let records: Vec<DropRecord> = (0..48)
+        .map(|case| drop(case, CoulombSlip::dry(1e9, 1e9, 0.0).expect("law"), &mut rng))
+        .collect();
+    let mut errors: Vec<Real> = records.iter().map(|r| r.mechanical).collect();
+    errors.sort_by(Real::total_cmp);
+    println!(
+        "mechanical energy error / m g h: median {:.2e}, worst {:.2e}; node contacts in {} of 48 drops",
+        errors[errors.len() / 2],
+        errors[errors.len() - 1],
+        records.iter().filter(|r| r.node_steps > 0).count()
+    );
+    let failures: Vec<&DropRecord> = records
+        .iter()
+        .filter(|r| r.impacts < 3 || r.mechanical > 0.02 || r.friction != (0.0, 0.0))
+        .collect();
+    assert!(failures.is_empty(), "{} of 48 drops: {failures:#?}", failures.len());
+    // Node contacts are what these drops exercise.
+    assert!(records.iter().filter(|r| r.node_steps > 0).count() >= 40);
+}
+
+/// **With friction the books close**: the same 48 drops with φ = 30°: the laws' dissipation is
+/// never negative at any step and the balance `input − accounted` stays within 1 % of `m g h`.
+#[test]
+fn sharp_drops_with_friction_dissipate_and_balance() {
+    let mut rng = Lcg(12345);
+    let records: Vec<DropRecord> = (0..48)
+        .map(|case| drop(case, CoulombSlip::dry(1e9, 1e9, 30.0).expect("law"), &mut rng))
+        .collect();
+    let worst = records.iter().map(|r| r.balance).fold(0.0, Real::max);
+    let dissipated = records.iter().map(|r| r.friction.1).fold(0.0, Real::max);
+    println!("balance / m g h: worst {worst:.2e}; largest friction {dissipated:.2} m g h");
+    let failures: Vec<&DropRecord> = records
+        .iter()
+        .filter(|r| r.balance > 0.01 || r.friction.0 < 0.0)
+        .collect();
+    assert!(failures.is_empty(), "{} of 48 drops: {failures:#?}", failures.len());
+    assert!(dissipated > 0.05, "the drops slide: {dissipated}");
+}
+
+/// **A block rocking from a corner to an edge to its face keeps its energy**: a 0.2 m cube on
+/// a fixed cube of the same size, offset so that the faces overlap in part, tilted onto one
+/// corner and released, undamped and frictionless: its contact turns from a corner to an edge
+/// to the face and back as it rocks and bounces for a second. The mechanical energy stays
+/// within 1 % of the energy released by the fall to flat.
+#[test]
+fn a_block_rocking_through_corner_edge_and_face_keeps_its_energy() {
+    let mut model = common::model(CoulombSlip::dry(1e9, 1e9, 0.0).expect("law"));
+    model.set_damping(Damping::None).expect("damping");
+    let h = 0.1;
+    model
+        .add_block(
+            RigidBlock::cuboid("below", Vector::new(-h, -h, -2.0 * h), Vector::new(h, h, 0.0), RHO)
+                .expect("block")
+                .with_fixity(Fixity::FIXED),
+        )
+        .expect("below");
+    let cube = RigidBlock::cuboid("cube", Vector::splat(-h), Vector::splat(h), RHO)
+        .expect("cube")
+        .transformed(Pose::from_rotation(Rotation::from_scaled_axis(
+            Vector::new(1.0, 0.6, 0.0).normalize() * 0.35,
+        )));
+    let low = z_range(&cube).0;
+    let id = model
+        .add_block(cube.transformed(Pose::from_translation(Vector::new(0.04, 0.03, -low))))
+        .expect("cube");
+    let m = model.block(id).expect("cube").mass_properties().mass;
+    let fall = m * 9.81 * (model.block(id).expect("cube").state().pose.translation.z - h);
+    let mut kinds = std::collections::BTreeSet::new();
+    let mut worst: Real = 0.0;
+    while model.time() < 1.0 {
+        model.step().expect("step");
+        for c in model.contacts() {
+            kinds.insert(matches!(c.kind(), voussoir::geometry::ContactKind::Nodes));
+        }
+        let e = model.energies();
+        worst = worst.max((e.kinetic + e.elastic - e.gravity_work - e.initial_kinetic).abs());
+    }
+    println!("largest mechanical energy error {worst:.3e} J against {fall:.3e} J released; node / face kinds seen: {kinds:?}");
+    assert!(kinds.contains(&true), "a node contact at the corner");
+    assert!(worst < 0.01 * fall, "{worst} J against {fall} J");
+}
