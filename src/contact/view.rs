@@ -144,7 +144,7 @@ impl<'a, S> ContactView<'a, S> {
     pub fn blocks(&self) -> (BlockId, BlockId) {
         (BlockId(self.pair.a), BlockId(self.pair.b))
     }
-    /// Contact case (face-face, or a point contact with its plane).
+    /// Contact case (a face-face joint, or a node contact).
     pub fn kind(&self) -> ContactKind {
         self.pair.kind
     }

@@ -34,7 +34,9 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// type; version 9 files (which have neither, so that corruption could not be told) are refused.
 /// Version 11 adds the pairs the narrow phase tested, with their relative poses, on which
 /// re-detection depends, and the blocks' stability bounds, which are re-evaluated block by block.
-const VERSION: u32 = 11;
+/// Version 12 has node contacts (`"Nodes"`) where 11 had point contacts (`"Point"`, with a
+/// plane), and the refinement's travel cap (`refine_travel`).
+const VERSION: u32 = 12;
 /// The checksum's field: `"crc32:"` and eight hexadecimal digits.
 const CHECKSUM: &str = "checksum";
 /// The largest step count (or detection count) a checkpoint may hold: 2⁵³, where `f64` stops
@@ -99,6 +101,9 @@ struct Snapshot<L: ConstitutiveLaw> {
     refine_until: Real,
     #[serde(default)]
     refine_omega2: Real,
+    /// Whether the refinement also caps the travel per step (a node contact asked for it).
+    #[serde(default)]
+    refine_travel: bool,
     /// The contacts under impact refinement (sorted block pairs).
     #[serde(default)]
     refining: Vec<(u32, u32)>,
@@ -322,6 +327,7 @@ where
             drift: self.state.drift,
             refine_until: self.state.refine_until,
             refine_omega2: self.state.refine_omega2,
+            refine_travel: self.state.refine_travel,
             refining: self.state.refining.clone(),
             motions: self.state.motions.clone(),
             pending_detection: self.state.changes.need_full_detection() || !self.state.refixed.is_empty(),
@@ -671,6 +677,7 @@ where
         };
         model.state.refine_until = snap.refine_until;
         model.state.refine_omega2 = snap.refine_omega2;
+        model.state.refine_travel = snap.refine_travel;
         model.state.refining = snap.refining;
         for (k, m) in snap.motions.into_iter().enumerate() {
             let block = BlockId(m.block);

@@ -104,6 +104,8 @@ pub(super) struct PairSums {
     pub fired_count: u32,
     /// Whether a loaded impacting contact moves fast.
     pub busy: bool,
+    /// Whether an impacting contact is a node contact.
+    pub node_impact: bool,
 }
 
 impl<L: ConstitutiveLaw> ContactPass<'_, L> {
@@ -199,6 +201,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                     sums.fired[sums.fired_count as usize] = (p.a, p.b);
                 }
                 sums.fired_count += 1;
+                sums.node_impact |= matches!(p.kind, ContactKind::Nodes);
             }
             sums.busy |= step.busy;
         }

@@ -180,6 +180,10 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     /// bound of the blocks that asked for it (0 when not refining).
     pub refine_until: Real,
     pub refine_omega2: Real,
+    /// Whether the refinement also caps every block's travel per step at `impact_step` of the
+    /// usual (`cap_drift`): a node contact asked for it (a node about to turn to
+    /// another face, a kink crossed at the relative speed rather than at a spring's frequency).
+    pub refine_travel: bool,
     /// The contacts (as sorted block pairs) the impact probe marked since the refinement began:
     /// the step is not relaxed while one of them is loaded and moving fast.
     pub refining: Vec<(u32, u32)>,
@@ -309,6 +313,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 drift: 0.0,
                 refine_until: 0.0,
                 refine_omega2: 0.0,
+                refine_travel: false,
                 refining: Vec::new(),
                 critical: None,
                 step: 0,
@@ -889,7 +894,7 @@ mod tests {
 
     /// A column of four cubes on a fixed base, each overhanging the one below by 40 mm: it
     /// leans and topples, so blocks move beyond the re-detection trigger, joints open onto
-    /// edges (point contacts) and contacts change.
+    /// edges (node contacts) and contacts change.
     pub(crate) fn toppling_column(params: ModelParameters) -> Model {
         let mut column: Model = Model::new(params).expect("model");
         column
@@ -1032,7 +1037,7 @@ mod tests {
     /// without) — give each sub-contact bit for bit the forces, gap, status, law state and slip
     /// of the one-at-a-time loop (which runs when the contact has dashpot forces); only the
     /// contact sums of the four-at-a-time loop, taken in another order, differ by round-off.
-    /// On a settling wall, and on a toppling column (point contacts, incremental gaps) in large-
+    /// On a settling wall, and on a toppling column (incremental gaps) in large-
     /// and small-displacement mode.
     #[test]
     fn grouped_and_single_sub_contact_loops_agree() {

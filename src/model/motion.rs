@@ -294,11 +294,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             return drift;
         }
         let v = *pipeline.max_speed.get_or_insert_with(|| self.max_move_speed());
-        // While an impact is being resolved, the travel too: a kink of a node's potential
-        // inside the other block (its normal turning to another face) is crossed by steps as
-        // short as its spring's kink is.
+        // While a node contact's impact is being resolved, the travel too: a kink of a node's
+        // potential inside the other block (its normal turning to another face) is crossed at
+        // the relative speed, by steps as short as a spring's kink is.
         let refine = match self.params.impact_step {
-            Some(r) if self.refine_omega2 > 0.0 => r,
+            Some(r) if self.refine_omega2 > 0.0 && self.refine_travel => r,
             _ => 1.0,
         };
         let c = STEP_TRAVEL * refine * self.params.contact.tolerance;

@@ -128,6 +128,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             return self.dt;
         };
         if impact > 0.0 {
+            self.refine_travel |= pipeline.pair_sums.iter().any(|s| s.node_impact);
             let hold = 3.0 * 2.0 / impact.sqrt();
             self.refine_until = self.refine_until.max(self.time + hold);
             self.refine_omega2 = self.refine_omega2.max(impact);
@@ -147,6 +148,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.dt.min(r * 2.0 / self.refine_omega2.sqrt())
         } else {
             self.refine_omega2 = 0.0;
+            self.refine_travel = false;
             self.refining.clear();
             self.dt
         }

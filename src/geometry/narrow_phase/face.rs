@@ -255,7 +255,7 @@ pub(super) fn face_face_hosted(
 /// are at an angle, as for a block balanced on its edge), projected on that plane and clipped by
 /// the host face — where the grid cells that carry the sub-contacts can close
 /// (`face_face_hosted`); for a
-/// point contact, or a face-face polygon that came out degenerate, the 2-D hull of `points`
+/// node contact, or a face-face polygon that came out degenerate, the 2-D hull of `points`
 /// (the sub-contacts) in the plane normal to `normal`: a polygon, a segment or a point.
 /// Corners closer than 1e-9 of the polygon's extent are merged, collinear ones dropped.
 #[cfg(feature = "limit")]

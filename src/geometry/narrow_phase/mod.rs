@@ -13,6 +13,7 @@ use crate::error::{in_range, positive, Result};
 use crate::math::{Pose, Real, Vector};
 
 mod face;
+#[cfg(feature = "limit")]
 mod hull;
 pub(crate) mod nodes;
 
@@ -20,6 +21,8 @@ pub(crate) mod nodes;
 pub(crate) use face::contact_polygon;
 pub(crate) use face::PARALLEL_ANGLE;
 use face::*;
+#[cfg(feature = "limit")]
+#[cfg(feature = "limit")]
 use hull::hull2d;
 use nodes::node_contact;
 
@@ -39,11 +42,10 @@ pub enum SubcontactDensity {
 /// face. A denser grid is refused rather than allocated (the reference paper uses 15).
 pub const MAX_SUBCONTACTS_PER_EDGE: u16 = 1000;
 
-/// Two faces further apart than the face angle tolerance but within this angle (rad, 60°) still
-/// form a face-face contact when the larger face covers the smaller one whole: an edge or a
-/// corner landing on a face is then the edge row or corner node of the grid that carries the
-/// face once it lands, instead of a differently discretised point contact (`docs/theory.md`
-/// §2.2). Where the faces overlap only in part (edge against edge), a point contact.
+/// A loaded joint whose faces turn beyond the face angle tolerance stays a joint up to this
+/// angle (rad, 60°) while the larger face covers the smaller one whole: a block rocking or
+/// toppling on a larger one, whose loaded edge row or corner node lies in cells that the other
+/// face covers (`docs/theory.md` §2.2).
 const COVERED_FACE_ANGLE: Real = std::f64::consts::FRAC_PI_3;
 
 /// Largest face angle tolerance (rad, 75°): beyond it the projection of one face on the other
@@ -66,12 +68,14 @@ pub struct ContactParameters {
     /// only if its two blocks moved relative to each other (a contact: by more than half the
     /// trigger since its test; `docs/theory.md` §2.3). Default `0.25`.
     pub redetect_fraction: Real,
-    /// The two faces most aligned with the contact normal form a face-to-face joint (a grid of
-    /// sub-contacts on one of the faces, gaps measured to the other face's plane) while their
-    /// normals are opposite within this angle (rad). Default 15°, so that an opening hinge keeps
-    /// its sub-contacts and their history. Beyond it and up to 60°, they still form a face-face
-    /// contact when the larger face covers the smaller one whole (an edge or corner landing on
-    /// a face); otherwise the contact is a point contact (`docs/theory.md` §2.2).
+    /// How far a loaded face-to-face joint (a grid of sub-contacts on one of the faces, gaps
+    /// measured to the other face's plane) may rotate and stay a joint (rad): its faces'
+    /// normals opposite within this angle, or up to 60° while the larger face covers the smaller
+    /// one whole. Default 15°, so that an opening hinge keeps its sub-contacts and their
+    /// history. A new joint forms where the two faces most aligned with the contact normal are
+    /// parallel within 1° (and this angle); every other contact — vertices, edges, tilted or
+    /// partly overlapping faces — is a node contact ([`ContactKind::Nodes`],
+    /// `docs/theory.md` §2.2).
     pub face_angle_tolerance: Real,
     /// Sub-contact density on joint faces. Default `PerEdge(15)` (the paper's value).
     pub density: SubcontactDensity,
@@ -284,8 +288,6 @@ pub fn detect(
         return None;
     }
     let n = axis.normal;
-    // Faces opposite within `cos`: a joint within the tolerance (any overlap), else up to
-    // `COVERED_FACE_ANGLE` where the larger face covers the smaller one whole.
     let tolerance = params.face_angle_tolerance.cos();
     let opposite = |fa: usize, fb: usize| {
         let na = a.pose.rotation * a.shape.faces()[fa].normal;
@@ -293,9 +295,10 @@ pub fn detect(
         -na.dot(nb)
     };
     // A loaded contact keeps its kind while it can: a face-face joint while its two faces stay
-    // within the tolerance (or covered within `COVERED_FACE_ANGLE`), a node contact always.
-    // The two store different energies for the same overlap, and a change under load would
-    // make or destroy the difference.
+    // opposite within the tolerance, or within `COVERED_FACE_ANGLE` while the larger face covers
+    // the smaller one whole (a block rocking on a larger one: the loaded edge row or corner node
+    // sits in cells the other face covers), a node contact always. The two store different energies
+    // for the same overlap, and a change under load would make or destroy the difference.
     if let Some(p) = previous.filter(|p| p.loaded) {
         let start = seeds.len();
         let kept = match p.kind {
@@ -324,15 +327,16 @@ pub fn detect(
         }
         seeds.truncate(start);
     }
+    // A new joint needs its faces parallel, within `PARALLEL_ANGLE` and the tolerance. Tilted
+    // faces meet along an edge or at a corner, which nodes carry whole: the grid of one face
+    // against the plane of the other misses the other face's edge digging into it where they
+    // overlap in part, and the grids of the different faces around a corner store different
+    // energies for the same overlap (a corner landing changed its energy by 5 % of m g h when
+    // the most aligned face changed under load).
     let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
     let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
     let cos = opposite(fa, fb);
-    // A new joint needs its faces parallel (within `PARALLEL_ANGLE` and the tolerance), or the
-    // smaller face covered: two tilted faces that overlap in part meet along an edge, which
-    // the grid of one face against the plane of the other does not see whole (the other
-    // face's edge can dig into the host unresisted), and nodes do.
-    let parallel = cos >= tolerance && cos >= PARALLEL_ANGLE.cos();
-    if parallel || cos >= COVERED_FACE_ANGLE.cos() {
+    if cos >= tolerance && cos >= PARALLEL_ANGLE.cos() {
         let start = seeds.len();
         let kept_host = match previous {
             Some(PreviousContact {
@@ -342,7 +346,7 @@ pub fn detect(
             }) if face_a as usize == fa && face_b as usize == fb => Some(host_is_a),
             _ => None,
         };
-        if let Some(found) = face_face(a, fa, b, fb, !parallel, kept_host, params, scratch, seeds) {
+        if let Some(found) = face_face(a, fa, b, fb, false, kept_host, params, scratch, seeds) {
             return Some(found);
         }
         seeds.truncate(start);
@@ -431,7 +435,7 @@ fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut Nar
     best
 }
 
-/// Characteristic sub-contact spacing for a pair (m), used for point contacts.
+/// Characteristic sub-contact spacing for a pair (m), used for node contacts.
 fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubcontactDensity) -> Real {
     match density {
         SubcontactDensity::Spacing(h) => h,

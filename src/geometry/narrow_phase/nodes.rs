@@ -14,63 +14,269 @@
 use super::*;
 use crate::math::Real;
 
-/// Bits of a node key: side (1), first vertex (15), second vertex (16), node along the edge (16),
-/// segments of the edge (16).
+/// The side bit of a node key (set: a node of block `b`), and the two bits of its place.
 const SIDE_BIT: u64 = 1 << 63;
+const PLACE_SHIFT: u32 = 61;
 
-/// The largest vertex index a node can name (the key gives it 15 bits).
-pub(crate) const MAX_NODE_VERTEX: u32 = 0x7fff;
+/// The largest vertex or face index a node can name (the key gives it 16 bits).
+pub(crate) const MAX_NODE_INDEX: u32 = 0xffff;
 
-/// A node of a node contact: on block `b` (`on_b`) or `a`, point `k` of `n` along the edge from
-/// vertex `v0` to `v1` (a vertex: `v0 == v1`, `k = 0`, `n = 1`).
+/// The most nodes along an edge, and grid lines across a face, a key can name (12 and 10 bits).
+const MAX_EDGE_SEGMENTS: u32 = 0xfff;
+const MAX_FACE_LINES: u32 = 0x3ff;
+
+/// Where on its block a node is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum NodePlace {
+    /// A vertex.
+    Vertex(u32),
+    /// Point `k` of `n` along the edge from vertex `v0` to `v1` (`v0 < v1`, `0 < k < n`).
+    Edge { v0: u32, v1: u32, k: u32, n: u32 },
+    /// The crossing of grid lines `i` of `nu` and `j` of `nv` of face `face`'s grid
+    /// ([`FaceGrid`]), strictly inside the face.
+    Face {
+        face: u32,
+        i: u32,
+        j: u32,
+        nu: u32,
+        nv: u32,
+    },
+}
+
+/// A node of a node contact: a material point of block `b` (`on_b`) or `a`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct NodeId {
     pub on_b: bool,
-    pub v0: u32,
-    pub v1: u32,
-    pub k: u32,
-    pub n: u32,
+    pub place: NodePlace,
 }
 
 impl NodeId {
-    /// Its sub-contact key (node keys sort by side, then vertex, edge and position).
+    /// Its sub-contact key (node keys sort by side, then by place).
     pub(crate) fn key(&self) -> SubKey {
+        let side = if self.on_b { SIDE_BIT } else { 0 };
         SubKey(
-            if self.on_b { SIDE_BIT } else { 0 }
-                | ((self.v0 as u64 & 0x7fff) << 48)
-                | ((self.v1 as u64 & 0xffff) << 32)
-                | ((self.k as u64 & 0xffff) << 16)
-                | (self.n as u64 & 0xffff),
+            side | match self.place {
+                NodePlace::Vertex(v) => (v as u64 & 0xffff) << 40,
+                NodePlace::Edge { v0, v1, k, n } => {
+                    (1 << PLACE_SHIFT)
+                        | ((v0 as u64 & 0xffff) << 40)
+                        | ((v1 as u64 & 0xffff) << 24)
+                        | ((k as u64 & 0xfff) << 12)
+                        | (n as u64 & 0xfff)
+                }
+                NodePlace::Face { face, i, j, nu, nv } => {
+                    (2 << PLACE_SHIFT)
+                        | ((face as u64 & 0xffff) << 40)
+                        | ((i as u64 & 0x3ff) << 30)
+                        | ((j as u64 & 0x3ff) << 20)
+                        | ((nu as u64 & 0x3ff) << 10)
+                        | (nv as u64 & 0x3ff)
+                }
+            },
         )
     }
 
     /// The node a key names.
     pub(crate) fn from_key(key: SubKey) -> Self {
         let k = key.0;
+        let field = |shift: u32, bits: u32| ((k >> shift) & ((1 << bits) - 1)) as u32;
+        let place = match (k >> PLACE_SHIFT) & 3 {
+            0 => NodePlace::Vertex(field(40, 16)),
+            1 => NodePlace::Edge {
+                v0: field(40, 16),
+                v1: field(24, 16),
+                k: field(12, 12),
+                n: field(0, 12),
+            },
+            _ => NodePlace::Face {
+                face: field(40, 16),
+                i: field(30, 10),
+                j: field(20, 10),
+                nu: field(10, 10),
+                nv: field(0, 10),
+            },
+        };
         Self {
             on_b: k & SIDE_BIT != 0,
-            v0: ((k >> 48) & 0x7fff) as u32,
-            v1: ((k >> 32) & 0xffff) as u32,
-            k: ((k >> 16) & 0xffff) as u32,
-            n: (k & 0xffff) as u32,
+            place,
         }
     }
 
-    /// Whether the node exists on `shape` (its vertices in range, `k < n`).
+    /// Whether the node exists on `shape` (its vertices or face in range, its grid place on the
+    /// grid).
+    #[cfg(any(feature = "serde", test))]
     pub(crate) fn fits(&self, shape: &Polyhedron) -> bool {
-        let count = shape.vertices().len() as u32;
-        self.v0 < count && self.v1 < count && self.n >= 1 && self.k < self.n
+        let vertices = shape.vertices().len() as u32;
+        match self.place {
+            NodePlace::Vertex(v) => v < vertices,
+            NodePlace::Edge { v0, v1, k, n } => v0 < vertices && v1 < vertices && 0 < k && k < n,
+            NodePlace::Face { face, i, j, nu, nv } => {
+                (face as usize) < shape.faces().len() && 0 < i && i < nu && 0 < j && j < nv
+            }
+        }
     }
 
     /// The node in its block's body frame (m).
     #[inline]
     pub(crate) fn point(&self, shape: &Polyhedron) -> Vector {
         let v = shape.vertices();
-        let p0 = v[self.v0 as usize];
-        if self.k == 0 {
-            return p0;
+        match self.place {
+            NodePlace::Vertex(i) => v[i as usize],
+            NodePlace::Edge { v0, v1, k, n } => {
+                let p0 = v[v0 as usize];
+                p0 + (v[v1 as usize] - p0) * (k as Real / n as Real)
+            }
+            NodePlace::Face { face, i, j, nu, nv } => FaceGrid::of(shape, face as usize).point(i, j, nu, nv),
         }
-        p0 + (v[self.v1 as usize] - p0) * (self.k as Real / self.n as Real)
+    }
+}
+
+/// The frame of a face's node grid: origin at its first vertex, `u` along its longest edge (the
+/// first of the longest), `v = n × u`, and the bounding rectangle of the face in those axes,
+/// split into `nu × nv` cells no wider than the spacing; the nodes are the crossings of the
+/// inner grid lines that lie inside the face.
+pub(crate) struct FaceGrid {
+    origin: Vector,
+    u: Vector,
+    v: Vector,
+    lo: (Real, Real),
+    size: (Real, Real),
+}
+
+impl FaceGrid {
+    pub(crate) fn of(shape: &Polyhedron, face: usize) -> Self {
+        let ring = shape.face_loop(face);
+        let vertex = |i: usize| shape.vertices()[ring[i % ring.len()] as usize];
+        let origin = vertex(0);
+        let mut longest = (Real::NEG_INFINITY, Vector::X);
+        for i in 0..ring.len() {
+            let e = vertex(i + 1) - vertex(i);
+            if e.length() > longest.0 {
+                longest = (e.length(), e);
+            }
+        }
+        let u = longest.1.normalize();
+        let v = shape.faces()[face].normal.cross(u);
+        let (mut lo, mut hi) = (
+            (Real::INFINITY, Real::INFINITY),
+            (Real::NEG_INFINITY, Real::NEG_INFINITY),
+        );
+        for i in 0..ring.len() {
+            let d = vertex(i) - origin;
+            let (x, y) = (u.dot(d), v.dot(d));
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+        }
+        Self {
+            origin,
+            u,
+            v,
+            lo,
+            size: (hi.0 - lo.0, hi.1 - lo.1),
+        }
+    }
+
+    /// Grid lines across the face for spacing `h`: `(nu, nv)`.
+    fn lines(&self, h: Real) -> (u32, u32) {
+        // (Less a hair, so that a width of exactly `k h` makes `k` cells despite round-off.)
+        let n = |w: Real| ((w / h - 1e-9).ceil() as u32).clamp(1, MAX_FACE_LINES);
+        (n(self.size.0), n(self.size.1))
+    }
+
+    /// Plane coordinates of crossing `(i, j)`.
+    fn coordinates(&self, i: u32, j: u32, nu: u32, nv: u32) -> (Real, Real) {
+        (
+            self.lo.0 + self.size.0 * (i as Real / nu as Real),
+            self.lo.1 + self.size.1 * (j as Real / nv as Real),
+        )
+    }
+
+    #[inline]
+    fn point(&self, i: u32, j: u32, nu: u32, nv: u32) -> Vector {
+        let (x, y) = self.coordinates(i, j, nu, nv);
+        self.origin + self.u * x + self.v * y
+    }
+
+    /// The grid lines `i` (of `nu`) whose crossing with line `j` (of `nv`) lies inside the face
+    /// by at least `margin` from every edge: a range, the face being convex.
+    fn row(&self, shape: &Polyhedron, face: usize, (j, nu, nv): (u32, u32, u32), margin: Real) -> std::ops::Range<u32> {
+        let ring = shape.face_loop(face);
+        let to2d = |i: usize| {
+            let d = shape.vertices()[ring[i % ring.len()] as usize] - self.origin;
+            (self.u.dot(d), self.v.dot(d))
+        };
+        let y = self.coordinates(0, j, nu, nv).1;
+        let (mut left, mut right) = (Real::NEG_INFINITY, Real::INFINITY);
+        for i in 0..ring.len() {
+            let (p, q) = (to2d(i), to2d(i + 1));
+            let (ex, ey) = (q.0 - p.0, q.1 - p.1);
+            let length = (ex * ex + ey * ey).sqrt();
+            if length == 0.0 {
+                continue;
+            }
+            // Counter-clockwise seen from outside, the inside is on the left of each edge:
+            // ex (y − p_y) − ey (x − p_x) ≥ margin · length.
+            let c = margin * length - ex * (y - p.1);
+            if ey < 0.0 {
+                left = left.max(p.0 + c / -ey);
+            } else if ey > 0.0 {
+                right = right.min(p.0 - c / ey);
+            } else if c > 0.0 {
+                return 0..0;
+            }
+        }
+        let cell = self.size.0 / nu as Real;
+        if left > right || left.is_nan() || right.is_nan() || cell <= 0.0 {
+            return 0..0;
+        }
+        let first = (((left - self.lo.0) / cell).ceil().max(1.0)) as u32;
+        let last = (((right - self.lo.0) / cell).floor().min((nu - 1) as Real)).max(0.0) as u32;
+        first..(last + 1).max(first)
+    }
+
+    /// The inner crossings of the grid for spacing `h` inside face `face` (at least a quarter
+    /// cell from its edges, which carry their own nodes), as `(i, j, nu, nv)`, in the window
+    /// `window` of plane coordinates (`None`: all).
+    fn nodes<'s>(
+        &'s self,
+        shape: &'s Polyhedron,
+        face: usize,
+        h: Real,
+        window: Option<((Real, Real), (Real, Real))>,
+    ) -> impl Iterator<Item = (u32, u32, u32, u32)> + 's {
+        let (nu, nv) = self.lines(h);
+        let (du, dv) = (self.size.0 / nu as Real, self.size.1 / nv as Real);
+        let margin = 0.25 * du.min(dv);
+        let (i_window, j_window) = match window {
+            Some((lo, hi)) if du > 0.0 && dv > 0.0 => (
+                (
+                    ((lo.0 - self.lo.0) / du).ceil().max(0.0) as u32,
+                    ((hi.0 - self.lo.0) / du).floor().max(-1.0),
+                ),
+                (
+                    ((lo.1 - self.lo.1) / dv).ceil().max(1.0) as u32,
+                    ((hi.1 - self.lo.1) / dv).floor().min((nv - 1) as Real),
+                ),
+            ),
+            _ => ((0, Real::INFINITY), (1, (nv - 1) as Real)),
+        };
+        let j_last = if j_window.1 < 0.0 { 0 } else { j_window.1 as u32 + 1 };
+        (j_window.0..j_last).flat_map(move |j| {
+            let row = self.row(shape, face, (j, nu, nv), margin);
+            let start = row.start.max(i_window.0);
+            let end = if i_window.1 < 0.0 {
+                start
+            } else {
+                row.end.min((i_window.1.min(u32::MAX as Real) as u32).saturating_add(1))
+            };
+            (start..end.max(start)).map(move |i| (i, j, nu, nv))
+        })
+    }
+
+    /// The plane coordinates of a body-frame point.
+    fn plane(&self, p: Vector) -> (Real, Real) {
+        let d = p - self.origin;
+        (self.u.dot(d), self.v.dot(d))
     }
 }
 
@@ -100,46 +306,63 @@ pub(crate) fn deepest_two(shape: &Polyhedron, q: Vector) -> (usize, Real, Real) 
 
 /// Segments of an edge of length `length` between nodes at most `h` apart.
 fn segments(length: Real, h: Real) -> u32 {
-    ((length / h).ceil() as u32).clamp(1, MAX_NODES_PER_EDGE)
+    ((length / h - 1e-9).ceil() as u32).clamp(1, MAX_EDGE_SEGMENTS)
 }
 
-/// The tributary area of a node (m²): its share of the faces around it, each face's area shared
-/// among the nodes of its boundary by the length of boundary each stands for (half the segments
-/// on either side), so that the nodes of a block carry its whole surface once, whatever the
-/// spacing `h`. A vertex of a cube of side `L` carries `3 L²/(4 n)`, `n` the segments per edge;
-/// a node inside an edge twice that.
-pub(crate) fn node_area(shape: &Polyhedron, id: &NodeId, h: Real) -> Real {
-    let v = shape.vertices();
-    let mut area = 0.0;
-    for (f, face) in shape.faces().iter().enumerate() {
-        let ring = shape.face_loop(f);
-        let m = ring.len();
-        let perimeter: Real = (0..m)
-            .map(|i| (v[ring[(i + 1) % m] as usize] - v[ring[i] as usize]).length())
-            .sum();
-        if perimeter <= 0.0 {
-            continue;
-        }
-        for i in 0..m {
-            let (p, q) = (ring[i], ring[(i + 1) % m]);
-            let length = (v[q as usize] - v[p as usize]).length();
-            let segment = length / segments(length, h) as Real;
-            let share = if id.v0 == id.v1 {
-                // A vertex stands for half the segment next to it on each of its edges.
-                if p == id.v0 || q == id.v0 {
-                    0.5 * segment
-                } else {
-                    0.0
-                }
-            } else if (p.min(q), p.max(q)) == (id.v0, id.v1) {
-                segment
-            } else {
-                0.0
-            };
-            area += face.area * share / perimeter;
+/// The nodes of a block for spacing `h` and the area each stands for.
+///
+/// Every face's area is shared equally among its nodes: its vertices, the nodes inside its
+/// edges and its inner grid nodes ([`FaceGrid`]), all about `h` apart, so that the nodes of a
+/// block carry its whole surface once, whatever `h`; a vertex or edge node adds up its shares
+/// of the faces around it.
+pub(crate) struct NodeAreas {
+    /// Per face: its area over its number of nodes (m²).
+    share: Vec<Real>,
+}
+
+impl NodeAreas {
+    pub(crate) fn of(shape: &Polyhedron, h: Real) -> Self {
+        let v = shape.vertices();
+        let share = (0..shape.faces().len())
+            .map(|f| {
+                let ring = shape.face_loop(f);
+                let m = ring.len();
+                let on_edges: u32 = (0..m)
+                    .map(|i| segments((v[ring[(i + 1) % m] as usize] - v[ring[i] as usize]).length(), h) - 1)
+                    .sum();
+                let grid = FaceGrid::of(shape, f);
+                let (nu, nv) = grid.lines(h);
+                let margin = 0.25 * (grid.size.0 / nu as Real).min(grid.size.1 / nv as Real);
+                let inner: u32 = (1..nv)
+                    .map(|j| grid.row(shape, f, (j, nu, nv), margin).len() as u32)
+                    .sum();
+                shape.faces()[f].area / (m as u32 + on_edges + inner) as Real
+            })
+            .collect();
+        Self { share }
+    }
+
+    /// The area of node `place` of `shape` (m²).
+    pub(crate) fn area(&self, shape: &Polyhedron, place: NodePlace) -> Real {
+        match place {
+            NodePlace::Face { face, .. } => self.share[face as usize],
+            NodePlace::Vertex(v) => (0..shape.faces().len())
+                .filter(|&f| shape.face_loop(f).contains(&v))
+                .map(|f| self.share[f])
+                .sum(),
+            NodePlace::Edge { v0, v1, .. } => (0..shape.faces().len())
+                .filter(|&f| {
+                    let ring = shape.face_loop(f);
+                    let m = ring.len();
+                    (0..m).any(|i| {
+                        let (p, q) = (ring[i], ring[(i + 1) % m]);
+                        (p.min(q), p.max(q)) == (v0, v1)
+                    })
+                })
+                .map(|f| self.share[f])
+                .sum(),
         }
     }
-    area
 }
 
 /// The nodes of `host` (on block `b` when `on_b`) whose gap to `other` is below `tolerance`,
@@ -155,8 +378,12 @@ fn push_nodes(
     let to_other = other.pose.inverse() * *host.pose;
     // Nodes farther than this from the other block's centroid cannot be within the tolerance.
     let reach = other.shape.radius() + tolerance;
+    let centre = to_other.inverse().transform_point(Vector::ZERO);
     let vertices = host.shape.vertices();
-    let try_node = |id: NodeId, seeds: &mut Vec<SubcontactSeed>| {
+    let start = seeds.len();
+    let mut areas = None;
+    let mut try_node = |place: NodePlace, seeds: &mut Vec<SubcontactSeed>| {
+        let id = NodeId { on_b, place };
         let anchor = id.point(host.shape);
         let q = to_other.transform_point(anchor);
         if q.length() > reach {
@@ -164,47 +391,60 @@ fn push_nodes(
         }
         let (_, gap) = deepest_face(other.shape, q);
         if gap < tolerance {
+            let areas = areas.get_or_insert_with(|| NodeAreas::of(host.shape, h));
             seeds.push(SubcontactSeed {
                 key: id.key(),
                 anchor,
-                area: node_area(host.shape, &id, h),
+                area: areas.area(host.shape, place),
                 gap,
             });
         }
     };
-    let start = seeds.len();
-    for v in 0..(vertices.len() as u32).min(MAX_NODE_VERTEX + 1) {
-        try_node(
-            NodeId {
-                on_b,
-                v0: v,
-                v1: v,
-                k: 0,
-                n: 1,
-            },
-            seeds,
-        );
+    for v in 0..(vertices.len() as u32).min(MAX_NODE_INDEX + 1) {
+        try_node(NodePlace::Vertex(v), seeds);
     }
     for &[i, j] in host.shape.edges() {
         let (v0, v1) = (i.min(j), i.max(j));
-        if v1 > MAX_NODE_VERTEX {
+        if v1 > MAX_NODE_INDEX {
             continue;
         }
         let (p0, p1) = (vertices[v0 as usize], vertices[v1 as usize]);
-        // The edge in the other block's frame, against its bounding sphere.
-        let (q0, q1) = (to_other.transform_point(p0), to_other.transform_point(p1));
-        let d = q1 - q0;
+        // The edge against the other block's bounding sphere.
+        let d = p1 - p0;
         let t = if d.length_squared() > 0.0 {
-            (-q0.dot(d) / d.length_squared()).clamp(0.0, 1.0)
+            ((centre - p0).dot(d) / d.length_squared()).clamp(0.0, 1.0)
         } else {
             0.0
         };
-        if (q0 + d * t).length() > reach {
+        if (p0 + d * t - centre).length() > reach {
             continue;
         }
-        let n = segments((p1 - p0).length(), h);
+        let n = segments(d.length(), h);
         for k in 1..n {
-            try_node(NodeId { on_b, v0, v1, k, n }, seeds);
+            try_node(NodePlace::Edge { v0, v1, k, n }, seeds);
+        }
+    }
+    for (f, face) in host.shape.faces().iter().enumerate().take(MAX_NODE_INDEX as usize + 1) {
+        // The face's plane against the other block's bounding sphere.
+        if (face.normal.dot(centre) - face.offset).abs() > reach {
+            continue;
+        }
+        let grid = FaceGrid::of(host.shape, f);
+        let (cx, cy) = grid.plane(centre);
+        let window = ((cx - reach, cy - reach), (cx + reach, cy + reach));
+        for (i, j, nu, nv) in grid.nodes(host.shape, f, h, Some(window)) {
+            if (grid.point(i, j, nu, nv) - centre).length() <= reach {
+                try_node(
+                    NodePlace::Face {
+                        face: f as u32,
+                        i,
+                        j,
+                        nu,
+                        nv,
+                    },
+                    seeds,
+                );
+            }
         }
     }
     seeds[start..].sort_unstable_by_key(|s| s.key);
@@ -235,60 +475,96 @@ mod tests {
     use super::*;
     use crate::geometry::Polyhedron;
 
-    fn cube(s: Real) -> Polyhedron {
-        Polyhedron::from_hull(
-            "cube",
-            &[
-                Vector::new(-s, -s, -s),
-                Vector::new(s, -s, -s),
-                Vector::new(-s, s, -s),
-                Vector::new(s, s, -s),
-                Vector::new(-s, -s, s),
-                Vector::new(s, -s, s),
-                Vector::new(-s, s, s),
-                Vector::new(s, s, s),
-            ],
-        )
-        .expect("cube")
-        .shape
+    fn shape(points: &[Vector]) -> Polyhedron {
+        Polyhedron::from_hull("test", points).expect("hull").shape
     }
 
-    /// Keys name their nodes back, and sort by side first.
+    fn cube(s: Real) -> Polyhedron {
+        let v = |x, y, z| Vector::new(x, y, z);
+        shape(&[
+            v(-s, -s, -s),
+            v(s, -s, -s),
+            v(-s, s, -s),
+            v(s, s, -s),
+            v(-s, -s, s),
+            v(s, -s, s),
+            v(-s, s, s),
+            v(s, s, s),
+        ])
+    }
+
+    fn wedge(s: Real) -> Polyhedron {
+        let v = |x, y, z| Vector::new(x, y, z);
+        shape(&[
+            v(-s, -s, -s),
+            v(s, -s, -s),
+            v(0.0, -s, s),
+            v(-s, s, -s),
+            v(s, s, -s),
+            v(0.0, s, s),
+        ])
+    }
+
+    /// Every node of a block for spacing `h`, with its area.
+    fn all_nodes(shape: &Polyhedron, h: Real) -> Vec<(NodePlace, Real)> {
+        let areas = NodeAreas::of(shape, h);
+        let mut places: Vec<NodePlace> = (0..shape.vertices().len() as u32).map(NodePlace::Vertex).collect();
+        for &[i, j] in shape.edges() {
+            let (v0, v1) = (i.min(j), i.max(j));
+            let n = segments(
+                (shape.vertices()[v1 as usize] - shape.vertices()[v0 as usize]).length(),
+                h,
+            );
+            places.extend((1..n).map(|k| NodePlace::Edge { v0, v1, k, n }));
+        }
+        for f in 0..shape.faces().len() {
+            let grid = FaceGrid::of(shape, f);
+            places.extend(grid.nodes(shape, f, h, None).map(|(i, j, nu, nv)| NodePlace::Face {
+                face: f as u32,
+                i,
+                j,
+                nu,
+                nv,
+            }));
+        }
+        places.into_iter().map(|p| (p, areas.area(shape, p))).collect()
+    }
+
+    /// Keys name their nodes back, sort by side first, and are distinct.
     #[test]
     fn node_keys_round_trip() {
-        for id in [
-            NodeId {
-                on_b: false,
-                v0: 3,
-                v1: 3,
-                k: 0,
-                n: 1,
-            },
-            NodeId {
-                on_b: true,
-                v0: 0x7fff,
-                v1: 0xffff,
-                k: 12,
-                n: 0xffff,
-            },
-        ] {
-            assert_eq!(NodeId::from_key(id.key()), id);
+        let s = wedge(0.1);
+        let nodes = all_nodes(&s, 0.013);
+        let mut keys = Vec::new();
+        for on_b in [false, true] {
+            for (place, _) in &nodes {
+                let id = NodeId { on_b, place: *place };
+                assert!(id.fits(&s));
+                assert_eq!(NodeId::from_key(id.key()), id);
+                keys.push(id.key());
+            }
         }
-        let a = NodeId {
+        let sorted = keys.windows(2).filter(|w| w[0] > w[1]).count();
+        keys.sort();
+        keys.dedup();
+        assert_eq!(keys.len(), 2 * nodes.len(), "distinct keys");
+        // Side first: every node of a sorts before every node of b.
+        let last_a = NodeId {
             on_b: false,
-            v0: 0x7fff,
-            v1: 0xffff,
-            k: 1,
-            n: 2,
+            place: NodePlace::Face {
+                face: 0xffff,
+                i: 0x3ff,
+                j: 0x3ff,
+                nu: 0x3ff,
+                nv: 0x3ff,
+            },
         };
-        let b = NodeId {
+        let first_b = NodeId {
             on_b: true,
-            v0: 0,
-            v1: 0,
-            k: 0,
-            n: 1,
+            place: NodePlace::Vertex(0),
         };
-        assert!(a.key() < b.key());
+        assert!(last_a.key() < first_b.key());
+        let _ = sorted;
     }
 
     /// The depth of a point inside a cube is its distance to the nearest face; outside, the
@@ -301,68 +577,37 @@ mod tests {
         let (f, g) = deepest_face(&c, Vector::new(0.0, 0.0, 0.7));
         assert!((g - 0.2).abs() < 1e-12 && c.faces()[f].normal.z > 0.99, "{g}");
     }
-}
 
-#[cfg(test)]
-mod area_tests {
-    use super::*;
-
-    /// The nodes of a block carry its whole surface, whatever the spacing.
+    /// The nodes of a block carry its whole surface, whatever the spacing; face nodes lie inside
+    /// their face, about `h` apart.
     #[test]
     fn node_areas_add_up_to_the_surface() {
-        let shape = Polyhedron::from_hull(
-            "wedge",
-            &[
-                Vector::new(-0.1, -0.1, -0.1),
-                Vector::new(0.1, -0.1, -0.1),
-                Vector::new(0.0, -0.1, 0.1),
-                Vector::new(-0.1, 0.1, -0.1),
-                Vector::new(0.1, 0.1, -0.1),
-                Vector::new(0.0, 0.1, 0.1),
-            ],
-        )
-        .expect("wedge")
-        .shape;
-        let surface: Real = shape.faces().iter().map(|f| f.area).sum();
-        for h in [0.3, 0.05, 0.013] {
-            let mut total = 0.0;
-            for v in 0..shape.vertices().len() as u32 {
-                total += node_area(
-                    &shape,
-                    &NodeId {
-                        on_b: false,
-                        v0: v,
-                        v1: v,
-                        k: 0,
-                        n: 1,
-                    },
-                    h,
+        for s in [cube(0.1), wedge(0.1)] {
+            let surface: Real = s.faces().iter().map(|f| f.area).sum();
+            for h in [0.3, 0.05, 0.013] {
+                let nodes = all_nodes(&s, h);
+                let total: Real = nodes.iter().map(|(_, a)| a).sum();
+                assert!(
+                    (total - surface).abs() < 1e-12 * surface,
+                    "h {h}: {total} against {surface}"
                 );
-            }
-            for &[i, j] in shape.edges() {
-                let (v0, v1) = (i.min(j), i.max(j));
-                let n = segments(
-                    (shape.vertices()[v1 as usize] - shape.vertices()[v0 as usize]).length(),
-                    h,
-                );
-                for k in 1..n {
-                    total += node_area(
-                        &shape,
-                        &NodeId {
+                for (place, _) in &nodes {
+                    if let NodePlace::Face { face, .. } = place {
+                        let p = NodeId {
                             on_b: false,
-                            v0,
-                            v1,
-                            k,
-                            n,
-                        },
-                        h,
-                    );
+                            place: *place,
+                        }
+                        .point(&s);
+                        let f = &s.faces()[*face as usize];
+                        assert!((f.normal.dot(p) - f.offset).abs() < 1e-12);
+                        assert!(deepest_face(&s, p).1 < 1e-12);
+                    }
                 }
             }
-            assert!(
-                (total - surface).abs() < 1e-12 * surface,
-                "h {h}: {total} against {surface}"
-            );
+            // A cube face at h = 0.05 (0.2 m): 4 × 4 cells, 3 × 3 inner nodes.
         }
+        let c = cube(0.1);
+        let inner = FaceGrid::of(&c, 0).nodes(&c, 0, 0.05, None).count();
+        assert_eq!(inner, 9);
     }
 }
