@@ -13,9 +13,9 @@ use crate::math::{Real, Vector};
 /// hosts the sub-contacts. Beyond it, the face whose edge or corner digs into the other does.
 pub(crate) const PARALLEL_ANGLE: Real = 0.017_453_292_519_943_295;
 
-/// A face-face contact between face `fa` of `a` and face `fb` of `b`; with `require_cover`,
-/// only if the larger face covers the smaller one whole; hosted by `kept_host` when given (the
-/// contact existed before).
+/// A face-face contact between face `fa` of `a` and face `fb` of `b`, only if their overlap covers
+/// at least the fraction `cover` of the smaller face (1: whole; 0: any overlap); hosted by
+/// `kept_host` when given (the contact existed before).
 ///
 /// The host is the smaller face when the faces are parallel within [`PARALLEL_ANGLE`]. When
 /// they are not, the deepest point of the overlap lies on the boundary of the face whose edge or
@@ -30,7 +30,7 @@ pub(super) fn face_face(
     fa: usize,
     b: BlockGeometry<'_>,
     fb: usize,
-    require_cover: bool,
+    cover: Real,
     kept_host: Option<bool>,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
@@ -38,18 +38,18 @@ pub(super) fn face_face(
 ) -> Option<DetectedContact> {
     let smaller_is_a = a.shape.faces()[fa].area <= b.shape.faces()[fb].area;
     if let Some(host_is_a) = kept_host {
-        return match face_face_hosted(a, fa, b, fb, host_is_a, false, require_cover, params, scratch, seeds) {
+        return match face_face_hosted(a, fa, b, fb, host_is_a, false, cover, params, scratch, seeds) {
             Hosted::Contact(found) => Some(found),
             _ => None,
         };
     }
     let start = seeds.len();
-    match face_face_hosted(a, fa, b, fb, smaller_is_a, true, require_cover, params, scratch, seeds) {
+    match face_face_hosted(a, fa, b, fb, smaller_is_a, true, cover, params, scratch, seeds) {
         Hosted::Contact(found) => Some(found),
         Hosted::None => None,
         Hosted::DeepestOnOther => {
             seeds.truncate(start);
-            match face_face_hosted(a, fa, b, fb, !smaller_is_a, false, false, params, scratch, seeds) {
+            match face_face_hosted(a, fa, b, fb, !smaller_is_a, false, 0.0, params, scratch, seeds) {
                 Hosted::Contact(found) => Some(found),
                 _ => None,
             }
@@ -74,7 +74,7 @@ pub(super) fn face_face_hosted(
     fb: usize,
     host_is_a: bool,
     check_deepest: bool,
-    require_cover: bool,
+    cover: Real,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
     seeds: &mut Vec<SubcontactSeed>,
@@ -118,7 +118,7 @@ pub(super) fn face_face_hosted(
     } else {
         other_area * n_other.dot(face.normal).abs()
     };
-    if overlap_area <= 1e-9 * face.area || (require_cover && overlap_area < (1.0 - 1e-9) * smaller_whole) {
+    if overlap_area <= 1e-9 * face.area || (cover > 0.0 && overlap_area < (cover - 1e-9) * smaller_whole) {
         return Hosted::None;
     }
     // Gap at a point of the host face: its signed distance from the other face's plane, along

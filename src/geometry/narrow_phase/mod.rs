@@ -311,7 +311,7 @@ pub fn detect(
                             face_a as usize,
                             b,
                             face_b as usize,
-                            cos < tolerance,
+                            if cos < tolerance { 1.0 } else { 0.0 },
                             Some(p.host_is_a),
                             params,
                             scratch,
@@ -336,17 +336,17 @@ pub fn detect(
     let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
     let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
     let cos = opposite(fa, fb);
+    let kept_host = match previous {
+        Some(PreviousContact {
+            kind: ContactKind::FaceFace { face_a, face_b },
+            host_is_a,
+            ..
+        }) if face_a as usize == fa && face_b as usize == fb => Some(host_is_a),
+        _ => None,
+    };
     if cos >= tolerance && cos >= PARALLEL_ANGLE.cos() {
         let start = seeds.len();
-        let kept_host = match previous {
-            Some(PreviousContact {
-                kind: ContactKind::FaceFace { face_a, face_b },
-                host_is_a,
-                ..
-            }) if face_a as usize == fa && face_b as usize == fb => Some(host_is_a),
-            _ => None,
-        };
-        if let Some(found) = face_face(a, fa, b, fb, false, kept_host, params, scratch, seeds) {
+        if let Some(found) = face_face(a, fa, b, fb, 0.0, kept_host, params, scratch, seeds) {
             return Some(found);
         }
         seeds.truncate(start);
