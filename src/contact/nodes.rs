@@ -153,11 +153,13 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         // node, the turn of its normal to another face (a kink of the potential inside the
         // other block), approached fast: `gap − next_gap` changes by at most `2|Δu|` a step.
         let moved = du.length();
-        step.impact |= (du_n.abs() > threshold
-            && (gap > 0.0) != (du_n > 0.0)
-            && gap.abs() < reach * du_n.abs()
-            && law.stays_open(sub.area, gap.abs(), &sub.state))
-            || (frame.gap < 0.0 && moved > threshold && frame.gap - frame.next_gap < 2.0 * reach * moved);
+        let turn = frame.gap < 0.0 && moved > threshold && frame.gap - frame.next_gap < 2.0 * reach * moved;
+        step.turn |= turn;
+        step.impact |= turn
+            || (du_n.abs() > threshold
+                && (gap > 0.0) != (du_n > 0.0)
+                && gap.abs() < reach * du_n.abs()
+                && law.stays_open(sub.area, gap.abs(), &sub.state));
         if (!dashpots || record.dashpot == Vector::ZERO) && stays_separated(law, sub, gap) {
             sub.gap = gap;
             continue;
@@ -195,6 +197,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         (pair.normal, pair.tangent) = (axes.normal, axes.tangent);
     }
     step.impact &= fastest > ctx.impact_speed * ctx.impact_speed;
+    step.turn &= step.impact;
     step.busy = watch && normal_force > 0.0 && fastest > ctx.impact_speed * ctx.impact_speed;
     step.wrench = ContactWrench {
         force,
