@@ -26,9 +26,6 @@ pub(crate) struct ContactStep {
     /// For a watched contact (see [`update_contact`]): whether it carries a normal force and
     /// the relative speed over it may exceed the probe's speed (an impact still under way).
     pub busy: bool,
-    /// Whether the impact is a loaded node about to turn to another face of the other block
-    /// (a node contact's kink crossed at the relative speed, `contact/nodes.rs`).
-    pub turn: bool,
 }
 
 /// Read-only data shared by all contacts of a step.
@@ -255,7 +252,6 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         dashpot_work: -0.5 * dashpot_sum,
         impact,
         busy,
-        turn: false,
     }
 }
 

@@ -154,7 +154,6 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         // other block), approached fast: `gap − next_gap` changes by at most `2|Δu|` a step.
         let moved = du.length();
         let turn = frame.gap < 0.0 && moved > threshold && frame.gap - frame.next_gap < 2.0 * reach * moved;
-        step.turn |= turn;
         step.impact |= turn
             || (du_n.abs() > threshold
                 && (gap > 0.0) != (du_n > 0.0)
@@ -197,7 +196,6 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         (pair.normal, pair.tangent) = (axes.normal, axes.tangent);
     }
     step.impact &= fastest > ctx.impact_speed * ctx.impact_speed;
-    step.turn &= step.impact;
     step.busy = watch && normal_force > 0.0 && fastest > ctx.impact_speed * ctx.impact_speed;
     step.wrench = ContactWrench {
         force,

@@ -104,7 +104,7 @@ pub(super) struct PairSums {
     pub fired_count: u32,
     /// Whether a loaded impacting contact moves fast.
     pub busy: bool,
-    /// Whether an impact is a loaded node about to turn to another face.
+    /// Whether an impacting contact is a node contact.
     pub node_impact: bool,
 }
 
@@ -201,7 +201,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                     sums.fired[sums.fired_count as usize] = (p.a, p.b);
                 }
                 sums.fired_count += 1;
-                sums.node_impact |= step.turn;
+                sums.node_impact |= matches!(p.kind, ContactKind::Nodes);
             }
             sums.busy |= step.busy;
         }

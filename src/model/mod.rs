@@ -181,8 +181,9 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     pub refine_until: Real,
     pub refine_omega2: Real,
     /// Whether the refinement also caps every block's travel per step at `impact_step` of the
-    /// usual (`cap_drift`): a loaded node about to turn to another face asked for it (a kink
-    /// crossed at the relative speed rather than at a spring's frequency).
+    /// usual (`cap_drift`): a node contact asked for it (a node about to turn to another face
+    /// is a kink crossed at the relative speed rather than at a spring's frequency; with
+    /// friction, the slips across the kinks booked 1.5 % of m g h in 48 sharp drops without it).
     pub refine_travel: bool,
     /// The contacts (as sorted block pairs) the impact probe marked since the refinement began:
     /// the step is not relaxed while one of them is loaded and moving fast.
