@@ -1,5 +1,6 @@
 //! Convex polyhedra in their principal frame, with exact mass properties.
 
+use super::narrow_phase::nodes::FaceGrid;
 use parry3d_f64::shape::{ConvexPolyhedron, Shape};
 use parry3d_f64::transformation::try_convex_hull;
 #[cfg(feature = "serde")]
@@ -52,6 +53,10 @@ pub struct Polyhedron {
     /// cuboid's 12 edges have 3). Derived from the vertices and edges.
     #[cfg_attr(feature = "serde", serde(skip))]
     edge_directions: Vec<u32>,
+    /// Each face's node grid frame (node contacts, `narrow_phase/nodes.rs`). Derived from the
+    /// vertices and faces.
+    #[cfg_attr(feature = "serde", serde(skip))]
+    face_grids: Vec<FaceGrid>,
     /// Largest distance from the centroid to a vertex (m).
     radius: Real,
     volume: Real,
@@ -307,17 +312,20 @@ impl Polyhedron {
         edges.sort_unstable();
         edges.dedup();
         let edge_directions = distinct_directions(&vertices, &edges);
-        Ok(Self {
+        let mut shape = Self {
             vertices,
             faces,
             face_vertices,
             edges,
             edge_directions,
+            face_grids: Vec::new(),
             radius,
             volume,
             unit_inertia,
             parry: Some(parry),
-        })
+        };
+        shape.face_grids = (0..shape.faces.len()).map(|f| FaceGrid::compute(&shape, f)).collect();
+        Ok(shape)
     }
 
     /// Rebuilds parry's shape after deserialisation and checks the stored topology.
@@ -346,6 +354,7 @@ impl Polyhedron {
             return Err(bad("stored edges refer to missing vertices"));
         }
         self.edge_directions = distinct_directions(&self.vertices, &self.edges);
+        self.face_grids = (0..self.faces.len()).map(|f| FaceGrid::compute(self, f)).collect();
         self.parry = Some(
             ConvexPolyhedron::from_convex_mesh(self.vertices.clone(), &tris)
                 .ok_or_else(|| bad("stored faces do not form a convex manifold"))?,
@@ -465,6 +474,12 @@ impl Polyhedron {
     pub fn face_loop(&self, face: usize) -> &[u32] {
         let f = &self.faces[face];
         &self.face_vertices[f.first as usize..(f.first + f.len) as usize]
+    }
+
+    /// The node grid frame of face `face` (node contacts).
+    #[inline]
+    pub(crate) fn face_grid(&self, face: usize) -> &FaceGrid {
+        &self.face_grids[face]
     }
 
     /// Unique edges as pairs of vertex indices.

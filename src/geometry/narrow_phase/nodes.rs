@@ -134,7 +134,9 @@ impl NodeId {
 /// The frame of a face's node grid: origin at its first vertex, `u` along its longest edge (the
 /// first of the longest), `v = n × u`, and the bounding rectangle of the face in those axes,
 /// split into `nu × nv` cells no wider than the spacing; the nodes are the crossings of the
-/// inner grid lines that lie inside the face.
+/// inner grid lines that lie inside the face. Computed once per face with the shape
+/// ([`Polyhedron::face_grid`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct FaceGrid {
     origin: Vector,
     u: Vector,
@@ -144,7 +146,14 @@ pub(crate) struct FaceGrid {
 }
 
 impl FaceGrid {
+    /// The grid frame of face `face` of `shape` (stored with the shape).
+    #[inline]
     pub(crate) fn of(shape: &Polyhedron, face: usize) -> Self {
+        *shape.face_grid(face)
+    }
+
+    /// Computes the grid frame of face `face` of `shape` from its vertices.
+    pub(crate) fn compute(shape: &Polyhedron, face: usize) -> Self {
         let ring = shape.face_loop(face);
         let vertex = |i: usize| shape.vertices()[ring[i % ring.len()] as usize];
         let origin = vertex(0);
