@@ -24,6 +24,7 @@
 
 mod common;
 
+use common::z_range;
 use voussoir::build::{running_bond_wall, WallSpec};
 use voussoir::prelude::*;
 
@@ -33,18 +34,6 @@ const EDGE: Real = 0.2;
 /// A frictionless, no-tension joint (kn = ks = 1 GPa/m, φ = 0).
 fn frictionless() -> CoulombSlip {
     CoulombSlip::dry(1e9, 1e9, 0.0).expect("valid law")
-}
-
-/// The lowest and highest world `z` of a block's vertices (m).
-fn z_range(block: &RigidBlock) -> (Real, Real) {
-    block
-        .shape()
-        .vertices()
-        .iter()
-        .map(|v| block.world_point(*v).z)
-        .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), z| {
-            (lo.min(z), hi.max(z))
-        })
 }
 
 /// A model with the slab and a 0.2 m cube turned by `rotation` whose lowest point is `height`

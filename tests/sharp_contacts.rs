@@ -14,6 +14,7 @@
 
 mod common;
 
+use common::z_range;
 use voussoir::prelude::*;
 
 const RHO: Real = 2500.0;
@@ -69,18 +70,6 @@ fn sharp_block(kind: usize, s: Real, rng: &mut Lcg) -> RigidBlock {
         }
     }
     .expect("block")
-}
-
-/// The lowest and highest world `z` of a block's vertices (m).
-fn z_range(block: &RigidBlock) -> (Real, Real) {
-    block
-        .shape()
-        .vertices()
-        .iter()
-        .map(|v| block.world_point(*v).z)
-        .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), z| {
-            (lo.min(z), hi.max(z))
-        })
 }
 
 /// What one drop did, relative to the energy released by the fall (`m g h`, more where the block

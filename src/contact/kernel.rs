@@ -45,6 +45,23 @@ pub(crate) struct KernelContext {
     pub mode: DisplacementMode,
 }
 
+impl KernelContext {
+    /// Whether Rayleigh stiffness damping is on, and the dashpot coefficients per unit area for
+    /// joint stiffness `k`, normal and shear (zero without it): `b k / Δt`.
+    #[inline]
+    pub(crate) fn dashpot_coefficients(&self, k: crate::law::JointStiffness) -> (bool, Real, Real) {
+        if self.stiffness_damping > 0.0 {
+            (
+                true,
+                self.stiffness_damping * k.normal / self.dt,
+                self.stiffness_damping * k.shear / self.dt,
+            )
+        } else {
+            (false, 0.0, 0.0)
+        }
+    }
+}
+
 /// Updates one contact for one step: its plane and axes (large-displacement mode), the forces of
 /// its sub-contacts (`subs` and `records` are the contact's own ranges), and returns its
 /// resultant, moments about both centroids and energy increments. Sums run in a fixed order — in
@@ -133,17 +150,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     };
     // Face gap at the anchor: g₀ − q·r = (g₀ − q·R o) − x q·R u − y q·R v.
     let face_gap_coefficients = face_plane.map(|(g0, q)| (g0 - q.dot(lever.origin), q.dot(lever.u), q.dot(lever.v)));
-    let k = law.stiffness();
-    // Dashpot coefficients per unit area (zero without Rayleigh damping).
-    let damped = ctx.stiffness_damping > 0.0;
-    let (cn, cs) = if damped {
-        (
-            ctx.stiffness_damping * k.normal / dt,
-            ctx.stiffness_damping * k.shear / dt,
-        )
-    } else {
-        (0.0, 0.0)
-    };
+    let (damped, cn, cs) = ctx.dashpot_coefficients(law.stiffness());
     // Last step's dashpot forces still owe the second half of their work (also in the step
     // after Rayleigh damping was switched off).
     let dashpots = damped || pair.dashpots;

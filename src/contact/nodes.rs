@@ -111,16 +111,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     let (sa, sb) = (a.0, b.0);
     let (xa, xb) = (sa.pose.translation, sb.pose.translation);
     let dt = ctx.dt;
-    let k = law.stiffness();
-    let damped = ctx.stiffness_damping > 0.0;
-    let (cn, cs) = if damped {
-        (
-            ctx.stiffness_damping * k.normal / dt,
-            ctx.stiffness_damping * k.shear / dt,
-        )
-    } else {
-        (0.0, 0.0)
-    };
+    let (damped, cn, cs) = ctx.dashpot_coefficients(law.stiffness());
     let dashpots = damped || pair.dashpots;
     let threshold = ctx.impact_speed * dt;
     let reach = ctx.impact_horizon / dt;

@@ -142,3 +142,15 @@ pub fn push_contact<S>(bits: &mut Vec<u64>, contact: &ContactView<'_, S>) {
         }
     }
 }
+
+/// The lowest and highest world `z` of a block's vertices (m).
+pub fn z_range(block: &RigidBlock) -> (Real, Real) {
+    block
+        .shape()
+        .vertices()
+        .iter()
+        .map(|v| block.world_point(*v).z)
+        .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), z| {
+            (lo.min(z), hi.max(z))
+        })
+}
