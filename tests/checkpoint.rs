@@ -164,7 +164,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 12"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads version 13"),
         "{err}"
     );
     // The tested pairs: in order, with finite unit poses and slacks, one for every contact.
@@ -246,7 +246,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 12);
+    assert_eq!(json["version"], 13);
     assert_eq!(json["law_type"], "CoulombSlip");
     assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
@@ -300,6 +300,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
             "reference_centroids",
             "reference_host_rotation",
             "springs",
+            "spread_energy",
             "subcontacts",
             "tangent",
             "wrench",
@@ -307,7 +308,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
     );
     assert_eq!(
         keys(&contact["subcontacts"][0]),
-        ["area", "dashpot", "force", "gap", "key", "plane", "slip", "state", "status"]
+        ["area", "dashpot", "force", "gap", "half", "key", "plane", "slip", "state", "status"]
     );
     Ok(())
 }

@@ -83,7 +83,7 @@ fn joint_sums(m: &Model, a: BlockId, b: BlockId) -> JointSums {
     for sub in c.subcontacts() {
         s.area += sub.area();
         s.normal_force += sub.normal_force();
-        s.first_moment += sub.point() * sub.normal_force();
+        s.first_moment += sub.normal_force_point() * sub.normal_force();
     }
     // The pair's own resultant must agree with the sum over its sub-contacts (same additions,
     // possibly a different order: round-off only).

@@ -178,7 +178,7 @@ fn joint_state(contact: Option<&impl Contact>, block: &RigidBlock, j: &JointRef,
         slip += s.slip * s.area;
         if s.normal_force > 0.0 {
             force += s.normal_force;
-            moment += s.point * s.normal_force;
+            moment += s.normal_force_point * s.normal_force;
         } else {
             open += s.area;
         }

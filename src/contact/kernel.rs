@@ -5,10 +5,11 @@
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
+use super::spread::{cell_response, CellResponse};
 use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::law::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
-use crate::math::{Matrix, Real, Vector, Vector2};
+use crate::math::{Matrix, Pose, Real, Vector, Vector2};
 
 /// What a contact's update returns besides what it stores in the contact: its wrench on the two
 /// blocks and its energy increments over the step.
@@ -106,15 +107,9 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // oriented from a to b, so that the normal force is the gradient of the spring energy.
     let mut face_plane = None;
     if ctx.mode == DisplacementMode::Large {
-        let (rotation_other, x_other) = if pair.host_is_a {
-            (rotation_b, sb.pose.translation)
-        } else {
-            (rotation_a, sa.pose.translation)
-        };
-        let m = *rotation_other * pair.plane_normal;
-        let d = pair.plane_offset + m.dot(x_other);
+        let (m, g0) = other_face_plane(pair, (&sa.pose, rotation_a), (&sb.pose, rotation_b));
         pair.normal = if pair.host_is_a { -m } else { m };
-        face_plane = Some((m.dot(xh) - d, -m));
+        face_plane = Some((g0, -m));
         pair.tangent = turned_tangent(previous_axes, pair.normal);
     }
     let axes = pair.axes();
@@ -150,6 +145,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     };
     // Face gap at the anchor: g₀ − q·r = (g₀ − q·R o) − x q·R u − y q·R v.
     let face_gap_coefficients = face_plane.map(|(g0, q)| (g0 - q.dot(lever.origin), q.dot(lever.u), q.dot(lever.v)));
+    let exact = ExactCells::of(law, face_gap_coefficients);
+    let mut spread_energy = 0.0;
     let (damped, cn, cs) = ctx.dashpot_coefficients(law.stiffness());
     // Last step's dashpot forces still owe the second half of their work (also in the step
     // after Rayleigh damping was switched off).
@@ -167,9 +164,9 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let elastic_regime = if dashpots { None } else { law.elastic_regime() };
     if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
-        (sums, dissipated) = match face_gap_coefficients {
-            Some(g) => update_elastic_first(subs, law, &regime, &kinematics, Some(g), axes, dt),
-            None => update_elastic_first(subs, law, &regime, &kinematics, None, axes, dt),
+        (sums, dissipated, spread_energy) = match face_gap_coefficients {
+            Some(g) => update_elastic_first(subs, law, &regime, &kinematics, Some(g), exact, axes, dt),
+            None => update_elastic_first(subs, law, &regime, &kinematics, None, None, axes, dt),
         };
         done = subs.len();
     } else if !dashpots {
@@ -189,7 +186,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     }
     for (sub, record) in subs[done..].iter_mut().zip(records[done..].iter_mut()) {
         let (x, y) = (sub.plane.x, sub.plane.y);
-        let face = face_gap_coefficients.map(|g| face_gap(g, x, y));
+        let cell = face_gap_coefficients.map(|g| exact.cell(law, sub, face_gap(g, x, y)));
+        let face = cell.map(|c| c.law_gap);
         // A separated sub-contact that the law says stays open with no force and no change of
         // state needs neither kinematics nor an update (nor a dashpot: it had none and gets none).
         if let Some(gap) = face {
@@ -203,7 +201,10 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let gap = face.unwrap_or(sub.gap + du_n);
         let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
         dissipated += lost;
-        sums.add_joint(&sub.force, sub.plane);
+        match cell {
+            Some(cell) => exact.add(&mut sums, &mut spread_energy, sub, &cell),
+            None => sums.add_joint(&sub.force, sub.plane),
+        }
         if dashpots {
             let mut dashpot = Vector::ZERO;
             if damped && status != JointStatus::Open {
@@ -224,6 +225,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // (the two sets of moments added first: one set of dot products).
     let spring_sum = pair.springs.plus(&springs).work(&increments);
     pair.springs = springs;
+    pair.spread_energy = spread_energy;
     let total = if dashpots {
         springs.plus(&dashpot_moments)
     } else {
@@ -301,19 +303,22 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     regime: &ElasticRegime,
     kinematics: &Kinematics,
     face: Option<(Real, Real, Real)>,
+    exact: Option<ExactCells>,
     axes: JointAxes,
     dt: Real,
-) -> (ForceMoments, Real) {
+) -> (ForceMoments, Real, Real) {
     let virgin = L::State::default();
     let mut sums = ForceMoments::default();
     let mut dissipated = 0.0;
+    let mut spread_energy = 0.0;
     for sub in subs.iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
-        let gap = match face {
-            Some(g) => face_gap(g, x, y),
-            None => sub.gap + du_n,
+        let cell = match face {
+            Some(g) => exact.cell(law, sub, face_gap(g, x, y)),
+            None => CellResponse::at_anchor(sub.gap + du_n),
         };
+        let gap = cell.law_gap;
         let du_s = Vector2::new(du_1, du_2);
         if sub.state == virgin {
             if let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) {
@@ -333,7 +338,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                 sub.force = force;
                 sub.gap = gap;
                 sub.status = status;
-                sums.add_joint(&force, sub.plane);
+                exact.add(&mut sums, &mut spread_energy, sub, &cell);
                 continue;
             }
         }
@@ -342,9 +347,152 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             continue;
         }
         dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt).1;
-        sums.add_joint(&sub.force, sub.plane);
+        exact.add(&mut sums, &mut spread_energy, sub, &cell);
     }
-    (sums, dissipated)
+    (sums, dissipated, spread_energy)
+}
+
+/// Sets the gaps of a face-face contact's sub-contacts to those the step gives their laws at the
+/// blocks' `poses` (a cell's [`CellResponse::law_gap`]; the gap at the anchor otherwise), as
+/// detection seeds them with the gap at the anchor: the law's books (the work of a step that
+/// changes its state) start from the gap the law saw.
+pub(crate) fn seed_law_gaps<L: ConstitutiveLaw>(
+    pair: &ContactPair,
+    own: &mut [SubContact<L::State>],
+    law: &L,
+    (pose_a, pose_b): (&Pose, &Pose),
+) {
+    let g = face_gap_coefficients(pair, pose_a, pose_b);
+    let exact = ExactCells::of(law, Some(g));
+    for sub in own {
+        sub.gap = exact.cell(law, sub, face_gap(g, sub.plane.x, sub.plane.y)).law_gap;
+    }
+}
+
+/// A face-face contact's spring moments (world) and spread energy as the step sums them, at the
+/// blocks' `poses` (`None`: small displacements, the forces at the anchors).
+pub(crate) fn spring_moments<L: ConstitutiveLaw>(
+    pair: &ContactPair,
+    own: &[SubContact<L::State>],
+    law: &L,
+    poses: Option<(&Pose, &Pose)>,
+) -> (ForceMoments, Real) {
+    let coefficients = poses.map(|(pose_a, pose_b)| face_gap_coefficients(pair, pose_a, pose_b));
+    let exact = ExactCells::of(law, coefficients);
+    let (mut sums, mut spread_energy) = (ForceMoments::default(), 0.0);
+    for sub in own {
+        let cell = match coefficients {
+            Some(g) => exact.cell(law, sub, face_gap(g, sub.plane.x, sub.plane.y)),
+            None => CellResponse::at_anchor(sub.gap),
+        };
+        exact.add(&mut sums, &mut spread_energy, sub, &cell);
+    }
+    (sums.to_world(&pair.axes()), spread_energy)
+}
+
+/// The gap coefficients `(g_o, g_x, g_y)` of a face-face contact at the blocks' poses: the gap
+/// at anchor-plane coordinates `(x, y)` is [`face_gap`] of them, as in the step.
+pub(crate) fn face_gap_coefficients(pair: &ContactPair, pose_a: &Pose, pose_b: &Pose) -> (Real, Real, Real) {
+    let (ra, rb) = (Matrix::from_quat(pose_a.rotation), Matrix::from_quat(pose_b.rotation));
+    let (m, g0) = other_face_plane(pair, (pose_a, &ra), (pose_b, &rb));
+    let r = if pair.host_is_a { ra } else { rb };
+    let (plane, q) = (pair.anchors, -m);
+    (g0 - q.dot(r * plane.origin), q.dot(r * plane.u), q.dot(r * plane.v))
+}
+
+/// The plane of the face a face-face contact's gaps are measured to (fixed in the block that is
+/// not the host) at the blocks' poses: its outward normal `m` (world) and `m·x_h − d`, the
+/// host centroid's signed distance from it.
+#[inline(always)]
+pub(crate) fn other_face_plane(
+    pair: &ContactPair,
+    (pose_a, rotation_a): (&Pose, &Matrix),
+    (pose_b, rotation_b): (&Pose, &Matrix),
+) -> (Vector, Real) {
+    let (rotation_other, x_other, x_host) = if pair.host_is_a {
+        (rotation_b, pose_b.translation, pose_a.translation)
+    } else {
+        (rotation_a, pose_a.translation, pose_b.translation)
+    };
+    let m = *rotation_other * pair.plane_normal;
+    let d = pair.plane_offset + m.dot(x_other);
+    (m, m.dot(x_host) - d)
+}
+
+/// How a face-face contact integrates its cells' normal springs (`contact/spread.rs`): exactly
+/// over each cell where the law's normal spring is linear ([`ConstitutiveLaw::elastic_regime`])
+/// and carries no tension in the cell's state ([`ConstitutiveLaw::stays_open`] at the smallest
+/// opening), with the gap geometric (large displacements); at the anchor otherwise.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ExactCells {
+    /// `k_n` (Pa/m).
+    normal_stiffness: Real,
+    /// The gap's slope on the anchor plane, `∂g/∂x`, `∂g/∂y`.
+    slope: Vector2,
+    /// Whether a virgin sub-contact carries no tension.
+    virgin_without_tension: bool,
+}
+
+impl ExactCells {
+    /// For a contact whose face gap has the coefficients `face` (`None`: not geometric).
+    #[inline(always)]
+    pub(crate) fn of<L: ConstitutiveLaw>(law: &L, face: Option<(Real, Real, Real)>) -> Option<Self> {
+        let (_, gx, gy) = face?;
+        let regime = law.elastic_regime()?;
+        (regime.normal_stiffness > 0.0).then(|| Self {
+            normal_stiffness: regime.normal_stiffness,
+            slope: Vector2::new(-gx, -gy),
+            virgin_without_tension: tension_free(law, &L::State::default()),
+        })
+    }
+}
+
+/// Whether a sub-contact in `state` carries no tension: the law keeps it open at the smallest
+/// opening ([`ConstitutiveLaw::stays_open`]); its cell's normal spring is then integrated
+/// exactly ([`ExactCells`]).
+#[inline]
+pub(crate) fn tension_free<L: ConstitutiveLaw>(law: &L, state: &L::State) -> bool {
+    law.stays_open(1.0, Real::MIN_POSITIVE, state)
+}
+
+/// [`ExactCells`] of a contact, or none.
+pub(crate) trait CellRule {
+    /// The response of `sub`'s cell to the gap `anchor_gap` at its anchor.
+    fn cell<L: ConstitutiveLaw>(&self, law: &L, sub: &SubContact<L::State>, anchor_gap: Real) -> CellResponse;
+    /// Adds `sub`'s spring forces to `sums` (joint axes), its normal force where `cell` puts
+    /// it, and the cell's spread energy to `spread_energy`.
+    fn add<S>(&self, sums: &mut ForceMoments, spread_energy: &mut Real, sub: &SubContact<S>, cell: &CellResponse);
+}
+
+impl CellRule for Option<ExactCells> {
+    #[inline(always)]
+    fn cell<L: ConstitutiveLaw>(&self, law: &L, sub: &SubContact<L::State>, anchor_gap: Real) -> CellResponse {
+        match self {
+            Some(e)
+                if if sub.state == L::State::default() {
+                    e.virgin_without_tension
+                } else {
+                    tension_free(law, &sub.state)
+                } =>
+            {
+                cell_response(anchor_gap, e.slope, sub.half(), sub.area)
+            }
+            _ => CellResponse::at_anchor(anchor_gap),
+        }
+    }
+
+    #[inline(always)]
+    fn add<S>(&self, sums: &mut ForceMoments, spread_energy: &mut Real, sub: &SubContact<S>, cell: &CellResponse) {
+        sums.add_joint(&sub.force, sub.plane);
+        if let Some(e) = self {
+            let normal = sub.force.normal;
+            if normal > 0.0 {
+                sums.per_x.x += normal * cell.offset.x;
+                sums.per_y.x += normal * cell.offset.y;
+                *spread_energy += e.normal_stiffness * cell.excess_energy;
+            }
+        }
+    }
 }
 
 /// The first tangent of `previous` turned into the plane normal to `normal` by the smallest

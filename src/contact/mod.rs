@@ -6,15 +6,16 @@ mod lanes;
 mod law_update;
 mod moments;
 mod nodes;
+mod spread;
 mod view;
 
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
-pub(crate) use kernel::{update_contact, KernelContext};
+pub(crate) use kernel::{face_gap_coefficients, tension_free, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
 pub(crate) use nodes::{node_frame, stored_node_frame, update_nodes};
-pub(crate) use view::NodeGeometry;
+pub(crate) use view::{CellGeometry, NodeGeometry, TensionFree};
 pub use view::{Contact, ContactView, SubContactSample, SubContactView};
 
 pub use crate::ids::ContactId;
@@ -80,6 +81,10 @@ pub(crate) struct ContactPair {
     /// recomputed from the sub-contacts at detection, checkpointed (a recomputation could sum
     /// in another order than the step did).
     pub(crate) springs: ForceMoments,
+    /// Elastic energy the spread of the gap over the face-face cells stores beyond the laws'
+    /// `F_n²/(2 k_n A)` (J, `contact/spread.rs`): kept by the step with `springs`,
+    /// checkpointed.
+    pub(crate) spread_energy: Real,
 }
 
 /// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
@@ -142,9 +147,9 @@ mod tests {
 
     /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
     #[test]
-    fn subcontact_is_72_bytes_with_coulomb_state() {
+    fn subcontact_is_80_bytes_with_coulomb_state() {
         use crate::law::CoulombState;
-        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 72);
+        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 80);
     }
 }
 
@@ -212,18 +217,35 @@ impl ContactPair {
         }
     }
 
-    /// Recomputes [`ContactPair::springs`] from the contact's own sub-contacts (`own`: those
-    /// of its range).
-    pub(crate) fn refresh_springs<S>(&mut self, own: &[SubContact<S>]) {
-        self.springs = self.springs_of(own);
+    /// Recomputes [`ContactPair::springs`] and [`ContactPair::spread_energy`] from the
+    /// contact's own sub-contacts (`own`: those of its range) at the blocks' `poses` (`None` in
+    /// small-displacement mode, whose gaps are not geometric).
+    /// A face-face contact's sub-contacts get the gaps the step gives their laws
+    /// (`kernel::seed_law_gaps`) first.
+    pub(crate) fn refresh_springs<L: crate::law::ConstitutiveLaw>(
+        &mut self,
+        own: &mut [SubContact<L::State>],
+        law: &L,
+        poses: Option<(&Pose, &Pose)>,
+    ) {
+        if let (ContactKind::FaceFace { .. }, Some(poses)) = (self.kind, poses) {
+            kernel::seed_law_gaps(self, own, law, poses);
+        }
+        (self.springs, self.spread_energy) = self.springs_of(own, law, poses);
     }
 
-    /// The spring moments of `own` (the contact's sub-contacts) on its anchor plane; none for
-    /// a node contact, whose step books each node's work by itself.
-    pub(crate) fn springs_of<S>(&self, own: &[SubContact<S>]) -> ForceMoments {
+    /// The spring moments of `own` (the contact's sub-contacts) on its anchor plane and their
+    /// spread energy, as the step sums them (see [`ContactPair::refresh_springs`]); none for a
+    /// node contact, whose step books each node's work by itself.
+    pub(crate) fn springs_of<L: crate::law::ConstitutiveLaw>(
+        &self,
+        own: &[SubContact<L::State>],
+        law: &L,
+        poses: Option<(&Pose, &Pose)>,
+    ) -> (ForceMoments, Real) {
         match self.kind {
-            ContactKind::Nodes => ForceMoments::default(),
-            ContactKind::FaceFace { .. } => ForceMoments::of_springs(&self.axes(), own),
+            ContactKind::Nodes => (ForceMoments::default(), 0.0),
+            ContactKind::FaceFace { .. } => kernel::spring_moments(self, own, law, poses),
         }
     }
 
@@ -330,7 +352,7 @@ impl AnchorPlane {
 
 /// A sub-contact: a point of a joint with a tributary area, its spring forces, its accumulated
 /// slip and the law's state — what the step reads and writes for every sub-contact, and nothing
-/// else (72 bytes with [`crate::law::CoulombSlip`]'s state). Its position is given by
+/// else (80 bytes with [`crate::law::CoulombSlip`]'s state). Its position is given by
 /// two coordinates on the contact's [`AnchorPlane`], its shear force by two components along the
 /// joint's tangents ([`JointAxes`]). Its identity, dashpot force and gap offset sit in a parallel
 /// [`SubContactRecord`]; its world position and forces follow from the contact, see
@@ -345,8 +367,19 @@ pub(crate) struct SubContact<S> {
     pub(crate) force: JointForce,
     /// Accumulated slip while sliding (m).
     pub(crate) slip: Real,
+    /// Half sizes of the rectangle a face-face sub-contact's normal spring is integrated over
+    /// (m, along the anchor plane's axes; `contact/spread.rs`), zero for a node.
+    pub(crate) half: [f32; 2],
     pub(crate) status: JointStatus,
     pub(crate) state: S,
+}
+
+impl<S> SubContact<S> {
+    /// [`SubContact::half`] as a vector.
+    #[inline(always)]
+    pub(crate) fn half(&self) -> Vector2 {
+        Vector2::new(self.half[0] as Real, self.half[1] as Real)
+    }
 }
 
 /// What a sub-contact keeps besides the fields of [`SubContact`]: its identity and dashpot

@@ -1,7 +1,6 @@
 //! Force moments over a contact's anchor plane: how a contact's sub-contact forces sum to its
 //! resultant, moment and work without visiting the sub-contacts again.
 
-use super::SubContact;
 use crate::law::{JointAxes, JointForce};
 use crate::math::{Real, Vector, Vector2};
 
@@ -45,15 +44,6 @@ impl ForceMoments {
         self.force += f;
         self.per_x += f * c.x;
         self.per_y += f * c.y;
-    }
-
-    /// The moments of the spring forces of `subs`, whose forces are components in `axes`.
-    pub fn of_springs<S>(axes: &JointAxes, subs: &[SubContact<S>]) -> Self {
-        let mut sums = Self::default();
-        for s in subs {
-            sums.add_joint(&s.force, s.plane);
-        }
-        sums.to_world(axes)
     }
 
     /// Adds a sub-contact's spring force in the joint axes, `(F_n, F_t₁, F_t₂)`, at plane

@@ -6,6 +6,8 @@
 //! through [`SubContactView`]; code that does not need the law's own state reads either through
 //! the law-free [`Contact`] trait.
 
+use super::lanes::face_gap;
+use super::spread::cell_response;
 use super::{stored_node_frame, AnchorPlane, ContactPair, ContactWrench, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::geometry::{ContactKind, NodeId, Polyhedron, SubKey};
@@ -31,6 +33,35 @@ impl NodeGeometry<'_> {
             (self.states[0], &self.rotations[0], self.shapes[0]),
             (self.states[1], &self.rotations[1], self.shapes[1]),
         )
+    }
+}
+
+/// What the views of a face-face contact need to place its cells' normal forces where the step
+/// put them (`contact/spread.rs`): the gap over the anchor plane at the blocks' poses, and the
+/// law, which says which cells carry no tension.
+#[derive(Debug)]
+pub(crate) struct CellGeometry<'a, S> {
+    pub law: &'a dyn TensionFree<S>,
+    /// Gap coefficients at the current poses ([`super::face_gap_coefficients`]).
+    pub coefficients: (Real, Real, Real),
+}
+
+impl<S> Clone for CellGeometry<'_, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<S> Copy for CellGeometry<'_, S> {}
+
+/// [`super::tension_free`] for a law whose type the views do not carry.
+pub(crate) trait TensionFree<S>: std::fmt::Debug + Sync {
+    fn tension_free(&self, state: &S) -> bool;
+}
+
+impl<L: crate::law::ConstitutiveLaw> TensionFree<L::State> for L {
+    fn tension_free(&self, state: &L::State) -> bool {
+        super::tension_free(self, state)
     }
 }
 
@@ -71,6 +102,8 @@ pub trait Contact {
 pub struct SubContactSample {
     /// World position (m).
     pub point: Vector,
+    /// Where the normal force acts (m, world): see [`SubContactView::normal_force_point`].
+    pub normal_force_point: Vector,
     /// Tributary area (m²).
     pub area: Real,
     /// Normal force (N, compression positive).
@@ -118,6 +151,7 @@ pub struct ContactView<'a, S> {
     frame: Pose,
     wrench: ContactWrench,
     nodes: Option<NodeGeometry<'a>>,
+    cells: Option<CellGeometry<'a, S>>,
 }
 
 impl<'a, S> ContactView<'a, S> {
@@ -127,7 +161,7 @@ impl<'a, S> ContactView<'a, S> {
         records: &'a [SubContactRecord],
         frame: Pose,
         wrench: ContactWrench,
-        nodes: Option<NodeGeometry<'a>>,
+        (nodes, cells): (Option<NodeGeometry<'a>>, Option<CellGeometry<'a, S>>),
     ) -> Self {
         debug_assert_eq!(subs.len(), records.len());
         Self {
@@ -137,6 +171,7 @@ impl<'a, S> ContactView<'a, S> {
             frame,
             wrench,
             nodes,
+            cells,
         }
     }
 
@@ -189,7 +224,7 @@ impl<'a, S> ContactView<'a, S> {
     }
     /// The sub-contacts, in order.
     pub fn subcontacts(&self) -> impl ExactSizeIterator<Item = SubContactView<'a, S>> + 'a {
-        let (pair, frame, nodes) = (self.pair, self.frame, self.nodes);
+        let (pair, frame, nodes, cells) = (self.pair, self.frame, self.nodes, self.cells);
         self.subs
             .iter()
             .zip(self.records)
@@ -199,6 +234,7 @@ impl<'a, S> ContactView<'a, S> {
                 sub,
                 record,
                 nodes,
+                cells,
             })
     }
     /// The sub-contact at `index`, if any.
@@ -209,6 +245,7 @@ impl<'a, S> ContactView<'a, S> {
             sub: self.subs.get(index)?,
             record: &self.records[index],
             nodes: self.nodes,
+            cells: self.cells,
         })
     }
     /// World positions of the sub-contacts, in order (m).
@@ -237,6 +274,7 @@ impl<S> Contact for ContactView<'_, S> {
         let s = ContactView::subcontact(self, index).expect("sub-contact index out of range");
         SubContactSample {
             point: s.point(),
+            normal_force_point: s.normal_force_point(),
             area: s.area(),
             normal_force: s.normal_force(),
             shear_force: s.shear_force(),
@@ -256,6 +294,7 @@ pub struct SubContactView<'a, S> {
     sub: &'a SubContact<S>,
     record: &'a SubContactRecord,
     nodes: Option<NodeGeometry<'a>>,
+    cells: Option<CellGeometry<'a, S>>,
 }
 
 impl<'a, S> SubContactView<'a, S> {
@@ -298,6 +337,24 @@ impl<'a, S> SubContactView<'a, S> {
         match &self.nodes {
             Some(g) => g.frame(self.sub, self.record).0,
             None => self.frame.transform_point(self.anchor()),
+        }
+    }
+    /// Where the normal force acts (m, world). A face-face cell whose law carries no tension
+    /// in its state has its normal spring integrated over the cell (`docs/theory.md` §2.3): its
+    /// force acts at the centre of the compression over the cell, which lies within the cell
+    /// and moves towards the closed side as the joint opens (at a hinge, towards the hinge's
+    /// edge), as of the blocks' current poses. Elsewhere (a node, a bonded cell, small
+    /// displacements), [`SubContactView::point`].
+    pub fn normal_force_point(&self) -> Vector {
+        match &self.cells {
+            Some(c) if self.sub.force.normal > 0.0 && c.law.tension_free(&self.sub.state) => {
+                let plane = self.sub.plane;
+                let gap = face_gap(c.coefficients, plane.x, plane.y);
+                let slope = Vector2::new(-c.coefficients.1, -c.coefficients.2);
+                let cell = cell_response(gap, slope, self.sub.half(), self.sub.area);
+                self.frame.transform_point(self.pair.anchors.point(plane + cell.offset))
+            }
+            _ => self.point(),
         }
     }
     /// Tributary area (m²).

@@ -82,9 +82,44 @@ pub fn area_centroid(poly: &[DVec2]) -> (Real, DVec2) {
     (0.5 * a2, o + c / (3.0 * a2))
 }
 
+/// Second moments of area of a convex polygon about `about`, `(∫ (x − aₓ)² dA, ∫ (y − a_y)² dA)`
+/// (counter-clockwise: positive).
+pub fn second_moments(poly: &[DVec2], about: DVec2) -> (Real, Real) {
+    let n = poly.len();
+    if n < 3 {
+        return (0.0, 0.0);
+    }
+    let o = poly[0] - about;
+    let (mut jx, mut jy) = (0.0, 0.0);
+    for i in 1..n - 1 {
+        let (p, q) = (poly[i] - about, poly[i + 1] - about);
+        let twice_area = (p - o).perp_dot(q - o);
+        jx += twice_area * (o.x * o.x + p.x * p.x + q.x * q.x + o.x * p.x + p.x * q.x + q.x * o.x);
+        jy += twice_area * (o.y * o.y + p.y * p.y + q.y * q.y + o.y * p.y + p.y * q.y + q.y * o.y);
+    }
+    (jx / 12.0, jy / 12.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn second_moments_of_a_rectangle_and_a_triangle() {
+        let rect = [
+            DVec2::new(1.0, 2.0),
+            DVec2::new(3.0, 2.0),
+            DVec2::new(3.0, 3.0),
+            DVec2::new(1.0, 3.0),
+        ];
+        let (jx, jy) = second_moments(&rect, DVec2::new(2.0, 2.5));
+        // b h³/12 about the centroid: 1·2³/12 and 2·1³/12.
+        assert!((jx - 8.0 / 12.0).abs() < 1e-14 && (jy - 2.0 / 12.0).abs() < 1e-14);
+        // A right triangle with legs 3 (x) and 2 (y) about its centroid: b h³/36 each way.
+        let tri = [DVec2::new(0.0, 0.0), DVec2::new(3.0, 0.0), DVec2::new(0.0, 2.0)];
+        let (jx, jy) = second_moments(&tri, DVec2::new(1.0, 2.0 / 3.0));
+        assert!((jx - 2.0 * 27.0 / 36.0).abs() < 1e-13 && (jy - 3.0 * 8.0 / 36.0).abs() < 1e-13);
+    }
 
     #[test]
     fn coincident_squares_give_the_square() {

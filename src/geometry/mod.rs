@@ -10,9 +10,9 @@ pub use broad_phase::BroadPhase;
 #[cfg(feature = "limit")]
 pub(crate) use narrow_phase::contact_polygon;
 pub(crate) use narrow_phase::nodes::{deepest_two, NodeId};
-pub(crate) use narrow_phase::PARALLEL_ANGLE;
 pub use narrow_phase::{
     detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact,
     SubKey, SubcontactDensity, SubcontactSeed, MAX_SUBCONTACTS_PER_EDGE,
 };
+pub(crate) use narrow_phase::{face_frame, PARALLEL_ANGLE};
 pub use polyhedron::{Face, MassProperties, PlacedPolyhedron, Polyhedron, MAX_HULL_VERTICES};

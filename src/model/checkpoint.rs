@@ -36,7 +36,7 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// re-detection depends, and the blocks' stability bounds, which are re-evaluated block by block.
 /// Version 12 has node contacts (`"Nodes"`) where 11 had point contacts (`"Point"`, with a
 /// plane), and the refinement's travel cap (`refine_travel`).
-const VERSION: u32 = 12;
+const VERSION: u32 = 13;
 /// The checksum's field: `"crc32:"` and eight hexadecimal digits.
 const CHECKSUM: &str = "checksum";
 /// The largest step count (or detection count) a checkpoint may hold: 2⁵³, where `f64` stops
@@ -131,6 +131,7 @@ struct ContactEntry<S> {
     /// Force and first moments of the spring forces as the step summed them (a recomputation
     /// could sum in another order): `[F, F_x, F_y]`.
     springs: [Vector; 3],
+    spread_energy: Real,
     /// Centroids and host rotation at detection (small-displacement mode).
     reference_centroids: (Vector, Vector),
     reference_host_rotation: Rotation,
@@ -151,6 +152,7 @@ struct SubContactEntry<S> {
     gap: Real,
     force: JointForce,
     slip: Real,
+    half: [f32; 2],
     status: JointStatus,
     state: S,
     dashpot: Vector,
@@ -172,6 +174,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             dashpots: p.dashpots,
             normal_force: p.normal_force,
             springs: [p.springs.force, p.springs.per_x, p.springs.per_y],
+            spread_energy: p.spread_energy,
             reference_centroids: (r.ref_a, r.ref_b),
             reference_host_rotation: r.ref_host_rotation,
             area: r.area,
@@ -187,6 +190,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     gap: s.gap,
                     force: s.force,
                     slip: s.slip,
+                    half: s.half,
                     status: s.status,
                     state: s.state.clone(),
                     dashpot: rec.dashpot,
@@ -225,6 +229,7 @@ fn into_storage<S>(
                 gap: s.gap,
                 force: s.force,
                 slip: s.slip,
+                half: s.half,
                 status: s.status,
                 state: s.state,
             });
@@ -253,6 +258,7 @@ fn into_storage<S>(
                 per_x: e.springs[1],
                 per_y: e.springs[2],
             },
+            spread_energy: e.spread_energy,
         });
         references.push(ContactReference {
             ref_a: e.reference_centroids.0,
@@ -641,8 +647,25 @@ where
             p.dashpots |= model.state.sub_records[p.range()]
                 .iter()
                 .any(|r| r.dashpot != Vector::ZERO);
-            // The stored spring moments are those of the stored forces, up to summation order.
-            if !p.springs.matches(&p.springs_of(&model.state.subs[p.range()])) {
+            // The stored spring moments are those of the stored forces, up to summation order,
+            // with each normal force placed within its cell's rectangle (where the step put it,
+            // `contact/spread.rs`, at the poses before the step's advance).
+            let law = &model.state.laws.laws()[p.law as usize];
+            let subs = &model.state.subs[p.range()];
+            let (anchored, _) = p.springs_of(subs, law, None);
+            let reach = |k: usize| subs.iter().map(|s| s.force.normal.max(0.0) * s.half()[k]).sum::<Real>();
+            let scale = 1e-9 * (anchored.force.length() + anchored.per_x.length() + anchored.per_y.length());
+            let placed = ForceMoments {
+                force: p.springs.force,
+                per_x: anchored.per_x,
+                per_y: anchored.per_y,
+            };
+            if !p.springs.force.is_finite()
+                || !placed.matches(&anchored)
+                || !((p.springs.per_x - anchored.per_x).length() <= reach(0) * (1.0 + 1e-9) + scale)
+                || !((p.springs.per_y - anchored.per_y).length() <= reach(1) * (1.0 + 1e-9) + scale)
+                || !(p.spread_energy >= 0.0 && p.spread_energy.is_finite())
+            {
                 return Err(corrupt(
                     &format!("contacts[{k}].springs"),
                     "inconsistent with the sub-contact forces",

@@ -614,13 +614,21 @@ impl<L: ConstitutiveLaw> Model<L> {
                 self.state.blocks[p.b as usize].shape(),
             ],
         });
+        let law = &self.state.laws.laws()[p.law as usize];
+        let exact = matches!(p.kind, crate::geometry::ContactKind::FaceFace { .. })
+            && self.state.params.mode == DisplacementMode::Large
+            && law.elastic_regime().is_some_and(|r| r.normal_stiffness > 0.0);
+        let cells = exact.then(|| crate::contact::CellGeometry {
+            law: law as &dyn crate::contact::TensionFree<L::State>,
+            coefficients: crate::contact::face_gap_coefficients(p, &sa.pose, &sb.pose),
+        });
         ContactView::new(
             p,
             &self.state.subs[p.range()],
             &self.state.sub_records[p.range()],
             p.frame(&self.state.references[k], &sa.pose, &sb.pose, self.state.params.mode),
             self.state.wrenches[k],
-            nodes,
+            (nodes, cells),
         )
     }
 
@@ -686,6 +694,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                             .iter()
                             .map(|s| law.elastic_energy(s.area, &s.force, &s.state))
                             .sum::<Real>()
+                            + p.spread_energy
                     })
                     .sum::<Real>()
             })
@@ -1125,8 +1134,10 @@ mod tests {
             sub.force.shear = crate::math::Vector2::new(30.0 - i as Real, 5.0 + 2.0 * i as Real);
             sub.status = JointStatus::Elastic;
         }
-        let subs = model.state.subs[model.state.pairs[0].range()].to_vec();
-        model.state.pairs[0].refresh_springs(&subs);
+        let mut subs = model.state.subs[model.state.pairs[0].range()].to_vec();
+        let law = model.state.laws.laws()[0].clone();
+        let poses = (model.state.blocks[0].state.pose, model.state.blocks[1].state.pose);
+        model.state.pairs[0].refresh_springs(&mut subs, &law, Some((&poses.0, &poses.1)));
         let world_shears = |m: &Model| -> Vec<(SubKey, Vector)> {
             let view = m.contacts().next().expect("the joint");
             view.subcontacts().map(|s| (s.key(), s.shear_force())).collect()

@@ -2,7 +2,7 @@
 
 use glam::DVec2;
 
-use super::super::clip::{area_centroid, clip_convex, clip_rect};
+use super::super::clip::{area_centroid, clip_convex, clip_rect, second_moments};
 use super::super::polyhedron::Polyhedron;
 use super::*;
 #[cfg(feature = "limit")]
@@ -198,36 +198,21 @@ pub(super) fn face_face_hosted(
                 } else {
                     SubKey::cell(fo32, fh32, i, j)
                 };
-                // The node, shifted by how far the overlap's share of the cell has its centroid
-                // from the centroid of the cell's part of the host face: the node itself when
-                // the overlap covers that part, and a point that follows the overlap's edge
-                // continuously as it crosses the cell. (At the node always, a sub-contact at the
-                // overlap's edge carried its force up to half a cell outside the overlap; at the
-                // centroid of its share once its node was uncovered, as before, it jumped by up
-                // to a quarter cell at that moment, and with it its gap and stored energy.)
-                let full = cell.x * cell.y;
-                let (host_area, host_centroid) = if area >= full * (1.0 - 1e-12) {
-                    (full, node)
-                } else {
-                    scratch.tmp_cell.clear();
-                    scratch.tmp_cell.extend_from_slice(&scratch.host);
-                    clip_rect(&mut scratch.tmp_cell, clo, chi, &mut scratch.tmp);
-                    area_centroid(&scratch.tmp_cell)
-                };
-                let at = if area >= host_area * (1.0 - 1e-12) || host_area <= 0.0 {
-                    if host_area > 0.0 {
-                        node
-                    } else {
-                        centroid
-                    }
-                } else {
-                    node + (centroid - host_centroid)
-                };
+                // The anchor is the centroid of the cell (the overlap's part of the node's
+                // tributary rectangle), and the cell's second moments about it give the half
+                // sizes of the rectangle the normal springs are integrated over
+                // (`contact/spread.rs`). The cell follows the overlap's edge continuously as it
+                // crosses the rectangle; the integration puts the hinge of a joint opening about
+                // an edge on that edge at any density.
+                let (jx, jy) = second_moments(&scratch.cell, centroid);
+                let half = DVec2::new((3.0 * jx / area).max(0.0).sqrt(), (3.0 * jy / area).max(0.0).sqrt());
+                let at = centroid;
                 seeds.push(SubcontactSeed {
                     key,
                     anchor: origin + u * at.x + v * at.y,
                     area,
                     gap: gap_at(at),
+                    half,
                 });
             }
         }

@@ -19,8 +19,8 @@ pub(crate) mod nodes;
 
 #[cfg(feature = "limit")]
 pub(crate) use face::contact_polygon;
-pub(crate) use face::PARALLEL_ANGLE;
 use face::*;
+pub(crate) use face::{face_frame, PARALLEL_ANGLE};
 #[cfg(feature = "limit")]
 #[cfg(feature = "limit")]
 use hull::hull2d;
@@ -221,6 +221,10 @@ pub struct SubcontactSeed {
     /// Normal gap at detection (m, positive = open): the signed distance of the anchor from the
     /// other block's plane.
     pub gap: Real,
+    /// Half sizes along the host face's frame of the rectangle a face-face sub-contact's
+    /// normal spring is integrated over (m): the cell's second moments of area about the
+    /// anchor are `A h_x²/3`, `A h_y²/3` (`docs/theory.md` §2.3). Zero for a node.
+    pub half: crate::math::Vector2,
 }
 
 /// A detected contact between blocks `a` and `b`.
@@ -243,7 +247,6 @@ pub struct NarrowPhaseScratch {
     host: Vec<DVec2>,
     other: Vec<DVec2>,
     cell: Vec<DVec2>,
-    tmp_cell: Vec<DVec2>,
     tmp: Vec<DVec2>,
     separation: Real,
 }

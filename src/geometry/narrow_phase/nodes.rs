@@ -436,6 +436,7 @@ fn push_nodes(
                 anchor,
                 area: areas.area(host.shape, place, h),
                 gap,
+                half: crate::math::Vector2::ZERO,
             });
         }
     };

@@ -10,7 +10,7 @@ use crate::contact::{
     node_frame, AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
 };
 use crate::error::Result;
-use crate::geometry::{ContactKind, DetectedContact, NodeId, SubKey, SubcontactSeed, PARALLEL_ANGLE};
+use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubKey, SubcontactSeed, PARALLEL_ANGLE};
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Real, Vector, Vector2};
 
@@ -22,6 +22,7 @@ pub(super) fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord)
         gap: 0.0,
         force: JointForce::default(),
         slip: 0.0,
+        half: [0.0; 2],
         status: JointStatus::Open,
         state: S::default(),
     };
@@ -47,6 +48,7 @@ pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
         dashpots: true,
         normal_force: 0.0,
         springs: ForceMoments::default(),
+        spread_energy: 0.0,
     };
     let reference = ContactReference {
         ref_a: Vector::ZERO,
@@ -175,7 +177,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
     /// law), carrying the history of old contact `k_old` by sub-contact key when it joins the
     /// same features with the same host.
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn write_detected(
+    pub(super) fn write_detected<L>(
         &mut self,
         (staged, first): (u32, u32),
         old: &OldContacts<'_, S>,
@@ -183,9 +185,12 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
         (i, bi): (u32, &RigidBlock),
         (j, bj): (u32, &RigidBlock),
         dc: &DetectedContact,
-        law: u32,
+        (law, joint_law): (u32, &L),
+        large: bool,
         seeds: &[SubcontactSeed],
-    ) {
+    ) where
+        L: ConstitutiveLaw<State = S>,
+    {
         let host = if dc.host_is_a { bi } else { bj };
         let bound_area = k_old.map_or(0.0, |k| old.references[k].bound_area);
         let old_subs = k_old.map(|k| {
@@ -203,7 +208,20 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
         };
         let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
         let old_anchors = k_old.map_or(AnchorPlane::default(), |k| old.pairs[k].anchors);
-        let anchors = AnchorPlane::through(seeds.iter().map(|s| s.anchor));
+        // A face-face contact's anchors lie on the host face, in its frame: the frame its
+        // cells' rectangles are aligned with (`contact/spread.rs`).
+        let anchors = match dc.kind {
+            ContactKind::FaceFace { face_a, face_b } => {
+                let (shape, face) = if dc.host_is_a {
+                    (bi.shape(), face_a)
+                } else {
+                    (bj.shape(), face_b)
+                };
+                let (origin, u, v) = face_frame(shape, face as usize);
+                AnchorPlane { origin, u, v }
+            }
+            ContactKind::Nodes => AnchorPlane::through(seeds.iter().map(|s| s.anchor)),
+        };
         let at = first as usize - self.sub_base;
         let (subs, records) = (
             &mut self.subs[at..at + seeds.len()],
@@ -243,6 +261,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 gap: seed.gap,
                 force: JointForce::default(),
                 slip: 0.0,
+                half: [seed.half.x as f32, seed.half.y as f32],
                 status: JointStatus::Open,
                 state: S::default(),
             };
@@ -261,6 +280,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                     // uniform, and a face sliding over a larger one takes its support along.
                     sub.plane = anchors.coordinates(old_anchors.point(o.plane));
                     sub.area = o.area;
+                    sub.half = o.half;
                 }
                 sub.force = o.force;
                 sub.slip = o.slip;
@@ -287,9 +307,10 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             dashpots: true,
             normal_force: 0.0,
             springs: ForceMoments::default(),
+            spread_energy: 0.0,
         };
         pair.cache_local_faces(bi.shape(), bj.shape());
-        pair.refresh_springs(subs);
+        pair.refresh_springs(subs, joint_law, large.then_some((&bi.state.pose, &bj.state.pose)));
         let k = staged as usize - self.pair_base;
         self.pairs[k] = pair;
         self.wrenches[k] = ContactWrench::default();
@@ -352,7 +373,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 (p.a, bi),
                 (p.b, bj),
                 &dc,
-                law,
+                (law, &self.laws.laws()[law as usize]),
+                self.params.mode == crate::contact::DisplacementMode::Large,
                 seeds,
             );
         }
