@@ -100,11 +100,15 @@ fn servo_loading_follows_the_static_answer_whatever_the_increment_and_threshold(
         // force, and a sample falls up to one increment (0.2 µm of 20) past its travel.
         assert!(e < 0.01, "{name}: {e}");
     }
-    // The answer at the same travel does not depend on the increment or the threshold.
+    // The answer at the same travel does not depend on the increment or the threshold: within
+    // 1 %, and the force of one coarse increment (4 N). A sample's forces are those the step
+    // computed before it moved the plate, which it may have just advanced by an increment: at
+    // the first sample (300 N) that alone is 1.3 % (measured: 301.8 N coarse, 297.9 N tight).
+    let increment_force = KN * AREA * 0.2e-6 / 2.0;
     for ((a, b), c) in fine.iter().zip(&coarse).zip(&tight) {
         let f = a.1.max(1.0);
-        assert!((a.1 - b.1).abs() < 0.01 * f, "{a:?} vs {b:?}");
-        assert!((b.1 - c.1).abs() < 0.01 * f, "{b:?} vs {c:?}");
+        assert!((a.1 - b.1).abs() < 0.01 * f + increment_force, "{a:?} vs {b:?}");
+        assert!((b.1 - c.1).abs() < 0.01 * f + increment_force, "{b:?} vs {c:?}");
     }
 }
 

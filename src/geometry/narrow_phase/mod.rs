@@ -347,7 +347,7 @@ pub fn detect(
         }) if face_a as usize == fa && face_b as usize == fb => Some(host_is_a),
         _ => None,
     };
-    if cos >= tolerance && cos >= PARALLEL_ANGLE.cos() {
+    if cos >= tolerance && cos >= PARALLEL_ANGLE.cos() && !near_coplanar_neighbour(a, fa, b, fb, params, scratch, seeds) {
         let start = seeds.len();
         if let Some(found) = face_face(a, fa, b, fb, 0.0, kept_host, params, scratch, seeds) {
             return Some(found);
@@ -355,6 +355,40 @@ pub fn detect(
         seeds.truncate(start);
     }
     node_contact(a, b, n, params, seeds)
+}
+
+/// Faces of one block whose outward normals lie within this angle (rad, 10°) of each other are
+/// near-coplanar neighbours for [`near_coplanar_neighbour`].
+const NEIGHBOUR_ANGLE: Real = 0.174_532_925_199_432_95;
+
+/// Whether face `fa` of `a` (or `fb` of `b`) also meets, within the tolerance and with an
+/// overlap, another face of the other block nearly coplanar with `fb` (or `fa`): a flat face
+/// across the shallow ridge of an irregular stone. A joint holds one pair of faces, and its
+/// grid measures gaps to one plane: the other face's part would be pressed into without a
+/// force, its overlap appearing whole, with its energy, when a later detection took that face
+/// (2.5 % of `m g h` in one of the sharp-block drops). Nodes carry such a contact; the faces of
+/// masonry units (cuboids, voussoirs) meet at far larger angles and never take this path.
+fn near_coplanar_neighbour(
+    a: BlockGeometry<'_>,
+    fa: usize,
+    b: BlockGeometry<'_>,
+    fb: usize,
+    params: &ContactParameters,
+    scratch: &mut NarrowPhaseScratch,
+    seeds: &mut Vec<SubcontactSeed>,
+) -> bool {
+    fn neighbours(shape: &Polyhedron, f: usize) -> impl Iterator<Item = usize> + '_ {
+        let n = shape.faces()[f].normal;
+        (0..shape.faces().len()).filter(move |&g| g != f && shape.faces()[g].normal.dot(n) >= NEIGHBOUR_ANGLE.cos())
+    }
+    let start = seeds.len();
+    let mut meets = |fa: usize, fb: usize| {
+        let host_is_a = a.shape.faces()[fa].area <= b.shape.faces()[fb].area;
+        let found = face_face_hosted(a, fa, b, fb, host_is_a, false, 0.0, params, scratch, seeds);
+        seeds.truncate(start);
+        matches!(found, Hosted::Contact(_))
+    };
+    neighbours(b.shape, fb).any(|g| meets(fa, g)) || neighbours(a.shape, fa).any(|g| meets(g, fb))
 }
 
 /// The common-plane normal from the separating axis theorem.
