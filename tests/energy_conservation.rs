@@ -293,8 +293,15 @@ fn undamped_wall_settles_without_walking() {
         worst / scale
     };
     let (coarse, fine) = (landing_balance(0.5), landing_balance(0.25));
-    println!("balance over the landing: {:.3} % at safety 0.5, {:.3} % at 0.25", 100.0 * coarse, 100.0 * fine);
-    assert!(fine <= coarse / 3.0 && fine <= 0.005, "balance {coarse} at the default step, {fine} at half");
+    println!(
+        "balance over the landing: {:.3} % at safety 0.5, {:.3} % at 0.25",
+        100.0 * coarse,
+        100.0 * fine
+    );
+    assert!(
+        fine <= coarse / 3.0 && fine <= 0.005,
+        "balance {coarse} at the default step, {fine} at half"
+    );
     let mut model = wall(0.5);
     let vertices = |m: &Model| -> Vec<Vector> {
         m.blocks()
@@ -341,6 +348,9 @@ fn undamped_wall_settles_without_walking() {
         e.friction
     );
     assert!(drift < 1e-5, "a brick walked {drift} m after settling");
-    assert!(worst_balance <= coarse * scale * (1.0 + 1e-9), "balance {worst_balance} J after the landing");
+    assert!(
+        worst_balance <= coarse * scale * (1.0 + 1e-9),
+        "balance {worst_balance} J after the landing"
+    );
     assert!(e.friction >= 0.0);
 }

@@ -5,6 +5,7 @@
 #![recursion_limit = "256"]
 
 mod blocks;
+mod convergence;
 mod convert;
 mod documents;
 mod errors;
@@ -33,6 +34,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(blocks::barrel_vault, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::dome, m)?)?;
     m.add_function(wrap_pyfunction!(series::benchmark_wall, m)?)?;
+    m.add_function(wrap_pyfunction!(convergence::check_density_convergence, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_static, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_impact, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::impact_setups, m)?)?;

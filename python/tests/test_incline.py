@@ -51,9 +51,15 @@ def test_smaller_step_closer():
     m.set_damping("none")
     m.add_cuboid("ramp", (-1.0, -0.5, -0.1), (3.0, 0.5, 0.0), density=2500.0, fixed=True)
     b = m.add_cuboid("brick", (0.0, -0.1, 0.0), (0.2, 0.1, 0.1), density=2500.0)
+    r0 = m.rotation_matrices()[b]
     m.run_until_time(0.3)
     a = m.velocities()[b, 0] / m.time
     assert abs(a - EXPECTED) < 0.01 * EXPECTED, (a, EXPECTED)
-    # It slides straight down the slope: no sideways motion, hardly any rocking.
+    # It slides straight down the slope: no sideways motion, hardly any rocking. The friction
+    # at its base tilts it on its (undamped) joint by about 2e-5 rad, about which it rocks at
+    # some 1,800 rad/s, so its angular velocity swings through ±0.1 rad/s (at 0.3 s it may be
+    # anywhere in that range): the tilt is what stays small.
     assert abs(m.velocities()[b, 1]) < 1e-9
-    assert np.allclose(m.angular_velocities()[b], 0.0, atol=1e-2)
+    turned = m.rotation_matrices()[b] @ r0.T
+    tilt = math.acos(min(1.0, (np.trace(turned) - 1.0) / 2.0))
+    assert tilt < 2e-4, tilt

@@ -375,3 +375,34 @@ def test_sharp_block_keeps_its_energy():
     assert np.all(np.isfinite(sub["point"]))
     assert worst < 0.02, worst
     assert b == 1
+
+
+def test_hinge_tilt_is_exact_at_any_density():
+    """A block whose joint opens under a moment (the resultant beyond the kern): its tilt is the
+    rigid block's on a no-tension elastic joint, 2 W / (kn c² d) with c = 3 (b/2 − e) the closed
+    length, already at 5 sub-contacts per edge (the joints' normal springs are integrated over
+    their cells), and refining the joints does not move it."""
+
+    def tilt(**density):
+        m = block_on_base(**density)
+        r0 = m.rotation_matrices()[1]
+        m.set_load(1, moment=(0.0, WEIGHT * 0.12, 0.0))
+        m.run_to_equilibrium(1e-7, 400_000)
+        turned = m.rotation_matrices()[1] @ r0.T
+        return abs(math.asin(turned[0, 2]))
+
+    c = vs.check_density_convergence(tilt, subcontacts_per_edge=5)
+    assert c["density"] == {"subcontacts_per_edge": 5}
+    assert c["refined_density"] == {"subcontacts_per_edge": 9}
+    expected = 2 * WEIGHT / (4e9 * (3 * (0.2 - 0.12)) ** 2 * 0.3)
+    assert abs(c["value"] / expected - 1) < 0.01, (c, expected)
+    assert c["relative_change"] < 0.005, c
+
+
+def test_density_convergence_refuses_what_it_cannot_run():
+    with pytest.raises(TypeError):
+        vs.check_density_convergence(42)
+    with pytest.raises(vs.VoussoirError):
+        vs.check_density_convergence(lambda **d: 1.0, subcontacts_per_edge=0)
+    with pytest.raises(ZeroDivisionError):
+        vs.check_density_convergence(lambda **d: 1 / 0)

@@ -27,10 +27,12 @@ IMPACT_KEYS = {
 
 
 def test_arch_static_cheap():
-    r = vs.scenarios.arch_static(per_edge=5, servo_increment=1e-4, max_displacement=0.003, convergence_check=True)
+    # The default servo increment, 20 µm: five times that (100 µm in one step into the loading
+    # plate's seated joint, 6 kN at kn 4 GPa/m) kicks voussoir 5 off the plate.
+    r = vs.scenarios.arch_static(per_edge=5, servo_increment=2e-5, max_displacement=0.003, convergence_check=True)
     assert set(r) == STATIC_KEYS | {"curve"}
     assert r["label"] == "baseline" and r["loading"] == "servo" and r["mode"] == "large"
-    assert r["servo"] == {"increment": 1e-4, "max_unbalanced_ratio": 1e-3}
+    assert r["servo"] == {"increment": 2e-5, "max_unbalanced_ratio": 1e-3}
     assert r["ks_pa_per_m"] == pytest.approx(0.4 * r["kn_pa_per_m"])
     assert 0.5 < r["peak_load_kn"] < 5.0
     assert r["rate_convergence"]["checked"] is True

@@ -18,6 +18,7 @@ from ._voussoir import (
     VoussoirError,
     VoussoirIOError,
     __version__,
+    check_density_convergence,
 )
 from . import build, scenarios, scenes
 
@@ -31,6 +32,7 @@ __all__ = [
     "VoussoirIOError",
     "__version__",
     "build",
+    "check_density_convergence",
     "scenarios",
     "scenes",
 ]

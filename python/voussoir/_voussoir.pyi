@@ -371,3 +371,15 @@ def arch_impact(
     offsets_mm: Sequence[float] = (0.0,),
 ) -> Dict[str, Any]: ...
 def impact_setups() -> List[Dict[str, Any]]: ...
+
+def check_density_convergence(
+    run: Callable[..., float],
+    *,
+    subcontacts_per_edge: int = 15,
+    subcontact_spacing: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Run ``run`` at a sub-contact density and at the density with the joints' cells halved
+    (``2 n - 1`` per edge, or half the spacing), passing the density as ``Model``'s keyword
+    argument; return ``value``, ``refined``, ``relative_change``, ``density`` and
+    ``refined_density``."""
+    ...

@@ -1,0 +1,73 @@
+//! The convergence check of the joints' discretisation from Python.
+
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use voussoir::geometry::SubcontactDensity;
+use voussoir::loading::Convergence;
+
+/// The keyword arguments of ``Model`` that give `density`.
+fn density_kwargs<'py>(py: Python<'py>, density: SubcontactDensity) -> PyResult<Bound<'py, PyDict>> {
+    let kwargs = PyDict::new(py);
+    match density {
+        SubcontactDensity::PerEdge(n) => kwargs.set_item("subcontacts_per_edge", n)?,
+        SubcontactDensity::Spacing(h) => kwargs.set_item("subcontact_spacing", h)?,
+    }
+    Ok(kwargs)
+}
+
+/// check_density_convergence(run, *, subcontacts_per_edge=15, subcontact_spacing=None)
+/// --
+///
+/// Runs an analysis at a sub-contact density and at the density with the joints' cells halved
+/// along each edge (``2 n - 1`` per edge, or half the spacing), and reports how much the
+/// quantity it returns (a collapse load, a displacement) changed: the check that an answer does
+/// not depend on how finely the joints are divided (Rust:
+/// ``SubcontactDensity::check_convergence``).
+///
+/// ``run`` is called with the density as the keyword argument ``Model`` takes
+/// (``subcontacts_per_edge=n`` or ``subcontact_spacing=h``), builds and runs the whole
+/// analysis, and returns a number. The two runs go one after the other.
+///
+/// Returns a dict: ``value``, ``refined`` (the two results), ``relative_change``
+/// (``|refined - value| / |value|``), ``density`` and ``refined_density`` (the keyword
+/// arguments each run was given).
+///
+/// >>> import voussoir as vs
+/// >>> c = vs.check_density_convergence(lambda subcontacts_per_edge: 1.0 + 0.1 / subcontacts_per_edge)
+/// >>> c["refined_density"], round(c["relative_change"], 5)
+/// ({'subcontacts_per_edge': 29}, 0.00321)
+#[pyfunction]
+#[pyo3(signature = (run, *, subcontacts_per_edge=15, subcontact_spacing=None))]
+pub fn check_density_convergence<'py>(
+    py: Python<'py>,
+    run: &Bound<'py, PyAny>,
+    subcontacts_per_edge: u16,
+    subcontact_spacing: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !run.is_callable() {
+        return Err(pyo3::exceptions::PyTypeError::new_err(
+            "check_density_convergence: run must be callable",
+        ));
+    }
+    let density = match subcontact_spacing {
+        Some(h) => SubcontactDensity::Spacing(h),
+        None => SubcontactDensity::PerEdge(subcontacts_per_edge),
+    };
+    let mut params = voussoir::geometry::ContactParameters::default();
+    params.density = density;
+    params.validate().map_err(crate::errors::to_py)?;
+    let refined_density = density.refined();
+    let call =
+        |d: SubcontactDensity| -> PyResult<f64> { run.call((), Some(&density_kwargs(py, d)?))?.extract::<f64>() };
+    let c = Convergence {
+        value: call(density)?,
+        refined: call(refined_density)?,
+    };
+    let out = PyDict::new(py);
+    out.set_item("value", c.value)?;
+    out.set_item("refined", c.refined)?;
+    out.set_item("relative_change", c.relative_change())?;
+    out.set_item("density", density_kwargs(py, density)?)?;
+    out.set_item("refined_density", density_kwargs(py, refined_density)?)?;
+    Ok(out)
+}
