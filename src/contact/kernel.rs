@@ -311,16 +311,40 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     let mut sums = ForceMoments::default();
     let mut dissipated = 0.0;
     let mut spread_energy = 0.0;
+    // `Σ A h_x²`, `Σ A h_y²` of the all-closed cells in the elastic regime: their forces'
+    // offsets and spread energies are linear in them (`N c = −k_n J s`, `½ k_n J s²`), added
+    // once for the contact after the loop.
+    let (mut closed_x, mut closed_y) = (0.0, 0.0);
     for sub in subs.iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
-        let cell = match face {
-            Some(g) => exact.cell(law, sub, face_gap(g, x, y)),
-            None => CellResponse::at_anchor(sub.gap + du_n),
+        let is_virgin = sub.state == virgin;
+        let cell = match (face, exact) {
+            (Some(g), Some(e))
+                if if is_virgin {
+                    e.virgin_without_tension
+                } else {
+                    tension_free(law, &sub.state)
+                } =>
+            {
+                let anchor_gap = face_gap(g, x, y);
+                let half = sub.half();
+                let spread = e.slope.x.abs() * half.x + e.slope.y.abs() * half.y;
+                if anchor_gap < 0.0 && anchor_gap <= -spread {
+                    Cell::Closed(anchor_gap, half)
+                } else {
+                    Cell::Response(cell_response(anchor_gap, e.slope, half, sub.area))
+                }
+            }
+            (Some(g), _) => Cell::Response(CellResponse::at_anchor(face_gap(g, x, y))),
+            (None, _) => Cell::Response(CellResponse::at_anchor(sub.gap + du_n)),
         };
-        let gap = cell.law_gap;
+        let gap = match cell {
+            Cell::Closed(gap, _) => gap,
+            Cell::Response(c) => c.law_gap,
+        };
         let du_s = Vector2::new(du_1, du_2);
-        if sub.state == virgin {
+        if is_virgin {
             if let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) {
                 if status == JointStatus::Sliding {
                     // As `update_with_law` books a slide: the shear spring's work less the
@@ -338,7 +362,14 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                 sub.force = force;
                 sub.gap = gap;
                 sub.status = status;
-                exact.add(&mut sums, &mut spread_energy, sub, &cell);
+                match cell {
+                    Cell::Closed(_, half) => {
+                        sums.add_joint(&force, sub.plane);
+                        closed_x += sub.area * half.x * half.x;
+                        closed_y += sub.area * half.y * half.y;
+                    }
+                    Cell::Response(c) => exact.add(&mut sums, &mut spread_energy, sub, &c),
+                }
                 continue;
             }
         }
@@ -347,9 +378,28 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             continue;
         }
         dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt).1;
-        exact.add(&mut sums, &mut spread_energy, sub, &cell);
+        let response = match (cell, exact) {
+            (Cell::Closed(anchor_gap, half), Some(e)) => cell_response(anchor_gap, e.slope, half, sub.area),
+            (Cell::Closed(anchor_gap, _), None) => CellResponse::at_anchor(anchor_gap),
+            (Cell::Response(c), _) => c,
+        };
+        exact.add(&mut sums, &mut spread_energy, sub, &response);
+    }
+    if let Some(e) = exact {
+        let (jx, jy) = (closed_x / 3.0, closed_y / 3.0);
+        sums.per_x.x -= e.normal_stiffness * e.slope.x * jx;
+        sums.per_y.x -= e.normal_stiffness * e.slope.y * jy;
+        spread_energy += 0.5 * e.normal_stiffness * (jx * e.slope.x * e.slope.x + jy * e.slope.y * e.slope.y);
     }
     (sums, dissipated, spread_energy)
+}
+
+/// A cell as the elastic-regime loop sees it: all closed (the gap at the anchor and the half
+/// sizes: its force and moments are linear in them), or its [`CellResponse`].
+#[derive(Clone, Copy)]
+enum Cell {
+    Closed(Real, Vector2),
+    Response(CellResponse),
 }
 
 /// Sets the gaps of a face-face contact's sub-contacts to those the step gives their laws at the
