@@ -165,8 +165,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
         (sums, dissipated, spread_energy) = match face_gap_coefficients {
-            Some(g) => update_elastic_first(subs, law, &regime, &kinematics, Some(g), exact, axes, dt),
-            None => update_elastic_first(subs, law, &regime, &kinematics, None, None, axes, dt),
+            Some(g) => update_elastic_first((subs, records), law, &regime, &kinematics, Some(g), exact, axes, dt),
+            None => update_elastic_first((subs, records), law, &regime, &kinematics, None, None, axes, dt),
         };
         done = subs.len();
     } else if !dashpots {
@@ -179,7 +179,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let mut lanes = LaneSums::default();
         let (groups, _) = subs.as_chunks_mut::<LANES>();
         for group in groups.iter_mut() {
-            update_group(group, law, &frame, &mut lanes);
+            update_group(group, &mut records[done..done + LANES], law, &frame, &mut lanes);
+            done += LANES;
         }
         done = groups.len() * LANES;
         (sums, dissipated) = lanes.total();
@@ -199,7 +200,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let [du_n, du_1, du_2] = increment(&kinematics, x, y);
         let du_s = Vector2::new(du_1, du_2);
         let gap = face.unwrap_or(sub.gap + du_n);
-        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt, &mut record.slip);
         dissipated += lost;
         match cell {
             Some(cell) => exact.add(&mut sums, &mut spread_energy, sub, &cell),
@@ -245,7 +246,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // that a quiet contact costs a few operations; then, out of line, each sub-contact.
     let fast = 2.0 * (v0.length_squared() + dw.length_squared() * (host_radius * host_radius))
         > ctx.impact_speed * ctx.impact_speed;
-    let impact = fast && impact_probe(subs, law, &kinematics, ctx);
+    let impact = fast && impact_probe(subs, law, &kinematics, ctx, face_gap_coefficients.zip(exact));
     // A contact the probe marked keeps the step refined while it is loaded and moving: a
     // bound of the relative speed, so that a block rocking on a loaded edge whose sub-contacts
     // barely move keeps it too (the step must not change while springs are loaded).
@@ -276,15 +277,30 @@ fn impact_probe<L: ConstitutiveLaw>(
     law: &L,
     kinematics: &Kinematics,
     ctx: KernelContext,
+    cells: Option<((Real, Real, Real), ExactCells)>,
 ) -> bool {
     let threshold = ctx.impact_speed * ctx.dt;
     let reach = ctx.impact_horizon / ctx.dt;
+    let crosses = |s: &SubContact<L::State>, gap: Real, du_n: Real| {
+        (gap > 0.0) != (du_n > 0.0) && gap.abs() < reach * du_n.abs() && law.stays_open(s.area, gap.abs(), &s.state)
+    };
     subs.iter().any(|s| {
         let du_n = increment(kinematics, s.plane.x, s.plane.y)[0];
-        du_n.abs() > threshold
-            && (s.gap > 0.0) != (du_n > 0.0)
-            && s.gap.abs() < reach * du_n.abs()
-            && law.stays_open(s.area, s.gap.abs(), &s.state)
+        if du_n.abs() <= threshold {
+            return false;
+        }
+        match cells {
+            // A cell integrated over its rectangle has two kinks: where its first corner
+            // closes (or its last opens) and where it closes whole (or starts to open), the
+            // gaps at its corners nearest and farthest, `ū ∓ (|s_x| h_x + |s_y| h_y)`.
+            Some((g, e)) if s.half != [0.0; 2] => {
+                let anchor_gap = face_gap(g, s.plane.x, s.plane.y);
+                let half = s.half();
+                let spread = e.slope.x.abs() * half.x + e.slope.y.abs() * half.y;
+                crosses(s, anchor_gap - spread, du_n) || crosses(s, anchor_gap + spread, du_n)
+            }
+            _ => crosses(s, s.gap, du_n),
+        }
     })
 }
 
@@ -298,7 +314,7 @@ fn impact_probe<L: ConstitutiveLaw>(
 /// dissipated.
 #[inline(always)]
 fn update_elastic_first<L: ConstitutiveLaw>(
-    subs: &mut [SubContact<L::State>],
+    (subs, records): (&mut [SubContact<L::State>], &mut [SubContactRecord]),
     law: &L,
     regime: &ElasticRegime,
     kinematics: &Kinematics,
@@ -315,7 +331,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     // offsets and spread energies are linear in them (`N c = −k_n J s`, `½ k_n J s²`), added
     // once for the contact after the loop.
     let (mut closed_x, mut closed_y) = (0.0, 0.0);
-    for sub in subs.iter_mut() {
+    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
         let is_virgin = sub.state == virgin;
@@ -357,7 +373,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                     } else {
                         work
                     };
-                    sub.slip += du_s.length();
+                    record.slip += du_s.length();
                 }
                 sub.force = force;
                 sub.gap = gap;
@@ -377,7 +393,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             sub.gap = gap;
             continue;
         }
-        dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt).1;
+        dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt, &mut record.slip).1;
         let response = match (cell, exact) {
             (Cell::Closed(anchor_gap, half), Some(e)) => cell_response(anchor_gap, e.slope, half, sub.area),
             (Cell::Closed(anchor_gap, _), None) => CellResponse::at_anchor(anchor_gap),

@@ -25,6 +25,7 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
     du_s: Vector2,
     axes: JointAxes,
     dt: Real,
+    slip: &mut Real,
 ) -> (JointStatus, Real) {
     let step = JointStep {
         area: sub.area,
@@ -55,7 +56,7 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
         0.0
     };
     if status == JointStatus::Sliding {
-        sub.slip += du_s.length();
+        *slip += du_s.length();
     }
     sub.gap = gap;
     sub.status = status;

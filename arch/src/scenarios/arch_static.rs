@@ -9,7 +9,7 @@
 //! is driven down quasi-statically by a servo ([`voussoir::loading::Servo`]: it advances only
 //! from settled states, and the load is read at them), or at a constant rate for the study of
 //! inertia effects ([`StaticCase::rate_study`]), with local damping on, until the plate has
-//! travelled `max_displacement` or the load has fallen below `stop_fraction` of its peak.
+//! travelled `max_displacement` or the load has stayed below `stop_fraction` of its peak over 1 mm.
 //! [`run_converged`] also runs the case refined and reports how much its peak moves.
 //! [`limit_analysis`] gives the rigid-block collapse load of the settled arch beside the DEM's
 //! peak (`docs/benchmarks/arch-static.md`, "Limit analysis").
@@ -57,7 +57,8 @@ pub struct StaticCase {
     pub local_damping: Real,
     /// Stop when the plate has travelled this far (m).
     pub max_displacement: Real,
-    /// Stop when the load falls below this fraction of its peak (after the peak).
+    /// Stop when the load has stayed below this fraction of its peak (after the peak) over
+    /// [`FALLEN_TRAVEL`] of plate travel.
     pub stop_fraction: Real,
     /// Unbalanced-force ratio at which the gravity settling stops.
     pub settle_ratio: Real,
@@ -306,6 +307,12 @@ pub struct StaticModel {
 
 const VOUSSOIR: usize = 5;
 
+/// How far the plate travels with the load below `stop_fraction` of its peak before a case
+/// stops (m): a collapse keeps the load down, where the first contact of the plate — closed by
+/// one increment at the plate's approach speed, 0.13 m/s — can bounce voussoir 5 off it and
+/// read zero at a settled state for a moment (φ = 25° stopped at 0.08 mm with a 95 N "peak").
+pub const FALLEN_TRAVEL: Real = 1e-3;
+
 /// Builds the model of a case (not yet settled).
 ///
 /// # Errors
@@ -388,6 +395,9 @@ struct StaticRun<'a, F> {
     window_sum: Real,
     at_peak: (Vec<JointState>, Mechanism),
     next_frame: Real,
+    /// The travel at which the load fell below `stop_fraction` of its peak and has stayed
+    /// there since.
+    fallen_since: Option<Real>,
 }
 
 impl<F: FnMut(&Model) -> Result<()>> voussoir::model::Observer<voussoir::law::CoulombSlip> for StaticRun<'_, F> {
@@ -448,8 +458,15 @@ impl<F: FnMut(&Model) -> Result<()>> voussoir::model::Observer<voussoir::law::Co
                 self.next_frame += every;
             }
         }
-        let fallen =
-            self.peak.0 > 0.0 && smoothed_load < case.stop_fraction * self.peak.0 && displacement > self.peak.1;
+        let below = self.peak.0 > 0.0 && smoothed_load < case.stop_fraction * self.peak.0 && displacement > self.peak.1;
+        self.fallen_since = if below {
+            Some(self.fallen_since.unwrap_or(displacement))
+        } else {
+            None
+        };
+        let fallen = self
+            .fallen_since
+            .is_some_and(|since| displacement - since >= FALLEN_TRAVEL);
         Ok(super::stop_when(displacement >= case.max_displacement || fallen))
     }
 }
@@ -507,6 +524,7 @@ pub fn run(
         window_sum: 0.0,
         at_peak: classify_joints(&model, &joints, &criteria),
         next_frame: 0.0,
+        fallen_since: None,
     };
     // Until the observer stops the run: the maximum displacement, or the load fallen after the
     // peak.
