@@ -165,8 +165,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
         (sums, dissipated, spread_energy) = match face_gap_coefficients {
-            Some(g) => update_elastic_first((subs, records), law, &regime, &kinematics, Some(g), exact, axes, dt),
-            None => update_elastic_first((subs, records), law, &regime, &kinematics, None, None, axes, dt),
+            Some(g) => update_elastic_first(subs, law, &regime, &kinematics, Some(g), exact, axes, dt),
+            None => update_elastic_first(subs, law, &regime, &kinematics, None, None, axes, dt),
         };
         done = subs.len();
     } else if !dashpots {
@@ -179,8 +179,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let mut lanes = LaneSums::default();
         let (groups, _) = subs.as_chunks_mut::<LANES>();
         for group in groups.iter_mut() {
-            update_group(group, &mut records[done..done + LANES], law, &frame, &mut lanes);
-            done += LANES;
+            update_group(group, law, &frame, &mut lanes);
         }
         done = groups.len() * LANES;
         (sums, dissipated) = lanes.total();
@@ -200,7 +199,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let [du_n, du_1, du_2] = increment(&kinematics, x, y);
         let du_s = Vector2::new(du_1, du_2);
         let gap = face.unwrap_or(sub.gap + du_n);
-        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt, &mut record.slip);
+        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
         dissipated += lost;
         match cell {
             Some(cell) => exact.add(&mut sums, &mut spread_energy, sub, &cell),
@@ -314,7 +313,7 @@ fn impact_probe<L: ConstitutiveLaw>(
 /// dissipated.
 #[inline(always)]
 fn update_elastic_first<L: ConstitutiveLaw>(
-    (subs, records): (&mut [SubContact<L::State>], &mut [SubContactRecord]),
+    subs: &mut [SubContact<L::State>],
     law: &L,
     regime: &ElasticRegime,
     kinematics: &Kinematics,
@@ -331,7 +330,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     // offsets and spread energies are linear in them (`N c = −k_n J s`, `½ k_n J s²`), added
     // once for the contact after the loop.
     let (mut closed_x, mut closed_y) = (0.0, 0.0);
-    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
+    for sub in subs.iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
         let is_virgin = sub.state == virgin;
@@ -373,7 +372,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                     } else {
                         work
                     };
-                    record.slip += du_s.length();
+                    sub.slip += du_s.length();
                 }
                 sub.force = force;
                 sub.gap = gap;
@@ -393,7 +392,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             sub.gap = gap;
             continue;
         }
-        dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt, &mut record.slip).1;
+        dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt).1;
         let response = match (cell, exact) {
             (Cell::Closed(anchor_gap, half), Some(e)) => cell_response(anchor_gap, e.slope, half, sub.area),
             (Cell::Closed(anchor_gap, _), None) => CellResponse::at_anchor(anchor_gap),

@@ -12,7 +12,7 @@ use std::ops::{Add, Mul, Sub};
 
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::ForceMoments;
-use super::{SubContact, SubContactRecord};
+use super::SubContact;
 use crate::law::{ConstitutiveLaw, JointAxes};
 use crate::math::{Real, Vector, Vector2};
 
@@ -155,7 +155,6 @@ impl LaneSums {
 #[inline(always)]
 pub(crate) fn update_group<L: ConstitutiveLaw>(
     group: &mut [SubContact<L::State>; LANES],
-    records: &mut [SubContactRecord],
     law: &L,
     frame: &ContactFrame,
     sums: &mut LaneSums,
@@ -167,7 +166,7 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
         Some(g) => face_gap(g, x, y),
         None => F4::from_fn(|l| group[l].gap) + du_n,
     };
-    for ((l, sub), record) in group.iter_mut().enumerate().zip(records.iter_mut()) {
+    for (l, sub) in group.iter_mut().enumerate() {
         let gap = gap.0[l];
         // A separated sub-contact that stays open: no force, no update (as the scalar loop).
         if frame.face_gap.is_some() && stays_separated(law, sub, gap) {
@@ -175,7 +174,7 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
             continue;
         }
         let du_s = Vector2::new(du_1.0[l], du_2.0[l]);
-        sums.dissipated += update_with_law(law, sub, gap, du_n.0[l], du_s, frame.axes, frame.dt, &mut record.slip).1;
+        sums.dissipated += update_with_law(law, sub, gap, du_n.0[l], du_s, frame.axes, frame.dt).1;
     }
     // The forces as the law left them (zero where skipped), read back lane by lane.
     let f = [

@@ -25,7 +25,6 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
     du_s: Vector2,
     axes: JointAxes,
     dt: Real,
-    slip: &mut Real,
 ) -> (JointStatus, Real) {
     let step = JointStep {
         area: sub.area,
@@ -56,7 +55,7 @@ pub(crate) fn update_with_law<L: ConstitutiveLaw>(
         0.0
     };
     if status == JointStatus::Sliding {
-        *slip += du_s.length();
+        sub.slip += du_s.length();
     }
     sub.gap = gap;
     sub.status = status;

@@ -147,9 +147,9 @@ mod tests {
 
     /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
     #[test]
-    fn subcontact_is_72_bytes_with_coulomb_state() {
+    fn subcontact_is_80_bytes_with_coulomb_state() {
         use crate::law::CoulombState;
-        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 72);
+        assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 80);
     }
 }
 
@@ -350,11 +350,11 @@ impl AnchorPlane {
     }
 }
 
-/// A sub-contact: a point of a joint with a tributary area (and, on a face, the half sizes of its
-/// cell), its spring forces and the law's state — what the step reads and writes for every
-/// sub-contact, and nothing else (72 bytes with [`crate::law::CoulombSlip`]'s state). Its position is given by
+/// A sub-contact: a point of a joint with a tributary area, its spring forces, its accumulated
+/// slip and the law's state — what the step reads and writes for every sub-contact, and nothing
+/// else (80 bytes with [`crate::law::CoulombSlip`]'s state). Its position is given by
 /// two coordinates on the contact's [`AnchorPlane`], its shear force by two components along the
-/// joint's tangents ([`JointAxes`]). Its identity, dashpot force and slip sit in a parallel
+/// joint's tangents ([`JointAxes`]). Its identity, dashpot force and gap offset sit in a parallel
 /// [`SubContactRecord`]; its world position and forces follow from the contact, see
 /// [`ContactView::point`], [`ContactView::shear_force`] and [`ContactView::total_force`].
 #[derive(Debug, Clone, PartialEq)]
@@ -365,6 +365,8 @@ pub(crate) struct SubContact<S> {
     /// Normal displacement `u_n` (m, positive = open).
     pub(crate) gap: Real,
     pub(crate) force: JointForce,
+    /// Accumulated slip while sliding (m).
+    pub(crate) slip: Real,
     /// Half sizes of the rectangle a face-face sub-contact's normal spring is integrated over
     /// (m, along the anchor plane's axes; `contact/spread.rs`), zero for a node.
     pub(crate) half: [f32; 2],
@@ -380,18 +382,16 @@ impl<S> SubContact<S> {
     }
 }
 
-/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity, dashpot force
-/// and accumulated slip. Stored in a parallel array (same index as the sub-contact), so that the
-/// step streams only the [`SubContact`]s and touches a record only while the sub-contact carries
-/// a dashpot force or slides.
+/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity and dashpot
+/// force. Stored in a parallel array (same index as the sub-contact), so that the step
+/// streams only the [`SubContact`]s and touches a record only while the sub-contact carries a
+/// dashpot force.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct SubContactRecord {
     pub(crate) key: SubKey,
     /// Stiffness-proportional (Rayleigh) dashpot force on `b` (world) of the last step; zero
     /// without Rayleigh damping.
     pub(crate) dashpot: Vector,
-    /// Accumulated slip while sliding (m): written only by a sliding step.
-    pub(crate) slip: Real,
 }
 
 impl SubContactRecord {
@@ -399,7 +399,6 @@ impl SubContactRecord {
         Self {
             key,
             dashpot: Vector::ZERO,
-            slip: 0.0,
         }
     }
 }

@@ -155,7 +155,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
             continue;
         }
         let before = axes.force(&sub.force);
-        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt, &mut record.slip);
+        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
         step.dissipated += lost;
         let spring = axes.force(&sub.force);
         spring_sum += (before + spring).dot(du);

@@ -394,7 +394,7 @@ impl<'a, S> SubContactView<'a, S> {
     /// Slip accumulated while sliding (m): the sum of the shear displacement increments of the
     /// steps that ended sliding.
     pub fn slip(&self) -> Real {
-        self.record.slip
+        self.sub.slip
     }
     /// Status after the last update.
     pub fn status(&self) -> JointStatus {

@@ -189,7 +189,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     area: s.area,
                     gap: s.gap,
                     force: s.force,
-                    slip: rec.slip,
+                    slip: s.slip,
                     half: s.half,
                     status: s.status,
                     state: s.state.clone(),
@@ -228,6 +228,7 @@ fn into_storage<S>(
                 area: s.area,
                 gap: s.gap,
                 force: s.force,
+                slip: s.slip,
                 half: s.half,
                 status: s.status,
                 state: s.state,
@@ -235,7 +236,6 @@ fn into_storage<S>(
             records.push(SubContactRecord {
                 key: s.key,
                 dashpot: s.dashpot,
-                slip: s.slip,
             });
         }
         pairs.push(ContactPair {

@@ -21,6 +21,7 @@ pub(super) fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord)
         area: 0.0,
         gap: 0.0,
         force: JointForce::default(),
+        slip: 0.0,
         half: [0.0; 2],
         status: JointStatus::Open,
         state: S::default(),
@@ -259,6 +260,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 area: seed.area,
                 gap: seed.gap,
                 force: JointForce::default(),
+                slip: 0.0,
                 half: [seed.half.x as f32, seed.half.y as f32],
                 status: JointStatus::Open,
                 state: S::default(),
@@ -281,6 +283,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                     sub.half = o.half;
                 }
                 sub.force = o.force;
+                sub.slip = o.slip;
                 sub.status = o.status;
                 sub.state = o.state.clone();
                 record = old_records[k].clone();
