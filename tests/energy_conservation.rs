@@ -266,8 +266,10 @@ fn undamped_block_at_rest_on_an_incline_stays_put() {
 #[test]
 fn undamped_wall_settles_without_walking() {
     let wall = |safety: Real| {
-        let mut params = ModelParameters::default();
-        params.time_step = voussoir::integrate::TimeStep::Auto { safety };
+        let params = ModelParameters {
+            time_step: voussoir::integrate::TimeStep::Auto { safety },
+            ..ModelParameters::default()
+        };
         let mut model = common::model_with(params, CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
         model.set_damping(Damping::None).expect("damping");
         let spec = WallSpec {

@@ -53,8 +53,10 @@ pub fn check_density_convergence<'py>(
         Some(h) => SubcontactDensity::Spacing(h),
         None => SubcontactDensity::PerEdge(subcontacts_per_edge),
     };
-    let mut params = voussoir::geometry::ContactParameters::default();
-    params.density = density;
+    let params = voussoir::geometry::ContactParameters {
+        density,
+        ..Default::default()
+    };
     params.validate().map_err(crate::errors::to_py)?;
     let refined_density = density.refined();
     let call =

@@ -311,6 +311,7 @@ fn impact_probe<L: ConstitutiveLaw>(
 /// coefficients (large displacements), `None` for gaps carried incrementally. Returns the
 /// spring-force sums in the joint axes, taken in sub-contact order, and the energy the law
 /// dissipated.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn update_elastic_first<L: ConstitutiveLaw>(
     subs: &mut [SubContact<L::State>],

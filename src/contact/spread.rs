@@ -113,7 +113,8 @@ fn straddling(gap: Real, slope: Vector2, half: Vector2, area: Real) -> CellRespo
     }
     let weight = area / (4.0 * half.x * half.y);
     let (i0, i1, i2) = (i0 * weight, i1 * weight, i2 * weight);
-    if !(i0 > 0.0) {
+    // Nothing closed (or a degenerate rectangle: NaN): no force.
+    if i0.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return CellResponse::at_anchor(0.0);
     }
     CellResponse {

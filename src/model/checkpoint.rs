@@ -660,12 +660,14 @@ where
                 per_x: anchored.per_x,
                 per_y: anchored.per_y,
             };
-            if !p.springs.force.is_finite()
-                || !placed.matches(&anchored)
-                || !((p.springs.per_x - anchored.per_x).length() <= reach(0) * (1.0 + 1e-9) + scale)
-                || !((p.springs.per_y - anchored.per_y).length() <= reach(1) * (1.0 + 1e-9) + scale)
-                || !(p.spread_energy >= 0.0 && p.spread_energy.is_finite())
-            {
+            let within = |offset: Vector, reach: Real| offset.length() <= reach * (1.0 + 1e-9) + scale;
+            let consistent = p.springs.force.is_finite()
+                && placed.matches(&anchored)
+                && within(p.springs.per_x - anchored.per_x, reach(0))
+                && within(p.springs.per_y - anchored.per_y, reach(1))
+                && p.spread_energy >= 0.0
+                && p.spread_energy.is_finite();
+            if !consistent {
                 return Err(corrupt(
                     &format!("contacts[{k}].springs"),
                     "inconsistent with the sub-contact forces",

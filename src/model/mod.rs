@@ -1135,7 +1135,7 @@ mod tests {
             sub.status = JointStatus::Elastic;
         }
         let mut subs = model.state.subs[model.state.pairs[0].range()].to_vec();
-        let law = model.state.laws.laws()[0].clone();
+        let law = model.state.laws.laws()[0];
         let poses = (model.state.blocks[0].state.pose, model.state.blocks[1].state.pose);
         model.state.pairs[0].refresh_springs(&mut subs, &law, Some((&poses.0, &poses.1)));
         let world_shears = |m: &Model| -> Vec<(SubKey, Vector)> {
