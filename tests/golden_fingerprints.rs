@@ -90,7 +90,7 @@ type Scene = (&'static str, fn() -> Model, u64, u64);
 /// The scenes.
 fn scenes() -> Vec<Scene> {
     vec![
-        ("cube flat", || cube_drop((0.0, 0.0)), 1500, 0xa03a_e468_9b44_dc5d),
+        ("cube flat", || cube_drop((0.0, 0.0)), 1500, 0x53a1_8e5e_3f76_82cf),
         ("cube on an edge", || cube_drop((0.5, 0.0)), 1500, 0x8de3_c88f_a6fc_a5d3),
         (
             "cube on a corner",
@@ -103,13 +103,13 @@ fn scenes() -> Vec<Scene> {
             "settling wall",
             || voussoir::scenes::benchmark_wall(300).expect("wall"),
             200,
-            0x4141_80fa_4f96_1db3,
+            0xf080_7837_1b7e_846f,
         ),
         (
             "shaking wall",
             || voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall"),
             400,
-            0x3f95_3205_bf46_2fbd,
+            0xf125_5737_bcd7_000f,
         ),
     ]
 }

@@ -327,10 +327,6 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     let mut sums = ForceMoments::default();
     let mut dissipated = 0.0;
     let mut spread_energy = 0.0;
-    // `Σ A h_x²`, `Σ A h_y²` of the all-closed cells in the elastic regime: their forces'
-    // offsets and spread energies are linear in them (`N c = −k_n J s`, `½ k_n J s²`), added
-    // once for the contact after the loop.
-    let (mut closed_x, mut closed_y) = (0.0, 0.0);
     for sub in subs.iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
@@ -380,9 +376,15 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                 sub.status = status;
                 match cell {
                     Cell::Closed(_, half) => {
+                        // `N c = −k_n J s` and `½ k_n J s²`, `J = A h²/3`: no division.
                         sums.add_joint(&force, sub.plane);
-                        closed_x += sub.area * half.x * half.x;
-                        closed_y += sub.area * half.y * half.y;
+                        if let Some(e) = exact {
+                            let (jx, jy) = (sub.area * half.x * half.x / 3.0, sub.area * half.y * half.y / 3.0);
+                            sums.per_x.x -= e.normal_stiffness * e.slope.x * jx;
+                            sums.per_y.x -= e.normal_stiffness * e.slope.y * jy;
+                            spread_energy +=
+                                0.5 * e.normal_stiffness * (jx * e.slope.x * e.slope.x + jy * e.slope.y * e.slope.y);
+                        }
                     }
                     Cell::Response(c) => exact.add(&mut sums, &mut spread_energy, sub, &c),
                 }
@@ -400,12 +402,6 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             (Cell::Response(c), _) => c,
         };
         exact.add(&mut sums, &mut spread_energy, sub, &response);
-    }
-    if let Some(e) = exact {
-        let (jx, jy) = (closed_x / 3.0, closed_y / 3.0);
-        sums.per_x.x -= e.normal_stiffness * e.slope.x * jx;
-        sums.per_y.x -= e.normal_stiffness * e.slope.y * jy;
-        spread_energy += 0.5 * e.normal_stiffness * (jx * e.slope.x * e.slope.x + jy * e.slope.y * e.slope.y);
     }
     (sums, dissipated, spread_energy)
 }
