@@ -647,6 +647,17 @@ where
             p.dashpots |= model.state.sub_records[p.range()]
                 .iter()
                 .any(|r| r.dashpot != Vector::ZERO);
+            // A cell's half sizes are lengths: finite (a huge number read into an `f32` is
+            // infinite, and would be saved as `null`) and not negative.
+            if let Some(j) = model.state.subs[p.range()]
+                .iter()
+                .position(|s| !s.half.iter().all(|h| h.is_finite() && *h >= 0.0))
+            {
+                return Err(corrupt(
+                    &format!("contacts[{k}].subcontacts[{j}].half"),
+                    "must be finite lengths, not negative",
+                ));
+            }
             // The stored spring moments are those of the stored forces, up to summation order,
             // with each normal force placed within its cell's rectangle (where the step put it,
             // `contact/spread.rs`, at the poses before the step's advance).
