@@ -103,13 +103,13 @@ fn scenes() -> Vec<Scene> {
             "settling wall",
             || voussoir::scenes::benchmark_wall(300).expect("wall"),
             200,
-            0xf080_7837_1b7e_846f,
+            0x7bf5_e9ea_cfc4_46ce,
         ),
         (
             "shaking wall",
             || voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall"),
             400,
-            0xf125_5737_bcd7_000f,
+            0x6069_46ef_736c_1df6,
         ),
     ]
 }

@@ -327,6 +327,8 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     let mut sums = ForceMoments::default();
     let mut dissipated = 0.0;
     let mut spread_energy = 0.0;
+    // `Σ J_xx`, `Σ J_yy` of the all-closed cells in the elastic regime, for their spread energy.
+    let mut closed_moments = Vector2::ZERO;
     for sub in subs.iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
@@ -379,11 +381,10 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                         // `N c = −k_n J s` and `½ k_n J s²`, `J = A h²/3`: no division.
                         sums.add_joint(&force, sub.plane);
                         if let Some(e) = exact {
-                            let (jx, jy) = (sub.area * half.x * half.x / 3.0, sub.area * half.y * half.y / 3.0);
+                            let (jx, jy) = (sub.area * half.x * half.x * THIRD, sub.area * half.y * half.y * THIRD);
                             sums.per_x.x -= e.normal_stiffness * e.slope.x * jx;
                             sums.per_y.x -= e.normal_stiffness * e.slope.y * jy;
-                            spread_energy +=
-                                0.5 * e.normal_stiffness * (jx * e.slope.x * e.slope.x + jy * e.slope.y * e.slope.y);
+                            closed_moments += Vector2::new(jx, jy);
                         }
                     }
                     Cell::Response(c) => exact.add(&mut sums, &mut spread_energy, sub, &c),
@@ -403,8 +404,17 @@ fn update_elastic_first<L: ConstitutiveLaw>(
         };
         exact.add(&mut sums, &mut spread_energy, sub, &response);
     }
+    // The all-closed cells' spread energy, `½ k_n (J_xx s_x² + J_yy s_y²)`, summed once.
+    if let Some(e) = exact {
+        spread_energy += 0.5
+            * e.normal_stiffness
+            * (closed_moments.x * e.slope.x * e.slope.x + closed_moments.y * e.slope.y * e.slope.y);
+    }
     (sums, dissipated, spread_energy)
 }
+
+/// One third.
+const THIRD: Real = 1.0 / 3.0;
 
 /// A cell as the elastic-regime loop sees it: all closed (the gap at the anchor and the half
 /// sizes: its force and moments are linear in them), or its [`CellResponse`].
