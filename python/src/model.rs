@@ -170,16 +170,23 @@ impl PyModel {
 
     /// Runs to `goal`, in chunks: the GIL is released during a chunk; between chunks Ctrl-C is
     /// looked for and, every `every` steps, `callback(step, time)` is called. Returns the steps
-    /// taken and whether the goal was reached (false: the callback returned False).
+    /// taken and whether the goal was reached (false: the callback returned a false value).
+    ///
+    /// The model is borrowed only while a chunk runs, not while the callback does: the callback
+    /// may read the model (time, ratios, positions, contacts, energies) and drive it (loads,
+    /// prescribed velocities, stopping by returning False).
     fn run(
-        &mut self,
-        py: Python<'_>,
+        slf: &Bound<'_, Self>,
         goal: Goal,
         callback: Option<&Bound<'_, PyAny>>,
         every: u64,
     ) -> PyResult<(u64, bool)> {
+        let py = slf.py();
         if every == 0 {
             return Err(bad("every: must be at least 1 step"));
+        }
+        if let Some(cb) = callback {
+            check_callback(py, cb)?;
         }
         match goal {
             Goal::Time(t) if !t.is_finite() => {
@@ -201,7 +208,9 @@ impl PyModel {
             } else {
                 u64::MAX
             };
-            let (model, samples) = (&mut self.model, &mut self.samples);
+            let mut guard = slf.borrow_mut();
+            let this = &mut *guard;
+            let (model, samples) = (&mut this.model, &mut this.samples);
             let outcome = py.detach(move || -> voussoir::Result<(u64, bool)> {
                 let start = Instant::now();
                 let mut n = 0u64;
@@ -234,9 +243,12 @@ impl PyModel {
                     n += 1;
                 }
             });
-            if let Some(e) = self.take_interrupt() {
+            if let Some(e) = this.take_interrupt() {
                 return Err(e);
             }
+            let (step, time) = (this.model.step_count(), this.model.time());
+            // The model is free again: the callback may read and drive it.
+            drop(guard);
             let (n, done) = outcome.py()?;
             taken += n;
             since_callback += n;
@@ -244,8 +256,9 @@ impl PyModel {
             if let Some(cb) = callback {
                 if since_callback >= every {
                     since_callback = 0;
-                    let answer = cb.call1((self.model.step_count(), self.model.time()))?;
-                    if answer.is(pyo3::types::PyBool::new(py, false)) {
+                    let answer = cb.call1((step, time))?;
+                    // None goes on; any false value (False, numpy.False_, 0) stops.
+                    if !answer.is_none() && !answer.is_truthy()? {
                         return Ok((taken, false));
                     }
                 }
@@ -255,6 +268,30 @@ impl PyModel {
             }
         }
     }
+}
+
+/// Refuses, before the first step, a callback that is not callable or cannot be called as
+/// `callback(step, time)` (its signature, where Python can tell it, does not bind two
+/// positional arguments).
+fn check_callback(py: Python<'_>, cb: &Bound<'_, PyAny>) -> PyResult<()> {
+    if !cb.is_callable() {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "callback: {} is not callable; expected callback(step, time)",
+            cb.get_type().name()?
+        )));
+    }
+    let Ok(signature) = py.import("inspect")?.call_method1("signature", (cb,)) else {
+        // A builtin without a signature: it is called as it is.
+        return Ok(());
+    };
+    if let Err(e) = signature.call_method1("bind", (0u64, 0.0f64)) {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "callback{}: cannot be called as callback(step, time): {}",
+            signature.str()?,
+            e.value(py).str()?
+        )));
+    }
+    Ok(())
 }
 
 fn component(s: &str) -> PyResult<Component> {
@@ -570,28 +607,30 @@ impl PyModel {
     // ---- running --------------------------------------------------------------------------
 
     /// One step.
-    fn step(&mut self, py: Python<'_>) -> PyResult<()> {
-        self.run(py, Goal::Steps(1), None, 1).map(|_| ())
+    fn step(slf: &Bound<'_, Self>) -> PyResult<()> {
+        Self::run(slf, Goal::Steps(1), None, 1).map(|_| ())
     }
 
     /// Runs ``n`` steps. ``callback(step, time)`` is called every ``every`` steps; the run stops
-    /// if it returns False (or raises). Returns True if all steps ran.
+    /// if it returns a false value (``False``, ``numpy.False_``; ``None`` goes on) or raises.
+    /// The model is free while the callback runs: it may read the model and drive it (loads,
+    /// prescribed velocities). A callback that is not callable, or cannot take ``(step, time)``,
+    /// is refused (``TypeError``) before the first step. Returns True if all steps ran.
     #[pyo3(signature = (n, callback=None, every=1000))]
-    fn run_steps(&mut self, py: Python<'_>, n: u64, callback: Option<&Bound<'_, PyAny>>, every: u64) -> PyResult<bool> {
-        Ok(self.run(py, Goal::Steps(n), callback, every)?.1)
+    fn run_steps(slf: &Bound<'_, Self>, n: u64, callback: Option<&Bound<'_, PyAny>>, every: u64) -> PyResult<bool> {
+        Ok(Self::run(slf, Goal::Steps(n), callback, every)?.1)
     }
 
     /// Runs until the simulated time reaches ``t`` (s); callback as ``run_steps``. Returns True
     /// if the time was reached.
     #[pyo3(signature = (t, callback=None, every=1000))]
     fn run_until_time(
-        &mut self,
-        py: Python<'_>,
+        slf: &Bound<'_, Self>,
         t: f64,
         callback: Option<&Bound<'_, PyAny>>,
         every: u64,
     ) -> PyResult<bool> {
-        Ok(self.run(py, Goal::Time(t), callback, every)?.1)
+        Ok(Self::run(slf, Goal::Time(t), callback, every)?.1)
     }
 
     /// Runs until the unbalanced-force ratio falls below ``ratio``; returns the steps taken.
@@ -599,24 +638,22 @@ impl PyModel {
     /// returns the steps taken so far).
     #[pyo3(signature = (ratio=1e-5, max_steps=1_000_000, callback=None, every=1000))]
     fn run_to_equilibrium(
-        &mut self,
-        py: Python<'_>,
+        slf: &Bound<'_, Self>,
         ratio: f64,
         max_steps: u64,
         callback: Option<&Bound<'_, PyAny>>,
         every: u64,
     ) -> PyResult<u64> {
-        Ok(self
-            .run(
-                py,
-                Goal::Equilibrium {
-                    target: ratio,
-                    max_steps,
-                },
-                callback,
-                every,
-            )?
-            .0)
+        Ok(Self::run(
+            slf,
+            Goal::Equilibrium {
+                target: ratio,
+                max_steps,
+            },
+            callback,
+            every,
+        )?
+        .0)
     }
 
     // ---- state ----------------------------------------------------------------------------

@@ -406,3 +406,41 @@ def test_density_convergence_refuses_what_it_cannot_run():
         vs.check_density_convergence(lambda **d: 1.0, subcontacts_per_edge=0)
     with pytest.raises(ZeroDivisionError):
         vs.check_density_convergence(lambda **d: 1 / 0)
+
+
+def test_callback_reads_and_drives_the_model():
+    """The README's callback, verbatim, and more: inside the callback the model is free, to be
+    read (time, step, ratios, positions, contacts, energies) and driven (a load, a prescribed
+    velocity)."""
+    m = block_on_base()
+    seen = []
+
+    def progress(step, t):
+        assert step == m.step_count and t == m.time
+        seen.append((m.unbalanced_force_ratio, m.displacements()[1, 2], len(m.contacts()["blocks"]), m.energies()["kinetic"]))
+        if step == 200:
+            m.set_load(1, force=(0.0, 0.0, -WEIGHT))
+        # The README's test (False would stop the run), read here without stopping.
+        return m.unbalanced_force_ratio > 1e-6 or True
+
+    assert m.run_steps(1_000, callback=progress, every=100)
+    assert len(seen) == 10 and all(np.isfinite(v).all() for v in map(np.array, seen))
+    # The added load (its own weight again) doubled the joint's normal force.
+    m.run_to_equilibrium(1e-6, 200_000)
+    assert abs(m.contacts()["normal_force"][0] - 2 * WEIGHT) < 1e-3 * WEIGHT
+
+
+def test_callback_false_values_stop_and_bad_callbacks_are_refused_before_the_first_step():
+    m = block_on_base()
+    assert not m.run_steps(1_000, callback=lambda step, t: np.False_, every=10)
+    assert m.step_count == 10
+    assert m.run_steps(30, callback=lambda step, t: None, every=10)
+    assert m.step_count == 40
+    for bad in (42, "progress", lambda: None, lambda a, b, c: None):
+        with pytest.raises(TypeError):
+            m.run_steps(100, callback=bad, every=10)
+        with pytest.raises(TypeError):
+            m.run_until_time(1.0, callback=bad)
+    assert m.step_count == 40, "refused before the first step"
+    # A callback with optional or variadic arguments is fine.
+    assert m.run_steps(10, callback=lambda *args: True, every=5)
