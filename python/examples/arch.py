@@ -4,7 +4,8 @@
     python python/examples/arch.py            # the baseline, as the command line runs it
     python python/examples/arch.py --quick    # coarse and fast (seconds), for a first look
 
-Plots the curve with matplotlib if it is installed (arch_static.png), else prints the table.
+Plots the curve with matplotlib if it is installed (arch_static.png, or arch_static_quick.png for
+the quick run, so that it does not overwrite the full run's), else prints the table.
 """
 
 import sys
@@ -16,7 +17,9 @@ EXPERIMENT_PEAK_KN = 2.71
 
 def main() -> None:
     quick = "--quick" in sys.argv
-    options = dict(per_edge=5, servo_increment=1e-4) if quick else {}
+    # Coarse joints, the default servo: five times its 20 µm increment is a 6 kN kick into the
+    # plate's seated joint (docs/benchmarks/arch-static.md), not a quasi-static load.
+    options = dict(per_edge=5, max_displacement=0.006) if quick else {}
     r = vs.scenarios.arch_static(**options)
     curve = r["curve"]
     print(
@@ -41,8 +44,9 @@ def main() -> None:
     ax.set_title("Arch under a quarter-span load")
     ax.legend()
     fig.tight_layout()
-    fig.savefig("arch_static.png", dpi=120)
-    print("wrote arch_static.png")
+    name = "arch_static_quick.png" if quick else "arch_static.png"
+    fig.savefig(name, dpi=120)
+    print(f"wrote {name}")
 
 
 if __name__ == "__main__":

@@ -184,11 +184,15 @@ fn wrap(blocks: Vec<RigidBlock>) -> Vec<PyBlock> {
 
 /// A circular segmental arch in the x–y plane (gravity along −y: use
 /// ``Model(gravity=(0, -9.81, 0))``), extruded along z by ``width``: the left abutment, the
-/// voussoirs from left to right, the right abutment; the abutments are fixed. Defaults: the
-/// reference arch of Pulatsu, Gonen & Lourenço (2021) (span 1.2 m, rise 0.4 m, ring 0.2 m, 13
-/// voussoirs, 24 kN/m³).
+/// voussoirs from left to right, the right abutment; the abutments are fixed.
+///
+/// ``span`` and ``rise`` are the clear span and the rise of the **intrados** (m; ``rise =
+/// span / 2`` gives a semicircle), ``thickness`` the radial ring thickness (m), ``width`` the
+/// depth along z (m), ``density`` the stones' density in kg/m³ (default 2446.5 kg/m³, a unit
+/// weight of 24 kN/m³). Defaults: the reference arch of Pulatsu, Gonen & Lourenço (2021) (span
+/// 1.2 m, rise 0.4 m, ring 0.2 m, 13 voussoirs).
 #[pyfunction]
-#[pyo3(signature = (*, span=1.2, rise=0.4, thickness=0.2, width=0.15, voussoirs=13, density=24_000.0 / 9.81,
+#[pyo3(signature = (*, span=1.2, rise=0.4, thickness=0.2, width=0.15, voussoirs=13, density=2446.4831804281343,
     abutment_outer_width=0.20, abutment_depth=0.30, voussoir_material=0, abutment_material=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn arch(

@@ -444,3 +444,16 @@ def test_callback_false_values_stop_and_bad_callbacks_are_refused_before_the_fir
     assert m.step_count == 40, "refused before the first step"
     # A callback with optional or variadic arguments is fine.
     assert m.run_steps(10, callback=lambda *args: True, every=5)
+
+
+def test_arch_documents_its_intrados_and_density():
+    """`build.arch` says that span and rise are the intrados' and shows its density default as a
+    number in kg/m³ (24 kN/m³ over g), not an ellipsis."""
+    import inspect
+
+    doc = vs.build.arch.__doc__
+    assert "intrados" in doc and "kg/m³" in doc
+    density = inspect.signature(vs.build.arch).parameters["density"].default
+    assert density == pytest.approx(24_000.0 / 9.81)
+    blocks = vs.build.arch()
+    assert len(blocks) == 15

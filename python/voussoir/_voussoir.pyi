@@ -276,7 +276,7 @@ def arch(
     thickness: float = 0.2,
     width: float = 0.15,
     voussoirs: int = 13,
-    density: float = ...,
+    density: float = 2446.4831804281343,
     abutment_outer_width: float = 0.20,
     abutment_depth: float = 0.30,
     voussoir_material: int = 0,
