@@ -378,14 +378,10 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                 sub.status = status;
                 match cell {
                     Cell::Closed(_, half) => {
-                        // `N c = −k_n J s` and `½ k_n J s²`, `J = A h²/3`: no division.
+                        // `N c = −k_n J s` and `½ k_n J s²`, `J = A h²/3`: summed over the
+                        // contact's all-closed cells as `Σ J` (the slope is the contact's).
                         sums.add_joint(&force, sub.plane);
-                        if let Some(e) = exact {
-                            let (jx, jy) = (sub.area * half.x * half.x * THIRD, sub.area * half.y * half.y * THIRD);
-                            sums.per_x.x -= e.normal_stiffness * e.slope.x * jx;
-                            sums.per_y.x -= e.normal_stiffness * e.slope.y * jy;
-                            closed_moments += Vector2::new(jx, jy);
-                        }
+                        closed_moments += sub.area * THIRD * (half * half);
                     }
                     Cell::Response(c) => exact.add(&mut sums, &mut spread_energy, sub, &c),
                 }
@@ -404,8 +400,11 @@ fn update_elastic_first<L: ConstitutiveLaw>(
         };
         exact.add(&mut sums, &mut spread_energy, sub, &response);
     }
-    // The all-closed cells' spread energy, `½ k_n (J_xx s_x² + J_yy s_y²)`, summed once.
+    // The all-closed cells' moments, `−k_n s Σ J`, and spread energy, `½ k_n (J_xx s_x² + J_yy s_y²)`,
+    // summed once.
     if let Some(e) = exact {
+        sums.per_x.x -= e.normal_stiffness * e.slope.x * closed_moments.x;
+        sums.per_y.x -= e.normal_stiffness * e.slope.y * closed_moments.y;
         spread_energy += 0.5
             * e.normal_stiffness
             * (closed_moments.x * e.slope.x * e.slope.x + closed_moments.y * e.slope.y * e.slope.y);

@@ -74,59 +74,146 @@ pub(crate) fn cell_response(gap: Real, slope: Vector2, half: Vector2, area: Real
     straddling(gap, slope, half, area)
 }
 
-/// A cell the line `g = 0` crosses: the rectangle clipped to its closed part, integrated by
-/// triangles (the edge-midpoint rule, exact for the quadratic integrands).
+/// A cell the line `g = 0` crosses, integrated in closed form (`docs/theory.md` §3).
+///
+/// In the unit square `u = x/h_x`, `v = y/h_y` the gap is `ḡ + p u + q v` with `p = s_x h_x`,
+/// `q = s_y h_y`; reflections make `p ≥ q ≥ 0` (they are undone on the first moments). For a
+/// given `v` the closed part of the row `u ∈ [−1, 1]` is `u < −c/p`, `c = ḡ + q v`: the whole row
+/// while `L = (p − c)/p ≥ 2` (region A), the first `L` of it while `0 < L < 2` (region B),
+/// nothing after (region C). `L = λ − κ v` with `λ = 1 − ḡ/p`, `κ = q/p ∈ [0, 1]` is linear in
+/// `v`, so the rows' integrals are polynomials in `v` on each region, integrated about the
+/// region's midpoint (every term positive or a centroid: no cancellation however thin the
+/// closed corner). Per row, `∫ max(−g, 0) du`, `∫ u max(−g, 0) du`, `∫ min(g, 0)² du` are
+/// `−2c`, `−2p/3`, `2c² + 2p²/3` in A and `p L²/2`, `p (L³/6 − L²/2)`, `p² L³/3` in B.
 #[cold]
 #[inline(never)]
 fn straddling(gap: Real, slope: Vector2, half: Vector2, area: Real) -> CellResponse {
-    let g = |r: Vector2| gap + slope.dot(r);
-    let corners = [
-        Vector2::new(-half.x, -half.y),
-        Vector2::new(half.x, -half.y),
-        Vector2::new(half.x, half.y),
-        Vector2::new(-half.x, half.y),
-    ];
-    let mut closed = [Vector2::ZERO; 6];
-    let mut n = 0;
-    for k in 0..4 {
-        let (a, b) = (corners[k], corners[(k + 1) % 4]);
-        let (ga, gb) = (g(a), g(b));
-        if ga <= 0.0 {
-            closed[n] = a;
-            n += 1;
-        }
-        if (ga <= 0.0) != (gb <= 0.0) {
-            closed[n] = a + (b - a) * (ga / (ga - gb));
-            n += 1;
-        }
+    let (px, py) = (slope.x * half.x, slope.y * half.y);
+    let swap = py.abs() > px.abs();
+    let (p, q) = if swap {
+        (py.abs(), px.abs())
+    } else {
+        (px.abs(), py.abs())
+    };
+    // Nothing closed (or a degenerate rectangle, or NaN): no force.
+    let usable = p > 0.0 && half.x > 0.0 && half.y > 0.0;
+    if !usable {
+        return CellResponse::at_anchor(0.0);
     }
-    let (mut i0, mut i1, mut i2) = (0.0, Vector2::ZERO, 0.0);
-    for k in 1..n.saturating_sub(1) {
-        let (a, b, c) = (closed[0], closed[k], closed[k + 1]);
-        let third_area = (b - a).perp_dot(c - a) / 6.0;
-        for m in [0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a)] {
-            let gm = g(m);
-            i0 -= third_area * gm;
-            i1 -= m * (third_area * gm);
-            i2 += third_area * gm * gm;
-        }
+    let inverse_p = 1.0 / p;
+    let (lambda, kappa) = (1.0 - gap * inverse_p, q * inverse_p);
+    // Region A is v ≤ v_a (L ≥ 2: q v ≤ −p − ḡ), region C is v ≥ v_c (L ≤ 0: q v ≥ p − ḡ),
+    // within [−1, 1].
+    let (v_a, v_c) = if q > 0.0 {
+        let inverse_q = 1.0 / q;
+        (
+            ((-p - gap) * inverse_q).clamp(-1.0, 1.0),
+            ((p - gap) * inverse_q).clamp(-1.0, 1.0),
+        )
+    } else if lambda >= 2.0 {
+        (1.0, 1.0)
+    } else if lambda <= 0.0 {
+        (-1.0, -1.0)
+    } else {
+        (-1.0, 1.0)
+    };
+    // Integrals over the unit square: ∫ max(−g, 0), ∫ u max(−g, 0), ∫ v max(−g, 0), ∫ min(g, 0)².
+    let (mut i0, mut iu, mut iv, mut i2) = (0.0, 0.0, 0.0, 0.0);
+    let t = v_a + 1.0;
+    if t > 0.0 {
+        let vm = 0.5 * (v_a - 1.0);
+        let cm = gap + q * vm;
+        let t3 = t * t * t / 12.0;
+        i0 -= 2.0 * t * cm;
+        iu -= 2.0 * p * t / 3.0;
+        iv -= 2.0 * (t * vm * cm + q * t3);
+        i2 += 2.0 * (t * cm * cm + q * q * t3) + 2.0 * p * p * t / 3.0;
     }
-    let weight = area / (4.0 * half.x * half.y);
-    let (i0, i1, i2) = (i0 * weight, i1 * weight, i2 * weight);
-    // Nothing closed (or a degenerate rectangle: NaN): no force.
+    let t = v_c - v_a;
+    if t > 0.0 {
+        let vm = 0.5 * (v_a + v_c);
+        let lm = lambda - kappa * vm;
+        let kt2 = kappa * kappa * t * t;
+        // ∫ L², ∫ L³, ∫ v L² over the region.
+        let j2 = t * (lm * lm + kt2 / 12.0);
+        let j3 = t * lm * (lm * lm + kt2 / 4.0);
+        let jv2 = vm * j2 - lm * kappa * t * t * t / 6.0;
+        i0 += 0.5 * p * j2;
+        iu += p * (j3 / 6.0 - 0.5 * j2);
+        iv += 0.5 * p * jv2;
+        i2 += p * p * j3 / 3.0;
+    }
+    // Back to the cell: reflections and the swap undone, the rectangle's scale and weight.
+    let (mut mx, mut my) = if swap { (iv, iu) } else { (iu, iv) };
+    if px < 0.0 {
+        mx = -mx;
+    }
+    if py < 0.0 {
+        my = -my;
+    }
+    // Over the cell, `∫ = (A/4) ∫∫ du dv`.
     if i0.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return CellResponse::at_anchor(0.0);
     }
+    let offset = Vector2::new(mx * half.x, my * half.y) * (1.0 / i0);
     CellResponse {
-        law_gap: -i0 / area,
-        offset: i1 / i0,
-        excess_energy: (0.5 * (i2 - i0 * i0 / area)).max(0.0),
+        law_gap: -0.25 * i0,
+        offset: offset.clamp(-half, half),
+        excess_energy: (0.125 * area * (i2 - 0.25 * i0 * i0)).max(0.0),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The former integration, kept as a reference: the rectangle clipped to its closed part,
+    /// integrated by triangles (the edge-midpoint rule, exact for the quadratic integrands).
+    fn straddling_by_triangles(gap: Real, slope: Vector2, half: Vector2, area: Real) -> CellResponse {
+        let g = |r: Vector2| gap + slope.dot(r);
+        let corners = [
+            Vector2::new(-half.x, -half.y),
+            Vector2::new(half.x, -half.y),
+            Vector2::new(half.x, half.y),
+            Vector2::new(-half.x, half.y),
+        ];
+        let mut closed = [Vector2::ZERO; 6];
+        let mut n = 0;
+        for k in 0..4 {
+            let (a, b) = (corners[k], corners[(k + 1) % 4]);
+            let (ga, gb) = (g(a), g(b));
+            if ga <= 0.0 {
+                closed[n] = a;
+                n += 1;
+            }
+            if (ga <= 0.0) != (gb <= 0.0) {
+                closed[n] = a + (b - a) * (ga / (ga - gb));
+                n += 1;
+            }
+        }
+        let (mut i0, mut i1, mut i2) = (0.0, Vector2::ZERO, 0.0);
+        for k in 1..n.saturating_sub(1) {
+            let (a, b, c) = (closed[0], closed[k], closed[k + 1]);
+            let third_area = (b - a).perp_dot(c - a) / 6.0;
+            for m in [0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a)] {
+                let gm = g(m);
+                i0 -= third_area * gm;
+                i1 -= m * (third_area * gm);
+                i2 += third_area * gm * gm;
+            }
+        }
+        let weight = area / (4.0 * half.x * half.y);
+        let (i0, i1, i2) = (i0 * weight, i1 * weight, i2 * weight);
+        // Nothing closed (or a degenerate rectangle: NaN): no force.
+        if i0.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return CellResponse::at_anchor(0.0);
+        }
+        CellResponse {
+            law_gap: -i0 / area,
+            offset: i1 / i0,
+            excess_energy: (0.5 * (i2 - i0 * i0 / area)).max(0.0),
+        }
+    }
 
     /// `∫ max(−g, 0)`, `∫ r max(−g, 0)`, `∫ min(g, 0)²` over the rectangle by a fine midpoint
     /// grid.
@@ -172,6 +259,43 @@ mod tests {
                 );
             } else {
                 assert!(c.law_gap >= 0.0 && c.excess_energy == 0.0);
+            }
+        }
+    }
+
+    /// The closed form agrees with the clipped rectangle integrated by triangles, over slopes
+    /// of both signs and either axis dominant, one component zero, and gaps from a sliver of a
+    /// closed corner to a sliver of an open one.
+    #[test]
+    fn the_closed_form_matches_the_clipped_rectangle() {
+        let half = Vector2::new(0.03, 0.012);
+        let area = 0.9 * 4.0 * half.x * half.y;
+        for slope in [
+            Vector2::new(2e-3, -1.5e-3),
+            Vector2::new(-2e-4, 3e-3),
+            Vector2::new(-1e-3, -1e-3),
+            Vector2::new(1e-3, 0.0),
+            Vector2::new(0.0, -2e-3),
+            Vector2::new(3e-3, 1e-9),
+        ] {
+            let spread = slope.x.abs() * half.x + slope.y.abs() * half.y;
+            for f in [
+                -0.999999, -0.99, -0.7, -0.3, -1e-3, 0.0, 0.2, 0.5, 0.9, 0.9999, 0.999999,
+            ] {
+                let gap = f * spread;
+                let (a, b) = (
+                    straddling(gap, slope, half, area),
+                    straddling_by_triangles(gap, slope, half, area),
+                );
+                let (fa, fb) = (-a.law_gap * area, -b.law_gap * area);
+                // Relative to the force of the cell fully compressed by the spread.
+                let scale = spread * area;
+                let e = ((fa - fb).abs() / scale)
+                    .max((a.offset * fa - b.offset * fb).length() / (scale * half.x))
+                    .max((a.excess_energy - b.excess_energy).abs() / (scale * spread));
+                assert!(fa > 0.0 && e < 1e-12, "slope {slope}, gap {gap}: {a:?} vs {b:?}");
+                // The force acts within the cell.
+                assert!(a.offset.abs().cmple(half).all());
             }
         }
     }
