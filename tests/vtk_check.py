@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Reads voussoir's VTU output back with VTK and checks it.
 
-usage: vtk_check.py BLOCKS.vtu CONTACTS.vtu PVD N_BLOCKS TOTAL_VOLUME N_SUBCONTACTS TOTAL_AREA
+usage: vtk_check.py BLOCKS.vtu CONTACTS.vtu PVD SURFACES.vtu N_BLOCKS TOTAL_VOLUME N_SUBCONTACTS
+    TOTAL_AREA N_FACES TOTAL_SURFACE
 Exit status 0 when everything matches; prints what it measured.
 """
 import sys
@@ -19,8 +20,9 @@ def read(path):
 
 
 def main():
-    blocks, contacts, pvd = sys.argv[1:4]
-    n_blocks, volume, n_subs, area = int(sys.argv[4]), float(sys.argv[5]), int(sys.argv[6]), float(sys.argv[7])
+    blocks, contacts, pvd, surfaces = sys.argv[1:5]
+    n_blocks, volume, n_subs, area = int(sys.argv[5]), float(sys.argv[6]), int(sys.argv[7]), float(sys.argv[8])
+    n_faces, surface = int(sys.argv[9]), float(sys.argv[10])
     g = read(blocks)
     assert g.GetNumberOfCells() == n_blocks, (g.GetNumberOfCells(), n_blocks)
     types = {g.GetCellType(i) for i in range(g.GetNumberOfCells())}
@@ -38,6 +40,20 @@ def main():
     for name in ("material", "displacement", "velocity", "rotation", "fixed"):
         assert g.GetCellData().GetArray(name) is not None, name
 
+    s = read(surfaces)
+    assert s.GetNumberOfCells() == n_faces, (s.GetNumberOfCells(), n_faces)
+    types = {s.GetCellType(i) for i in range(s.GetNumberOfCells())}
+    assert types <= {vtk.VTK_TRIANGLE, vtk.VTK_QUAD, vtk.VTK_POLYGON}, types
+    q = vtk.vtkCellSizeFilter()
+    q.SetInputData(s)
+    q.SetComputeArea(True)
+    q.Update()
+    areas = q.GetOutput().GetCellData().GetArray("Area")
+    total_surface = sum(areas.GetValue(i) for i in range(areas.GetNumberOfTuples()))
+    assert abs(total_surface - surface) < 1e-9 * surface, (total_surface, surface)
+    ids = s.GetCellData().GetArray("block_id")
+    assert sorted({int(ids.GetValue(i)) for i in range(n_faces)}) == list(range(n_blocks))
+
     c = read(contacts)
     assert c.GetNumberOfPoints() == n_subs, (c.GetNumberOfPoints(), n_subs)
     assert c.GetNumberOfCells() == n_subs
@@ -52,6 +68,7 @@ def main():
         p.SetFileName(pvd)
         p.UpdateInformation()
     print(f"VTK {vtk.vtkVersion.GetVTKVersion()}: {n_blocks} polyhedra, volume {total:.12g} m3, "
+          f"{n_faces} faces, area {total_surface:.12g} m2, "
           f"{n_subs} sub-contacts, area {total_area:.12g} m2")
 
 

@@ -3,7 +3,8 @@
 //!
 //! The structure of the files is checked here in Rust. With `VOUSSOIR_VTK_CHECK=1` (set by
 //! `.ci/run`, which installs VTK's Python package) the files are also read by VTK itself, which
-//! checks cell counts, cell types, the total volume of the polyhedra and the sub-contact areas.
+//! checks cell counts, cell types, the total volume of the polyhedra, the total area of the
+//! face polygons the series writes and the sub-contact areas.
 
 mod common;
 
@@ -49,10 +50,22 @@ fn vtu_frames_are_read_back_by_vtk() -> Result<()> {
     series.write_frame(&model)?;
     assert_eq!(series.len(), 2);
 
-    let blocks = dir.join("demo_blocks_00001.vtu");
+    // The series writes the blocks as the polygons of their faces (meshio reads them too);
+    // `write_blocks` writes them as polyhedra.
+    let surfaces = dir.join("demo_blocks_00001.vtu");
     let contacts = dir.join("demo_contacts_00001.vtu");
+    let blocks = dir.join("polyhedra.vtu");
+    voussoir::io::vtk::write_blocks(&blocks, model.blocks(), |i| *model.blocks()[i].initial_pose())?;
     let text = std::fs::read_to_string(&blocks).expect("blocks file");
     assert!(text.contains("NumberOfCells=\"3\"") && text.contains("Name=\"faces\""));
+    let faces: usize = model.blocks().iter().map(|b| b.shape().faces().len()).sum();
+    let surface: f64 = model
+        .blocks()
+        .iter()
+        .flat_map(|b| b.shape().faces().iter().map(|f| f.area))
+        .sum();
+    let text = std::fs::read_to_string(&surfaces).expect("surfaces file");
+    assert!(text.contains(&format!("NumberOfCells=\"{faces}\"")) && text.contains("Name=\"face\""));
     let pvd = std::fs::read_to_string(series.blocks_pvd()).expect("pvd");
     assert_eq!(pvd.matches("<DataSet").count(), 2);
 
@@ -66,12 +79,14 @@ fn vtu_frames_are_read_back_by_vtk() -> Result<()> {
         let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/vtk_check.py");
         let out = Command::new("python3")
             .arg(script)
-            .args([&blocks, &contacts, &series.blocks_pvd()])
+            .args([&blocks, &contacts, &series.blocks_pvd(), &surfaces])
             .args([
                 model.blocks().len().to_string(),
                 volume.to_string(),
                 model.subcontact_count().to_string(),
                 area.to_string(),
+                faces.to_string(),
+                surface.to_string(),
             ])
             .output()
             .expect("python3 runs");

@@ -1027,10 +1027,22 @@ contact_resultant, energy or unbalanced_ratio"
         voussoir::io::csv::write_history(&path, &h).py()
     }
 
-    /// Writes the blocks as a ParaView file (``.vtu``) at ``path``.
-    fn write_vtk_blocks(&self, path: PathBuf) -> PyResult<()> {
+    /// Writes the blocks as a ParaView file (``.vtu``) at ``path``: with ``cells="surfaces"``
+    /// (the default, as ``ParaviewSeries`` writes them) one polygon per face, with the block's
+    /// cell data on each face and ``face``, which ParaView and meshio both read; with
+    /// ``cells="polyhedra"`` one polyhedron cell per block (ParaView; meshio cannot read blocks
+    /// of different vertex counts as polyhedra).
+    #[pyo3(signature = (path, *, cells = "surfaces"))]
+    fn write_vtk_blocks(&self, path: PathBuf, cells: &str) -> PyResult<()> {
         let blocks = self.model.blocks();
-        voussoir::io::vtk::write_blocks(&path, blocks, |i| *blocks[i].initial_pose()).py()
+        let initial = |i: usize| *blocks[i].initial_pose();
+        match cells {
+            "surfaces" => voussoir::io::vtk::write_block_surfaces(&path, blocks, initial).py(),
+            "polyhedra" => voussoir::io::vtk::write_blocks(&path, blocks, initial).py(),
+            other => Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "cells must be \"surfaces\" or \"polyhedra\", not {other:?}"
+            ))),
+        }
     }
 
     /// Writes the sub-contacts (points with forces, stresses, status) as a ParaView file

@@ -28,6 +28,36 @@ def test_paraview(tmp_path, model):
     assert pvd.exists() and len(ET.parse(pvd).getroot().findall(".//DataSet")) == 3
 
 
+def test_paraview_files_read_by_meshio(tmp_path, model):
+    """The blocks and sub-contacts a series writes, and both kinds of block file, read back by
+    meshio (the usual Python mesh reader) with the model's numbers."""
+    meshio = pytest.importorskip("meshio")
+    model.run_steps(50)
+    series = vs.ParaviewSeries(tmp_path, "demo")
+    series.write_frame(model)
+    blocks = meshio.read(tmp_path / "demo_blocks_00000.vtu")
+    faces = sum(len(b) for b in blocks.cells)
+    ids = np.concatenate(blocks.cell_data["block_id"])
+    assert sorted(set(ids.tolist())) == list(range(model.block_count))
+    # Six quadrilateral faces a cuboid, each face carrying its block's displacement.
+    assert faces == 6 * model.block_count
+    displacement = np.concatenate(blocks.cell_data["displacement"])
+    for i in range(model.block_count):
+        want = model.displacements()[i]
+        assert np.allclose(displacement[ids == i], want, rtol=0, atol=1e-15)
+    subs = meshio.read(tmp_path / "demo_contacts_00000.vtu")
+    assert len(subs.points) == model.subcontact_count
+    assert subs.point_data["area"].sum() == pytest.approx(model.subcontacts()["area"].sum(), rel=1e-12)
+    model.write_vtk_blocks(tmp_path / "surfaces.vtu")
+    assert sum(len(b) for b in meshio.read(tmp_path / "surfaces.vtu").cells) == faces
+    # Polyhedra: ParaView's; meshio reads cuboids (all of one vertex count) as such.
+    model.write_vtk_blocks(tmp_path / "poly.vtu", cells="polyhedra")
+    poly = meshio.read(tmp_path / "poly.vtu")
+    assert sum(len(b) for b in poly.cells) == model.block_count
+    with pytest.raises(ValueError, match="surfaces"):
+        model.write_vtk_blocks(tmp_path / "x.vtu", cells="solids")
+
+
 def test_history_csv(tmp_path, model):
     model.add_monitor("ux", "displacement", block=1, point=(0.2, 0.15, 0.1), component="x")
     model.add_monitor("Ek", "energy", term="kinetic")

@@ -1,5 +1,6 @@
-//! ParaView output: VTU files with real polyhedron cells (VTK cell type 42) for the blocks, a
-//! point set for the sub-contacts, and `.pvd` collections for time series.
+//! ParaView output: VTU files of the blocks (as polyhedron cells, VTK type 42, or as the polygons
+//! of their faces, which meshio reads too), a point set for the sub-contacts, and `.pvd`
+//! collections for time series.
 //!
 //! The arrays are inline binary (base64, little-endian, exact), readable by any VTK ≥ 8.1 reader
 //! and ParaView.
@@ -17,6 +18,10 @@ use crate::model::Model;
 const VTK_POLYHEDRON: u8 = 42;
 /// VTK cell type of a vertex.
 const VTK_VERTEX: u8 = 1;
+/// VTK cell types of a triangle, a quad and a general polygon.
+const VTK_TRIANGLE: u8 = 5;
+const VTK_QUAD: u8 = 9;
+const VTK_POLYGON: u8 = 7;
 
 /// Sub-contact state codes written to the `state` array.
 pub const STATE_CODES: &str = "0 elastic, 1 sliding, 2 open, 3 failed";
@@ -25,74 +30,190 @@ pub const STATE_CODES: &str = "0 elastic, 1 sliding, 2 open, 3 failed";
 /// `displacement` (of the centroid, m), `velocity` (m/s), `rotation` (rotation vector from the
 /// initial pose, rad) and `fixed` (1 when all degrees of freedom are constrained).
 ///
+/// ParaView reads it; meshio (5.3) does not read blocks of different vertex counts as
+/// polyhedra: [`write_block_surfaces`] writes the same blocks as polygons, which both read.
+///
 /// # Errors
 /// [`crate::Error::Io`] naming the file.
 pub fn write_blocks<B: Block>(path: &Path, blocks: &[B], initial: impl Fn(usize) -> crate::math::Pose) -> Result<()> {
-    let mut points: Vec<f64> = Vec::new();
+    let data = BlockData::of(blocks, initial);
     let mut connectivity: Vec<i64> = Vec::new();
     let mut offsets: Vec<i64> = Vec::with_capacity(blocks.len());
     let mut faces: Vec<i64> = Vec::new();
     let mut face_offsets: Vec<i64> = Vec::with_capacity(blocks.len());
-    let mut n_points = 0i64;
-    for b in blocks {
+    for (b, &first) in blocks.iter().zip(&data.first_point) {
         let shape = b.shape();
-        let pose = &b.state().pose;
-        for v in shape.vertices() {
-            points.extend(pose.transform_point(*v).to_array());
-        }
-        connectivity.extend((0..shape.vertices().len() as i64).map(|k| n_points + k));
+        connectivity.extend((0..shape.vertices().len() as i64).map(|k| first + k));
         offsets.push(connectivity.len() as i64);
         faces.push(shape.faces().len() as i64);
         for f in 0..shape.faces().len() {
             let ids = shape.face_loop(f);
             faces.push(ids.len() as i64);
-            faces.extend(ids.iter().map(|&i| n_points + i as i64));
+            faces.extend(ids.iter().map(|&i| first + i as i64));
         }
         face_offsets.push(faces.len() as i64);
-        n_points += shape.vertices().len() as i64;
     }
     let n = blocks.len();
-    let (mut displacement, mut velocity, mut rotation) = (
-        Vec::with_capacity(3 * n),
-        Vec::with_capacity(3 * n),
-        Vec::with_capacity(3 * n),
-    );
-    let (mut block_id, mut material, mut fixed) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
-    for (i, b) in blocks.iter().enumerate() {
-        let s = b.state();
-        let p0 = initial(i);
-        rotation.extend((s.pose.rotation * p0.rotation.inverse()).to_scaled_axis().to_array());
-        displacement.extend((s.pose.translation - p0.translation).to_array());
-        velocity.extend(s.velocity.to_array());
-        block_id.push(i as i32);
-        material.push(i32::from(b.material().0));
-        let all = b
-            .fixity()
-            .translation
-            .iter()
-            .chain(&b.fixity().rotation)
-            .all(|d| d.prescribed().is_some());
-        fixed.push(u8::from(all));
-    }
-    let mut out = String::with_capacity(points.len() * 12);
-    header(&mut out, n_points as usize, n);
-    data_array(&mut out, "Points", 3, Values::F64(&points), true);
+    let mut out = String::with_capacity(data.points.len() * 12);
+    header(&mut out, data.points.len() / 3, n);
+    data_array(&mut out, "Points", 3, Values::F64(&data.points), true);
     out.push_str("</Points>\n<Cells>\n");
     data_array(&mut out, "connectivity", 1, Values::I64(&connectivity), false);
     data_array(&mut out, "offsets", 1, Values::I64(&offsets), false);
     data_array(&mut out, "types", 1, Values::U8(&vec![VTK_POLYHEDRON; n]), false);
     data_array(&mut out, "faces", 1, Values::I64(&faces), false);
     data_array(&mut out, "faceoffsets", 1, Values::I64(&face_offsets), false);
-    out.push_str("</Cells>\n<CellData Scalars=\"block_id\" Vectors=\"displacement\">\n");
-    data_array(&mut out, "block_id", 1, Values::I32(&block_id), false);
-    data_array(&mut out, "material", 1, Values::I32(&material), false);
-    data_array(&mut out, "fixed", 1, Values::U8(&fixed), false);
-    data_array(&mut out, "displacement", 3, Values::F64(&displacement), false);
-    data_array(&mut out, "velocity", 3, Values::F64(&velocity), false);
-    data_array(&mut out, "rotation", 3, Values::F64(&rotation), false);
-    out.push_str("</CellData>\n");
+    out.push_str("</Cells>\n");
+    data.cell_data(&mut out, |_| 1, None);
     footer(&mut out);
     write_file(path, &out)
+}
+
+/// Writes the blocks as one VTU file of polygon cells, one per face (VTK triangles, quads and
+/// polygons): the cell data of [`write_blocks`] repeated on each face of a block, and `face`
+/// (the face's index in its block). ParaView draws it as [`write_blocks`]'s polyhedra, and
+/// readers without polyhedra (meshio) read it; the [`Series`] writes its blocks so.
+///
+/// # Errors
+/// [`crate::Error::Io`] naming the file.
+pub fn write_block_surfaces<B: Block>(
+    path: &Path,
+    blocks: &[B],
+    initial: impl Fn(usize) -> crate::math::Pose,
+) -> Result<()> {
+    let data = BlockData::of(blocks, initial);
+    let mut connectivity: Vec<i64> = Vec::new();
+    let (mut offsets, mut types, mut face_counts, mut face_index) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (b, &first) in blocks.iter().zip(&data.first_point) {
+        let shape = b.shape();
+        face_counts.push(shape.faces().len());
+        for f in 0..shape.faces().len() {
+            let ids = shape.face_loop(f);
+            connectivity.extend(ids.iter().map(|&i| first + i as i64));
+            offsets.push(connectivity.len() as i64);
+            types.push(match ids.len() {
+                3 => VTK_TRIANGLE,
+                4 => VTK_QUAD,
+                _ => VTK_POLYGON,
+            });
+            face_index.push(f as i32);
+        }
+    }
+    let mut out = String::with_capacity(data.points.len() * 12);
+    header(&mut out, data.points.len() / 3, types.len());
+    data_array(&mut out, "Points", 3, Values::F64(&data.points), true);
+    out.push_str("</Points>\n<Cells>\n");
+    data_array(&mut out, "connectivity", 1, Values::I64(&connectivity), false);
+    data_array(&mut out, "offsets", 1, Values::I64(&offsets), false);
+    data_array(&mut out, "types", 1, Values::U8(&types), false);
+    out.push_str("</Cells>\n");
+    data.cell_data(&mut out, |i| face_counts[i], Some(&face_index));
+    footer(&mut out);
+    write_file(path, &out)
+}
+
+/// The blocks' points (world) and per-block cell data, shared by the two block writers.
+struct BlockData {
+    points: Vec<f64>,
+    /// Index of each block's first point.
+    first_point: Vec<i64>,
+    block_id: Vec<i32>,
+    material: Vec<i32>,
+    fixed: Vec<u8>,
+    displacement: Vec<f64>,
+    velocity: Vec<f64>,
+    rotation: Vec<f64>,
+}
+
+impl BlockData {
+    fn of<B: Block>(blocks: &[B], initial: impl Fn(usize) -> crate::math::Pose) -> Self {
+        let n = blocks.len();
+        let mut d = Self {
+            points: Vec::new(),
+            first_point: Vec::with_capacity(n),
+            block_id: Vec::with_capacity(n),
+            material: Vec::with_capacity(n),
+            fixed: Vec::with_capacity(n),
+            displacement: Vec::with_capacity(3 * n),
+            velocity: Vec::with_capacity(3 * n),
+            rotation: Vec::with_capacity(3 * n),
+        };
+        for (i, b) in blocks.iter().enumerate() {
+            let s = b.state();
+            d.first_point.push((d.points.len() / 3) as i64);
+            for v in b.shape().vertices() {
+                d.points.extend(s.pose.transform_point(*v).to_array());
+            }
+            let p0 = initial(i);
+            d.rotation
+                .extend((s.pose.rotation * p0.rotation.inverse()).to_scaled_axis().to_array());
+            d.displacement.extend((s.pose.translation - p0.translation).to_array());
+            d.velocity.extend(s.velocity.to_array());
+            d.block_id.push(i as i32);
+            d.material.push(i32::from(b.material().0));
+            let all = b
+                .fixity()
+                .translation
+                .iter()
+                .chain(&b.fixity().rotation)
+                .all(|d| d.prescribed().is_some());
+            d.fixed.push(u8::from(all));
+        }
+        d
+    }
+
+    /// Writes the cell data, each block's values repeated on its `cells(block)` cells, and the
+    /// `face` array when given.
+    fn cell_data(&self, out: &mut String, cells: impl Fn(usize) -> usize, face: Option<&[i32]>) {
+        fn repeat<T: Copy>(values: &[T], width: usize, cells: &impl Fn(usize) -> usize) -> Vec<T> {
+            values
+                .chunks(width)
+                .enumerate()
+                .flat_map(|(i, v)| std::iter::repeat_n(v, cells(i)).flatten().copied())
+                .collect()
+        }
+        out.push_str("<CellData Scalars=\"block_id\" Vectors=\"displacement\">\n");
+        data_array(
+            out,
+            "block_id",
+            1,
+            Values::I32(&repeat(&self.block_id, 1, &cells)),
+            false,
+        );
+        data_array(
+            out,
+            "material",
+            1,
+            Values::I32(&repeat(&self.material, 1, &cells)),
+            false,
+        );
+        data_array(out, "fixed", 1, Values::U8(&repeat(&self.fixed, 1, &cells)), false);
+        data_array(
+            out,
+            "displacement",
+            3,
+            Values::F64(&repeat(&self.displacement, 3, &cells)),
+            false,
+        );
+        data_array(
+            out,
+            "velocity",
+            3,
+            Values::F64(&repeat(&self.velocity, 3, &cells)),
+            false,
+        );
+        data_array(
+            out,
+            "rotation",
+            3,
+            Values::F64(&repeat(&self.rotation, 3, &cells)),
+            false,
+        );
+        if let Some(face) = face {
+            data_array(out, "face", 1, Values::I32(face), false);
+        }
+        out.push_str("</CellData>\n");
+    }
 }
 
 /// Writes the sub-contacts of a model as a VTU point set with point data `normal_force` (N,
@@ -192,9 +313,16 @@ fn data_array(out: &mut String, name: &str, components: usize, values: Values<'_
     } else {
         format!(" Name=\"{name}\"")
     };
+    // One component is VTK's default, and left out: readers that reshape every array to its
+    // stated components (meshio) then read the cells' index arrays as the flat lists they are.
+    let components_attr = if components == 1 {
+        String::new()
+    } else {
+        format!(" NumberOfComponents=\"{components}\"")
+    };
     let _ = writeln!(
         out,
-        "<DataArray type=\"{ty}\"{name_attr} NumberOfComponents=\"{components}\" format=\"binary\">"
+        "<DataArray type=\"{ty}\"{name_attr}{components_attr} format=\"binary\">"
     );
     let mut block = Vec::with_capacity(8 + bytes.len());
     block.extend((bytes.len() as u64).to_le_bytes());
@@ -470,7 +598,7 @@ impl Series {
         let blocks = format!("{}_blocks_{k:05}.vtu", self.name);
         let contacts = format!("{}_contacts_{k:05}.vtu", self.name);
         let initial = |i: usize| *model.blocks()[i].initial_pose();
-        write_blocks(&self.dir.join(&blocks), model.blocks(), initial)?;
+        write_block_surfaces(&self.dir.join(&blocks), model.blocks(), initial)?;
         write_subcontacts(&self.dir.join(&contacts), model)?;
         self.frames.push((model.time(), blocks, contacts));
         self.write_collections()
