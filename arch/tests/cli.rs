@@ -283,3 +283,52 @@ fn arch_static_fails_when_a_case_is_not_converged() {
     assert_eq!(c["checked"], true);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The first command writes what a user looks at (issue 32): ParaView frames of one setup's
+/// central run by default, M60H20's, its sub-contacts on every fifth frame; the others with
+/// `--paraview-setups`. Here M60H20 alone at its central drop height, 0.3 s (31 block frames,
+/// 7 sub-contact frames); measured 5.1 MB (the full second: 15 MB, the whole first command 19 MB,
+/// 278 MB before).
+#[test]
+fn the_first_command_writes_one_paraview_series_of_modest_size() {
+    let dir = std::env::temp_dir().join(format!("voussoir-first-command-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("mkdir");
+    let args = [
+        "--out",
+        "out",
+        "--setup",
+        "M60H20,M60H25",
+        "--offsets",
+        "0",
+        "--duration",
+        "0.3",
+    ];
+    let (code, stderr, _) = run_example("arch_impact", &args, &dir);
+    assert_eq!(code, Some(0), "{stderr}");
+    let paraview = dir.join("out/paraview");
+    let files: Vec<_> = std::fs::read_dir(&paraview)
+        .expect("paraview folder")
+        .map(|e| e.expect("entry"))
+        .collect();
+    let count = |prefix: &str| {
+        files
+            .iter()
+            .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
+            .count()
+    };
+    assert_eq!(count("M60H25"), 0, "only the default setup's series");
+    assert_eq!(count("M60H20_blocks_"), 31);
+    assert_eq!(count("M60H20_contacts_"), 7);
+    let pvd = std::fs::read_to_string(paraview.join("M60H20_contacts.pvd")).expect("pvd");
+    assert_eq!(pvd.matches("<DataSet").count(), 7);
+    let bytes: u64 = files.iter().map(|e| e.metadata().expect("metadata").len()).sum();
+    assert!(bytes < 8_000_000, "{bytes} bytes");
+    // Every setup's with `--paraview-setups all`.
+    let mut all = args.to_vec();
+    all.extend(["--paraview-setups", "all", "--out", "all"]);
+    let (code, stderr, _) = run_example("arch_impact", &all, &dir);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert!(dir.join("all/paraview/M60H25_blocks.pvd").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -8,9 +8,12 @@ use voussoir::io::scene::Scene;
 use crate::errors::OrPy;
 use crate::model::PyModel;
 
-/// A ParaView series: ``ParaviewSeries(folder, name)``; ``write_frame(model)`` writes the
-/// blocks and sub-contacts of the model as a frame and rewrites the ``.pvd`` collections
-/// (``blocks_pvd``), which ParaView opens as a time series. One series writes a name in a
+/// A ParaView series: ``ParaviewSeries(folder, name, *, subcontacts_every=1)``;
+/// ``write_frame(model)`` writes the blocks (the polygons of their faces) and the sub-contacts
+/// (points) of the model as a frame and rewrites the ``.pvd`` collections (``blocks_pvd``),
+/// which ParaView opens as a time series; ``meshio.read`` opens each frame's files. With
+/// ``subcontacts_every=n`` the sub-contacts, the large files, are written on every n-th frame
+/// only (the first, then every n-th), the blocks on every frame. One series writes a name in a
 /// folder at a time (a lock file ``.<name>.lock`` from the first frame until the series is
 /// freed): a second one, in this process or another, raises ``VoussoirIOError``; so does a
 /// frame after the folder was deleted or emptied mid-run.
@@ -22,11 +25,16 @@ pub struct PySeries {
 #[pymethods]
 impl PySeries {
     #[new]
-    #[pyo3(signature = (folder, name="model"))]
-    fn new(folder: PathBuf, name: &str) -> Self {
-        Self {
-            inner: voussoir::io::vtk::Series::new(folder, name),
+    #[pyo3(signature = (folder, name="model", *, subcontacts_every=1))]
+    fn new(folder: PathBuf, name: &str, subcontacts_every: usize) -> PyResult<Self> {
+        if subcontacts_every == 0 {
+            return Err(pyo3::exceptions::PyValueError::new_err(
+                "subcontacts_every must be at least 1 (every frame)",
+            ));
         }
+        Ok(Self {
+            inner: voussoir::io::vtk::Series::new(folder, name).with_subcontacts_every(subcontacts_every),
+        })
     }
 
     /// Writes a frame of the model.

@@ -26,6 +26,18 @@ def test_paraview(tmp_path, model):
     assert len(series) == 3
     pvd = pathlib.Path(series.blocks_pvd)
     assert pvd.exists() and len(ET.parse(pvd).getroot().findall(".//DataSet")) == 3
+    # Sub-contacts on every second frame: frames 0, 2 and 4 of five.
+    sparse = vs.ParaviewSeries(tmp_path / "sparse", "demo", subcontacts_every=2)
+    for _ in range(5):
+        model.run_steps(1)
+        sparse.write_frame(model)
+    contacts = tmp_path / "sparse" / "demo_contacts.pvd"
+    files = [d.get("file") for d in ET.parse(contacts).getroot().findall(".//DataSet")]
+    assert files == [f"demo_contacts_{k:05}.vtu" for k in (0, 2, 4)]
+    assert not (tmp_path / "sparse" / "demo_contacts_00001.vtu").exists()
+    assert len(ET.parse(sparse.blocks_pvd).getroot().findall(".//DataSet")) == 5
+    with pytest.raises(ValueError, match="at least 1"):
+        vs.ParaviewSeries(tmp_path / "x", "demo", subcontacts_every=0)
 
 
 def test_paraview_files_read_by_meshio(tmp_path, model):

@@ -388,7 +388,10 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
 pub struct Series {
     dir: PathBuf,
     name: String,
-    frames: Vec<(Real, String, String)>,
+    /// Each frame's time, blocks file and sub-contacts file (none when skipped).
+    frames: Vec<(Real, String, Option<String>)>,
+    /// Sub-contacts are written on every this many frames (1: every frame).
+    subcontacts_every: usize,
     /// The lock file this series holds (from its first frame).
     lock: Option<PathBuf>,
     /// This series' number in the process, written in its lock file.
@@ -406,6 +409,7 @@ impl Clone for Series {
             dir: self.dir.clone(),
             name: self.name.clone(),
             frames: self.frames.clone(),
+            subcontacts_every: self.subcontacts_every,
             lock: None,
             id: SERIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
@@ -507,6 +511,7 @@ impl Series {
             dir: dir.into(),
             name: name.to_owned(),
             frames: Vec::new(),
+            subcontacts_every: 1,
             lock: None,
             id: SERIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
@@ -558,7 +563,7 @@ impl Series {
     /// The earlier frames' files must still be there.
     fn check_frames(&self) -> Result<()> {
         for (_, b, c) in &self.frames {
-            for file in [b, c] {
+            for file in std::iter::once(b).chain(c) {
                 let path = self.dir.join(file);
                 if !path.is_file() {
                     return Err(Error::Io {
@@ -573,6 +578,22 @@ impl Series {
         Ok(())
     }
 
+    /// The same series writing its sub-contacts on every `every`-th frame only (the first,
+    /// then every `every`-th; `every` is at least 1), its blocks on every frame: sub-contact
+    /// files are the large ones (a 14-joint arch's are 35 times its blocks'), so a smooth
+    /// animation of the blocks need not cost as many of them. The sub-contacts' `.pvd`
+    /// collection lists the frames that have them.
+    ///
+    /// ```
+    /// let series = voussoir::io::vtk::Series::new("out/demo", "wall").with_subcontacts_every(5);
+    /// assert!(series.is_empty());
+    /// ```
+    #[must_use]
+    pub fn with_subcontacts_every(mut self, every: usize) -> Self {
+        self.subcontacts_every = every.max(1);
+        self
+    }
+
     /// A new, empty series written into `dir`, its name checked by [`check_series_name`].
     ///
     /// # Errors
@@ -582,7 +603,8 @@ impl Series {
         Ok(Self::new(dir, name))
     }
 
-    /// Writes the model's blocks and sub-contacts as the next frame, at the model's time.
+    /// Writes the model's blocks and sub-contacts as the next frame, at the model's time (the
+    /// sub-contacts only on the frames [`Series::with_subcontacts_every`] asks for).
     ///
     /// # Errors
     /// [`Error::InvalidName`] (nothing written) if the series name is not a portable file name
@@ -596,10 +618,14 @@ impl Series {
         self.check_frames()?;
         let k = self.frames.len();
         let blocks = format!("{}_blocks_{k:05}.vtu", self.name);
-        let contacts = format!("{}_contacts_{k:05}.vtu", self.name);
+        let contacts = k
+            .is_multiple_of(self.subcontacts_every)
+            .then(|| format!("{}_contacts_{k:05}.vtu", self.name));
         let initial = |i: usize| *model.blocks()[i].initial_pose();
         write_block_surfaces(&self.dir.join(&blocks), model.blocks(), initial)?;
-        write_subcontacts(&self.dir.join(&contacts), model)?;
+        if let Some(contacts) = &contacts {
+            write_subcontacts(&self.dir.join(contacts), model)?;
+        }
         self.frames.push((model.time(), blocks, contacts));
         self.write_collections()
     }
@@ -625,7 +651,10 @@ impl Series {
                 "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n<Collection>\n",
             );
             for (t, b, c) in &self.frames {
-                let file = xml_escape(if pick == 0 { b } else { c });
+                let Some(file) = (if pick == 0 { Some(b) } else { c.as_ref() }) else {
+                    continue;
+                };
+                let file = xml_escape(file);
                 let _ = writeln!(
                     out,
                     "<DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{file}\"/>"

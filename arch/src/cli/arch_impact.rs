@@ -12,9 +12,11 @@
 //! Flags: `--setup NAME[,NAME]`, `--kn PA_PER_M`, `--damping RATIO`, `--width M`, `--duration S`,
 //! `--guide frame|seat`, `--base sloped|flat`, `--release above|full`, `--offsets MM[,MM]`
 //! (drop-height perturbations, default `-0.5,-0.25,0,0.25,0.5`), `--out DIR`, `--study`,
-//! `--compare-release`, `--no-paraview`. Writes `summary.json`, one history CSV per setup (with
-//! the energy terms), `displacement_time.svg`, `max_disp_vs_experiment.svg`, a ParaView series per
-//! setup (and `sensitivity.svg` with `--study`) under `out/arch_impact/`. The ranges of the
+//! `--compare-release`, `--paraview-setups NAME[,NAME]|all`, `--no-paraview`. Writes
+//! `summary.json`, one history CSV per setup (with the energy terms), `displacement_time.svg`,
+//! `max_disp_vs_experiment.svg`, the ParaView series of M60H20's central run (blocks every 10 ms,
+//! sub-contacts every 50 ms: about 15 MB; every setup's with `--paraview-setups all`), and
+//! `sensitivity.svg` with `--study`, under `out/arch_impact/`. The ranges of the
 //! numbers (`--help`; [`DAMPING_RANGE`], [`DURATION_RANGE`], ...) are checked when parsed, and a
 //! setup or an offset given twice is refused.
 
@@ -33,6 +35,20 @@ use crate::scenarios::arch_impact::{
 
 /// The six tests, as `--setup` takes them.
 pub const SETUP_NAMES: [&str; 6] = ["M60H20", "M60H25", "M60H30", "M75H20", "M75H45", "M80H45"];
+
+/// The values of `--paraview-setups`: a setup, or `all`.
+const PARAVIEW_SETUP_NAMES: [&str; 7] = ["M60H20", "M60H25", "M60H30", "M75H20", "M75H45", "M80H45", "all"];
+
+/// Whether the central run of `setup` writes a ParaView series: it is one of
+/// `--paraview-setups` (`all`: every one), or by default M60H20 when it runs, else the first
+/// setup that runs (`running`, in order).
+fn writes_paraview(o: &ImpactOptions, setup: &str, running: &[&str]) -> bool {
+    match &o.paraview_setups {
+        Some(names) => names.iter().any(|n| n == "all" || n == setup),
+        None if running.contains(&"M60H20") => setup == "M60H20",
+        None => running.first() == Some(&setup),
+    }
+}
 
 /// Range of `--kn` (Pa/m).
 pub const KN_RANGE: Interval = Interval {
@@ -114,6 +130,17 @@ pub struct ImpactOptions {
         default_value = "-0.5,-0.25,0,0.25,0.5"
     )]
     pub offsets_mm: Vec<f64>,
+    /// Setups whose central run writes a ParaView series (blocks every 10 ms, sub-contacts every
+    /// 50 ms), or `all` [default: M60H20, or the first setup run without it]: about 15 MB a
+    /// standing setup
+    #[arg(
+        long = "paraview-setups",
+        value_name = "NAME[,NAME]|all",
+        value_delimiter = ',',
+        action = ArgAction::Set,
+        value_parser = PossibleValuesParser::new(PARAVIEW_SETUP_NAMES)
+    )]
+    pub paraview_setups: Option<Vec<String>>,
     /// Add the paper's Fig. 14 study (kn and damping, M60 setups)
     #[arg(long)]
     pub study: bool,
@@ -189,6 +216,7 @@ impl Run for ImpactOptions {
     /// A setup or a drop-height offset given twice would run twice into the same files.
     fn check(&self) -> Result<(), String> {
         args::unique("--setup", self.setups.as_deref().unwrap_or_default())?;
+        args::unique("--paraview-setups", self.paraview_setups.as_deref().unwrap_or_default())?;
         args::unique("--offsets", &self.offsets_mm)
     }
 
@@ -606,6 +634,12 @@ fn markdown(outcomes: &[Outcome], agree: usize, main_count: usize) -> String {
 
 fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
     let groups = groups(o)?;
+    // The setups that run, in order (for the default of `--paraview-setups`).
+    let running: Vec<&str> = groups
+        .iter()
+        .filter(|g| g.kind == "main")
+        .map(|g| g.base.setup.name.as_str())
+        .collect();
     // Every group runs at every drop-height perturbation (the central one first).
     let mut offsets: Vec<f64> = o.offsets_mm.iter().map(|mm| mm * 1e-3).collect();
     offsets.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
@@ -670,7 +704,8 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
     println!("  collapse rule: a voussoir's centroid drops by more than half the ring thickness (0.1 m).");
     let results: Vec<(usize, ImpactResult)> = out.run_all(&cases, "impact runs", |_, (k, case)| {
         let central = groups[*k].kind == "main" && case.height_offset == 0.0;
-        out.with_frames(central.then_some(case.setup.name.as_str()), 0.01, |every, frame| {
+        let frames = central && writes_paraview(o, &case.setup.name, &running);
+        out.with_frames_and_subcontacts(frames.then_some(case.setup.name.as_str()), 0.01, 5, |every, frame| {
             run(case, every, frame)
         })
         .map(|r| (*k, r))

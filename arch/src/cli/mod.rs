@@ -211,9 +211,25 @@ impl Outputs {
         every: f64,
         run: impl FnOnce(Option<f64>, &mut (dyn FnMut(&Model) -> voussoir::Result<()> + Send)) -> voussoir::Result<T>,
     ) -> voussoir::Result<T> {
+        self.with_frames_and_subcontacts(name, every, 1, run)
+    }
+
+    /// [`Outputs::with_frames`] with the sub-contacts written on every `subcontacts_every`-th
+    /// frame only ([`vtk::Series::with_subcontacts_every`]).
+    ///
+    /// # Errors
+    /// `run`'s.
+    pub fn with_frames_and_subcontacts<T>(
+        &self,
+        name: Option<&str>,
+        every: f64,
+        subcontacts_every: usize,
+        run: impl FnOnce(Option<f64>, &mut (dyn FnMut(&Model) -> voussoir::Result<()> + Send)) -> voussoir::Result<T>,
+    ) -> voussoir::Result<T> {
         match name.filter(|_| self.paraview) {
             Some(name) => {
-                let mut series = vtk::Series::new(self.dir.join("paraview"), name);
+                let mut series =
+                    vtk::Series::new(self.dir.join("paraview"), name).with_subcontacts_every(subcontacts_every);
                 run(Some(every), &mut |m| series.write_frame(m))
             }
             None => run(None, &mut |_| Ok(())),
