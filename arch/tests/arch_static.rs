@@ -210,3 +210,19 @@ fn hinge_governed_capacity_depends_on_kn_and_sliding_governed_does_not() {
     let (hinges_soft, hinges_stiff) = (peak(35.0, 4e9), peak(35.0, 4e10));
     assert!(hinges_stiff > 1.05 * hinges_soft, "{hinges_soft} → {hinges_stiff}");
 }
+
+/// A loading plate that slides off instead of loading the arch is an error, not a capacity of
+/// zero. Free to slide horizontally (as in the test), the plate rests on voussoir 5's sloping
+/// extrados (20.7°) through its joint's shear springs; with ks 0.4 GPa/m (ks/kn 0.1) they let it
+/// slide off as the servo lowers it: 3 mm of travel at zero load, which the run reported as a
+/// peak of 0.3 N.
+#[test]
+fn a_plate_that_slides_off_is_an_error_not_a_zero_capacity() {
+    let c = case("soft shear", |c| c.ks = 0.4e9);
+    let err = run(&c, None, |_| Ok(())).expect_err("the plate slides off");
+    let message = err.to_string();
+    assert!(
+        message.contains("slid off") && message.contains("plate's own weight"),
+        "{message}"
+    );
+}
