@@ -3,6 +3,7 @@
 //! arrays, its monitors and its files.
 
 use std::path::PathBuf;
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -124,16 +125,65 @@ enum Goal {
 ///
 /// Joint laws are set per pair of materials (``set_joint_law``); block indices are ints, the
 /// rows of the arrays that ``positions()``, ``velocities()`` etc. return.
-#[pyclass(name = "Model", module = "voussoir")]
+#[pyclass(name = "Model", module = "voussoir", frozen)]
 pub struct PyModel {
-    pub(crate) model: Model<AnyLaw>,
-    samples: Samples,
+    /// The model and its recorded histories, behind a lock: a run holds it while a chunk of
+    /// steps runs (the GIL let go), and a reader in another thread waits for it (the GIL let go
+    /// while waiting) instead of finding the model borrowed.
+    inner: Mutex<Inner>,
+    /// Threads waiting for `inner`: a run lets them in between its chunks.
+    waiting: std::sync::atomic::AtomicUsize,
     /// The KeyboardInterrupt the model's interrupt check took from Python within a step, to be
     /// raised once the step has stopped.
     interrupted: Arc<Mutex<Option<PyErr>>>,
 }
 
+/// What [`PyModel`] locks.
+pub(crate) struct Inner {
+    pub(crate) model: Model<AnyLaw>,
+    samples: Samples,
+}
+
+impl Inner {
+    /// The block of index `block` (`VoussoirError` naming the argument `what` when out of range).
+    fn id(&self, block: &Int, what: &str) -> PyResult<BlockId> {
+        block.block(what, self.model.blocks().len())
+    }
+}
+
 impl PyModel {
+    /// The model, locked; while another thread holds it (a run's chunk, or a reader), waits
+    /// with the GIL let go, so that the holder can take the GIL if it needs it.
+    pub(crate) fn lock(&self, py: Python<'_>) -> std::sync::MutexGuard<'_, Inner> {
+        loop {
+            match self.inner.try_lock() {
+                Ok(guard) => return guard,
+                Err(std::sync::TryLockError::Poisoned(p)) => return p.into_inner(),
+                Err(std::sync::TryLockError::WouldBlock) => {
+                    // Wait until it is free (the guard dropped at once: it cannot leave the
+                    // closure without the GIL), then take it with the GIL held.
+                    self.waiting.fetch_add(1, Ordering::SeqCst);
+                    py.detach(|| drop(self.inner.lock()));
+                    self.waiting.fetch_sub(1, Ordering::SeqCst);
+                }
+            }
+        }
+    }
+
+    /// Lets the threads waiting for the model take it (a run, between its chunks): waits, the
+    /// GIL let go, until none waits or for at most 20 ms.
+    fn let_waiting_in(&self, py: Python<'_>) {
+        if self.waiting.load(Ordering::SeqCst) == 0 {
+            return;
+        }
+        py.detach(|| {
+            let start = Instant::now();
+            while self.waiting.load(Ordering::SeqCst) > 0 && start.elapsed() < Duration::from_millis(20) {
+                std::thread::yield_now();
+            }
+        });
+    }
+
     /// Wraps `model`, with an interrupt check that looks for Ctrl-C from within a long step
     /// (between the batches of a contact detection: the first step of a 100k-block wall takes
     /// seconds), taking the GIL back for the look.
@@ -152,8 +202,11 @@ impl PyModel {
             })
         })));
         Self {
-            model,
-            samples: Samples::new(),
+            inner: Mutex::new(Inner {
+                model,
+                samples: Samples::new(),
+            }),
+            waiting: std::sync::atomic::AtomicUsize::new(0),
             interrupted,
         }
     }
@@ -163,18 +216,17 @@ impl PyModel {
         self.interrupted.lock().ok().and_then(|mut slot| slot.take())
     }
 
-    /// The block of index `block` (`VoussoirError` naming the argument `what` when out of range).
-    fn id(&self, block: &Int, what: &str) -> PyResult<BlockId> {
-        block.block(what, self.model.blocks().len())
-    }
-
-    /// Runs to `goal`, in chunks: the GIL is released during a chunk; between chunks Ctrl-C is
-    /// looked for and, every `every` steps, `callback(step, time)` is called. Returns the steps
-    /// taken and whether the goal was reached (false: the callback returned a false value).
+    /// Runs to `goal`, in chunks of at most [`SIGNAL_INTERVAL`]: the GIL is let go during a
+    /// chunk; between chunks Ctrl-C is looked for and, every `every` steps,
+    /// `callback(step, time)` is called. Returns the steps taken and whether the goal was
+    /// reached (false: the callback returned a false value).
     ///
-    /// The model is borrowed only while a chunk runs, not while the callback does: the callback
+    /// The model is locked only while a chunk runs, not while the callback does: the callback
     /// may read the model (time, ratios, positions, contacts, energies) and drive it (loads,
-    /// prescribed velocities, stopping by returning False).
+    /// prescribed velocities, stopping by returning False). Another Python thread that reads
+    /// the model during a chunk waits for the chunk's end (at most [`SIGNAL_INTERVAL`]) instead
+    /// of finding it borrowed (`Already mutably borrowed` in 13 of 50 reads before), and a
+    /// chunk waits for a reader that holds it.
     fn run(
         slf: &Bound<'_, Self>,
         goal: Goal,
@@ -208,7 +260,8 @@ impl PyModel {
             } else {
                 u64::MAX
             };
-            let mut guard = slf.borrow_mut();
+            let me = slf.get();
+            let mut guard = me.lock(py);
             let this = &mut *guard;
             let (model, samples) = (&mut this.model, &mut this.samples);
             let outcome = py.detach(move || -> voussoir::Result<(u64, bool)> {
@@ -243,12 +296,14 @@ impl PyModel {
                     n += 1;
                 }
             });
-            if let Some(e) = this.take_interrupt() {
+            if let Some(e) = me.take_interrupt() {
                 return Err(e);
             }
             let (step, time) = (this.model.step_count(), this.model.time());
-            // The model is free again: the callback may read and drive it.
+            // The model is free again: the callback may read and drive it, and threads waiting
+            // for it take it.
             drop(guard);
+            me.let_waiting_in(py);
             let (n, done) = outcome.py()?;
             taken += n;
             since_callback += n;
@@ -382,15 +437,17 @@ impl PyModel {
 
     /// Sets the joint law between two materials (ints, either order): a ``CoulombSlip`` or a
     /// ``LinearElastic``.
-    fn set_joint_law(&mut self, a: Int, b: Int, law: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set_joint_law(&self, py: Python<'_>, a: Int, b: Int, law: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut this = self.lock(py);
         let (a, b) = (material(&a, "material a")?, material(&b, "material b")?);
         let law = law_from_py(law)?;
-        self.model.set_joint_law(a, b, law).py()
+        this.model.set_joint_law(a, b, law).py()
     }
 
     /// The joint law between two materials, or None.
     fn joint_law<'py>(&self, py: Python<'py>, a: Int, b: Int) -> PyResult<Option<Bound<'py, PyAny>>> {
-        self.model
+        let this = self.lock(py);
+        this.model
             .law_table()
             .get(material(&a, "material a")?, material(&b, "material b")?)
             .map(|l| law_to_py(py, l))
@@ -402,8 +459,10 @@ impl PyModel {
     /// parts equal, or with the coefficients ``mass`` (1/s) and ``stiffness`` (s);
     /// ``"rayleigh_mass"`` or ``"rayleigh_stiffness"`` with ``ratio`` and ``frequency``.
     #[pyo3(signature = (kind, *, alpha=0.8, ratio=None, frequency=None, mass=None, stiffness=None))]
+    #[allow(clippy::too_many_arguments)]
     fn set_damping(
-        &mut self,
+        &self,
+        py: Python<'_>,
         kind: &str,
         alpha: f64,
         ratio: Option<f64>,
@@ -411,6 +470,7 @@ impl PyModel {
         mass: Option<f64>,
         stiffness: Option<f64>,
     ) -> PyResult<()> {
+        let mut this = self.lock(py);
         let need = |what: &str| -> PyResult<(f64, f64)> {
             match (ratio, frequency) {
                 (Some(r), Some(f)) => Ok((r, f)),
@@ -447,15 +507,16 @@ impl PyModel {
                 )))
             }
         };
-        self.model.set_damping(damping).py()
+        this.model.set_damping(damping).py()
     }
 
     /// The damping as a dict: ``{"kind": "none"}``, ``{"kind": "local", "alpha": α}`` or
     /// ``{"kind": "rayleigh", "mass": a, "stiffness": b}``.
     #[getter]
     fn damping<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let this = self.lock(py);
         let d = PyDict::new(py);
-        match self.model.damping() {
+        match this.model.damping() {
             Damping::None => d.set_item("kind", "none")?,
             Damping::Local { alpha } => {
                 d.set_item("kind", "local")?;
@@ -473,27 +534,31 @@ impl PyModel {
     /// Gravity (m/s²), a (3,) array; settable.
     #[getter]
     fn gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        vector(py, self.model.parameters().gravity)
+        let this = self.lock(py);
+        vector(py, this.model.parameters().gravity)
     }
 
     #[setter]
-    fn set_gravity(&mut self, g: &Bound<'_, PyAny>) -> PyResult<()> {
-        let mut p = *self.model.parameters();
+    fn set_gravity(&self, py: Python<'_>, g: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut this = self.lock(py);
+        let mut p = *this.model.parameters();
         p.gravity = vec3(g, "gravity")?;
-        self.model.set_parameters(p).py()
+        this.model.set_parameters(p).py()
     }
 
     /// Adds a ``Block``; returns its index.
-    fn add_block(&mut self, block: PyRef<'_, PyBlock>) -> PyResult<usize> {
-        Ok(self.model.add_block(block.inner.clone()).py()?.index())
+    fn add_block(&self, py: Python<'_>, block: PyRef<'_, PyBlock>) -> PyResult<usize> {
+        let mut this = self.lock(py);
+        Ok(this.model.add_block(block.inner.clone()).py()?.index())
     }
 
     /// Adds blocks (a list from ``voussoir.build``, say); returns their indices. All or nothing:
     /// when one is refused, none is added (the error names the first refused, by its position
     /// in the list).
-    fn add_blocks(&mut self, blocks: Vec<PyRef<'_, PyBlock>>) -> PyResult<Vec<usize>> {
+    fn add_blocks(&self, py: Python<'_>, blocks: Vec<PyRef<'_, PyBlock>>) -> PyResult<Vec<usize>> {
+        let mut this = self.lock(py);
         // The checks of `add_block` depend on the parameters only: tried on an empty model first.
-        let mut trial = Model::<AnyLaw>::new(*self.model.parameters()).py()?;
+        let mut trial = Model::<AnyLaw>::new(*this.model.parameters()).py()?;
         for (k, b) in blocks.iter().enumerate() {
             trial
                 .add_block(b.inner.clone())
@@ -501,7 +566,7 @@ impl PyModel {
         }
         blocks
             .iter()
-            .map(|b| Ok(self.model.add_block(b.inner.clone()).py()?.index()))
+            .map(|b| Ok(this.model.add_block(b.inner.clone()).py()?.index()))
             .collect()
     }
 
@@ -510,7 +575,8 @@ impl PyModel {
     #[pyo3(signature = (name, min, max, density, *, material=0, fixed=None, velocity=None, angular_velocity=None))]
     #[allow(clippy::too_many_arguments)]
     fn add_cuboid(
-        &mut self,
+        &self,
+        py: Python<'_>,
         name: &str,
         min: &Bound<'_, PyAny>,
         max: &Bound<'_, PyAny>,
@@ -520,9 +586,10 @@ impl PyModel {
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<usize> {
+        let mut this = self.lock(py);
         let b =
             crate::blocks::PyBlock::cuboid(name, min, max, density, material, fixed, velocity, angular_velocity)?.inner;
-        Ok(self.model.add_block(b).py()?.index())
+        Ok(this.model.add_block(b).py()?.index())
     }
 
     /// Adds the convex hull of world points (an (n, 3) array or a list of triples), or, with
@@ -530,7 +597,8 @@ impl PyModel {
     #[pyo3(signature = (name, vertices, density, *, faces=None, material=0, fixed=None, velocity=None, angular_velocity=None))]
     #[allow(clippy::too_many_arguments)]
     fn add_polyhedron(
-        &mut self,
+        &self,
+        py: Python<'_>,
         name: &str,
         vertices: &Bound<'_, PyAny>,
         density: f64,
@@ -540,6 +608,7 @@ impl PyModel {
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<usize> {
+        let mut this = self.lock(py);
         let b = crate::blocks::PyBlock::from_vertices(
             name,
             vertices,
@@ -551,43 +620,48 @@ impl PyModel {
             angular_velocity,
         )?
         .inner;
-        Ok(self.model.add_block(b).py()?.index())
+        Ok(this.model.add_block(b).py()?.index())
     }
 
     /// Sets a block's fixity: ``"fixed"``, ``"free"``, a bool, or ``{"translation": [d, d, d],
     /// "rotation": [d, d, d]}`` with each ``d`` ``"free"``, ``"fixed"`` or a velocity.
-    fn set_fixity(&mut self, block: Int, fixity: &Bound<'_, PyAny>) -> PyResult<()> {
-        let id = self.id(&block, "block index")?;
+    fn set_fixity(&self, py: Python<'_>, block: Int, fixity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut this = self.lock(py);
+        let id = this.id(&block, "block index")?;
         let f = crate::convert::fixity(Some(fixity))?;
-        self.model.set_fixity(id, f).py()
+        this.model.set_fixity(id, f).py()
     }
 
     /// Sets the load on a block: a force (N) at its centroid and a moment (N·m).
     #[pyo3(signature = (block, force=None, moment=None))]
     fn set_load(
-        &mut self,
+        &self,
+        py: Python<'_>,
         block: Int,
         force: Option<&Bound<'_, PyAny>>,
         moment: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let id = self.id(&block, "block index")?;
+        let mut this = self.lock(py);
+        let id = this.id(&block, "block index")?;
         let w = Wrench {
             force: vec3_or_zero(force, "force")?,
             moment: vec3_or_zero(moment, "moment")?,
         };
-        self.model.set_load(id, w).py()
+        this.model.set_load(id, w).py()
     }
 
     /// Sets a block's velocity (m/s) and angular velocity (rad/s).
     #[pyo3(signature = (block, velocity, angular_velocity=None))]
     fn set_velocity(
-        &mut self,
+        &self,
+        py: Python<'_>,
         block: Int,
         velocity: &Bound<'_, PyAny>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<()> {
-        let id = self.id(&block, "block index")?;
-        self.model
+        let mut this = self.lock(py);
+        let id = this.id(&block, "block index")?;
+        this.model
             .set_velocity(
                 id,
                 vec3(velocity, "velocity")?,
@@ -599,9 +673,10 @@ impl PyModel {
     /// Changes the values of a block's prescribed translation velocities (m/s): each
     /// translation that its fixity prescribes (a number in ``set_fixity``) takes the matching
     /// component; free and fixed ones stay. Cheap enough to call between every step.
-    fn set_prescribed_velocity(&mut self, block: Int, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
-        let id = self.id(&block, "block index")?;
-        self.model.set_prescribed_velocity(id, vec3(velocity, "velocity")?).py()
+    fn set_prescribed_velocity(&self, py: Python<'_>, block: Int, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut this = self.lock(py);
+        let id = this.id(&block, "block index")?;
+        this.model.set_prescribed_velocity(id, vec3(velocity, "velocity")?).py()
     }
 
     // ---- running --------------------------------------------------------------------------
@@ -659,74 +734,88 @@ impl PyModel {
     // ---- state ----------------------------------------------------------------------------
 
     /// Number of blocks.
-    fn __len__(&self) -> usize {
-        self.model.blocks().len()
+    fn __len__(&self, py: Python<'_>) -> usize {
+        let this = self.lock(py);
+        this.model.blocks().len()
     }
 
     /// Number of blocks.
     #[getter]
-    fn block_count(&self) -> usize {
-        self.model.blocks().len()
+    fn block_count(&self, py: Python<'_>) -> usize {
+        let this = self.lock(py);
+        this.model.blocks().len()
     }
     /// Simulated time (s).
     #[getter]
-    fn time(&self) -> f64 {
-        self.model.time()
+    fn time(&self, py: Python<'_>) -> f64 {
+        let this = self.lock(py);
+        this.model.time()
     }
     /// Steps taken.
     #[getter]
-    fn step_count(&self) -> u64 {
-        self.model.step_count()
+    fn step_count(&self, py: Python<'_>) -> u64 {
+        let this = self.lock(py);
+        this.model.step_count()
     }
     /// Current time step (s); 0 before the first step.
     #[getter]
-    fn dt(&self) -> f64 {
-        self.model.dt()
+    fn dt(&self, py: Python<'_>) -> f64 {
+        let this = self.lock(py);
+        this.model.dt()
     }
     /// The critical time step (s) of the last detection, or None before the first step.
     #[getter]
-    fn critical_step(&self) -> Option<f64> {
-        self.model.critical_step().map(|c| c.dt)
+    fn critical_step(&self, py: Python<'_>) -> Option<f64> {
+        let this = self.lock(py);
+        this.model.critical_step().map(|c| c.dt)
     }
     /// Unbalanced-force ratio of the last step.
     #[getter]
-    fn unbalanced_force_ratio(&self) -> f64 {
-        self.model.unbalanced_force_ratio()
+    fn unbalanced_force_ratio(&self, py: Python<'_>) -> f64 {
+        let this = self.lock(py);
+        this.model.unbalanced_force_ratio()
     }
     /// Number of contacts.
     #[getter]
-    fn contact_count(&self) -> usize {
-        self.model.contacts().len()
+    fn contact_count(&self, py: Python<'_>) -> usize {
+        let this = self.lock(py);
+        let count = this.model.contacts().len();
+        count
     }
     /// Number of sub-contacts.
     #[getter]
-    fn subcontact_count(&self) -> usize {
-        self.model.subcontact_count()
+    fn subcontact_count(&self, py: Python<'_>) -> usize {
+        let this = self.lock(py);
+        this.model.subcontact_count()
     }
 
     /// A copy of block ``i`` as it is now (a ``Block``).
-    fn block(&self, i: Int) -> PyResult<PyBlock> {
-        let id = self.id(&i, "block index")?;
+    fn block(&self, py: Python<'_>, i: Int) -> PyResult<PyBlock> {
+        let this = self.lock(py);
+        let id = this.id(&i, "block index")?;
         Ok(PyBlock {
-            inner: self.model.block(id).py()?.clone(),
+            inner: this.model.block(id).py()?.clone(),
         })
     }
 
     /// Block names, in index order.
-    fn block_names(&self) -> Vec<String> {
-        self.model.blocks().iter().map(|b| b.name().to_owned()).collect()
+    fn block_names(&self, py: Python<'_>) -> Vec<String> {
+        let this = self.lock(py);
+        this.model.blocks().iter().map(|b| b.name().to_owned()).collect()
     }
 
     /// Centroids (m), an (n, 3) array.
     fn positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        array_n3(py, self.model.blocks().iter().map(|b| b.state().pose.translation))
+        let this = self.lock(py);
+        array_n3(py, this.model.blocks().iter().map(|b| b.state().pose.translation))
     }
 
     /// Centroid displacements since the blocks were built (m), an (n, 3) array.
     fn displacements<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let this = self.lock(py);
         array_n3(
             py,
-            self.model
+            this.model
                 .blocks()
                 .iter()
                 .map(|b| b.state().pose.translation - b.initial_pose().translation),
@@ -737,9 +826,10 @@ impl PyModel {
     /// ``Rotation.from_quat``), an (n, 4) array: the rotation from each block's principal frame
     /// to the world.
     fn rotations<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let this = self.lock(py);
         array_nk(
             py,
-            self.model.blocks().iter().map(|b| {
+            this.model.blocks().iter().map(|b| {
                 let q = b.state().pose.rotation;
                 [q.x, q.y, q.z, q.w]
             }),
@@ -748,9 +838,10 @@ impl PyModel {
 
     /// Orientations as rotation matrices (principal frame to world), an (n, 3, 3) array.
     fn rotation_matrices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        let this = self.lock(py);
         array_n33(
             py,
-            self.model.blocks().iter().map(|b| {
+            this.model.blocks().iter().map(|b| {
                 let q = b.state().pose.rotation;
                 let (x, y, z) = (q * Vector::X, q * Vector::Y, q * Vector::Z); // the columns
                 [[x.x, y.x, z.x], [x.y, y.y, z.y], [x.z, y.z, z.z]]
@@ -760,12 +851,14 @@ impl PyModel {
 
     /// Velocities of the centroids (m/s), an (n, 3) array.
     fn velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        array_n3(py, self.model.blocks().iter().map(|b| b.state().velocity))
+        let this = self.lock(py);
+        array_n3(py, this.model.blocks().iter().map(|b| b.state().velocity))
     }
 
     /// Angular velocities (rad/s, world), an (n, 3) array.
     fn angular_velocities<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        array_n3(py, self.model.blocks().iter().map(|b| b.state().angular_velocity))
+        let this = self.lock(py);
+        array_n3(py, this.model.blocks().iter().map(|b| b.state().angular_velocity))
     }
 
     /// The contacts, as a dict of arrays (one row per contact): ``blocks`` (m, 2) ints (a < b),
@@ -773,7 +866,8 @@ impl PyModel {
     /// ``force`` (m, 3) resultant on b (N), ``moment_a``, ``moment_b`` (m, 3) its moments about
     /// the centroids (N·m), ``subcontact_count`` (m,) ints.
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let cs: Vec<_> = self.model.contacts().collect();
+        let this = self.lock(py);
+        let cs: Vec<_> = this.model.contacts().collect();
         let d = PyDict::new(py);
         let pairs: Vec<i64> = cs
             .iter()
@@ -810,6 +904,7 @@ impl PyModel {
     /// positive), ``shear_force`` (k, 3) N on block b, ``normal_displacement`` (k,) m (positive
     /// open), ``slip`` (k,) m, ``status`` a list of ``"elastic"``, ``"sliding"``, ``"open"``.
     fn subcontacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let this = self.lock(py);
         let mut contact = Vec::new();
         let mut point = Vec::new();
         let mut area = Vec::new();
@@ -819,7 +914,7 @@ impl PyModel {
         let mut un = Vec::new();
         let mut slip = Vec::new();
         let mut status = Vec::new();
-        for (k, c) in self.model.contacts().enumerate() {
+        for (k, c) in this.model.contacts().enumerate() {
             for s in c.subcontacts() {
                 contact.push(k as i64);
                 point.push(s.point());
@@ -849,7 +944,8 @@ impl PyModel {
     /// ``gravity_work``, ``load_work``, ``boundary_work``, ``friction``, ``damping``,
     /// ``joint_work``, and ``input``, ``accounted``, ``balance_error``.
     fn energies<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let e = self.model.energies();
+        let this = self.lock(py);
+        let e = this.model.energies();
         let d = PyDict::new(py);
         for (k, v) in [
             ("kinetic", e.kinetic),
@@ -873,14 +969,16 @@ impl PyModel {
     /// The force (N) and moment (N·m) that supports and prescribed velocities applied to a
     /// block in the last step: ``{"force": (3,), "moment": (3,)}``.
     fn reaction<'py>(&self, py: Python<'py>, block: Int) -> PyResult<Bound<'py, PyDict>> {
-        let w = self.model.reaction(self.id(&block, "block index")?).py()?;
+        let this = self.lock(py);
+        let w = this.model.reaction(this.id(&block, "block index")?).py()?;
         wrench(py, w)
     }
 
     /// The total contact force (N) and moment (N·m, about the centroid) on a block:
     /// ``{"force": (3,), "moment": (3,)}``.
     fn contact_wrench<'py>(&self, py: Python<'py>, block: Int) -> PyResult<Bound<'py, PyDict>> {
-        let w = self.model.contact_wrench(self.id(&block, "block index")?).py()?;
+        let this = self.lock(py);
+        let w = this.model.contact_wrench(this.id(&block, "block index")?).py()?;
         wrench(py, w)
     }
 
@@ -896,7 +994,8 @@ impl PyModel {
     #[pyo3(signature = (name, kind, *, block=None, point=None, component="z", a=None, b=None, term=None))]
     #[allow(clippy::too_many_arguments)]
     fn add_monitor(
-        &mut self,
+        &self,
+        py: Python<'_>,
         name: &str,
         kind: &str,
         block: Option<Int>,
@@ -906,12 +1005,13 @@ impl PyModel {
         b: Option<Int>,
         term: Option<&str>,
     ) -> PyResult<()> {
+        let mut this = self.lock(py);
         let c = self::component(component)?;
         let need_block = || -> PyResult<BlockId> {
             let k = block
                 .as_ref()
                 .ok_or_else(|| bad(format!("monitor {name:?} of kind {kind:?}: give block=")))?;
-            self.id(k, "block index")
+            this.id(k, "block index")
         };
         let monitor = match kind.to_ascii_lowercase().as_str() {
             "displacement" | "velocity" => {
@@ -946,8 +1046,8 @@ impl PyModel {
                     )));
                 };
                 Monitor::ContactResultant {
-                    a: self.id(&a, "block index a")?,
-                    b: self.id(&b, "block index b")?,
+                    a: this.id(&a, "block index a")?,
+                    b: this.id(&b, "block index b")?,
                     component: c,
                 }
             }
@@ -964,38 +1064,42 @@ contact_resultant, energy or unbalanced_ratio"
         };
         // The library's own checks, with its messages.
         Recorder::<AnyLaw>::new(1)
-            .add_monitor(&self.model, name, monitor)
+            .add_monitor(&this.model, name, monitor)
             .py()?;
-        self.samples.add(name, monitor)
+        this.samples.add(name, monitor)
     }
 
     /// Steps between monitor samples (default 1).
     #[getter]
-    fn monitor_interval(&self) -> u64 {
-        self.samples.interval
+    fn monitor_interval(&self, py: Python<'_>) -> u64 {
+        let this = self.lock(py);
+        this.samples.interval
     }
 
     #[setter]
-    fn set_monitor_interval(&mut self, n: u64) -> PyResult<()> {
+    fn set_monitor_interval(&self, py: Python<'_>, n: u64) -> PyResult<()> {
+        let mut this = self.lock(py);
         if n == 0 {
             return Err(bad("monitor_interval: must be at least 1 step"));
         }
-        self.samples.interval = n;
+        this.samples.interval = n;
         Ok(())
     }
 
     /// Names of the monitors, in order.
-    fn monitor_names(&self) -> Vec<String> {
-        self.samples.monitors.iter().map(|(n, _)| n.clone()).collect()
+    fn monitor_names(&self, py: Python<'_>) -> Vec<String> {
+        let this = self.lock(py);
+        this.samples.monitors.iter().map(|(n, _)| n.clone()).collect()
     }
 
     /// The sampled histories: ``{"step": ints, "time": s, <monitor name>: values, ...}``, each
     /// a 1-D array (NaN where a monitor added late has no sample).
     fn history<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let this = self.lock(py);
         let d = PyDict::new(py);
-        d.set_item("step", array1(py, self.samples.steps.clone()))?;
-        d.set_item("time", array1(py, self.samples.times.clone()))?;
-        for ((name, _), c) in self.samples.monitors.iter().zip(&self.samples.columns) {
+        d.set_item("step", array1(py, this.samples.steps.clone()))?;
+        d.set_item("time", array1(py, this.samples.times.clone()))?;
+        for ((name, _), c) in this.samples.monitors.iter().zip(&this.samples.columns) {
             d.set_item(name, array1(py, c.clone()))?;
         }
         Ok(d)
@@ -1003,18 +1107,20 @@ contact_resultant, energy or unbalanced_ratio"
 
     /// SI units of the monitors: ``{name: unit}``.
     fn history_units<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let this = self.lock(py);
         let d = PyDict::new(py);
-        for (name, m) in &self.samples.monitors {
+        for (name, m) in &this.samples.monitors {
             d.set_item(name, m.unit())?;
         }
         Ok(d)
     }
 
     /// Forgets the samples (keeps the monitors).
-    fn clear_history(&mut self) {
-        self.samples.steps.clear();
-        self.samples.times.clear();
-        for c in &mut self.samples.columns {
+    fn clear_history(&self, py: Python<'_>) {
+        let mut this = self.lock(py);
+        this.samples.steps.clear();
+        this.samples.times.clear();
+        for c in &mut this.samples.columns {
             c.clear();
         }
     }
@@ -1022,8 +1128,9 @@ contact_resultant, energy or unbalanced_ratio"
     // ---- files ----------------------------------------------------------------------------
 
     /// Writes the histories as CSV (``time [s],step,<name> [unit],...``), creating the folder.
-    fn write_history_csv(&self, path: PathBuf) -> PyResult<()> {
-        let h = self.samples.history().py()?;
+    fn write_history_csv(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let this = self.lock(py);
+        let h = this.samples.history().py()?;
         voussoir::io::csv::write_history(&path, &h).py()
     }
 
@@ -1033,8 +1140,9 @@ contact_resultant, energy or unbalanced_ratio"
     /// ``cells="polyhedra"`` one polyhedron cell per block (ParaView; meshio cannot read blocks
     /// of different vertex counts as polyhedra).
     #[pyo3(signature = (path, *, cells = "surfaces"))]
-    fn write_vtk_blocks(&self, path: PathBuf, cells: &str) -> PyResult<()> {
-        let blocks = self.model.blocks();
+    fn write_vtk_blocks(&self, py: Python<'_>, path: PathBuf, cells: &str) -> PyResult<()> {
+        let this = self.lock(py);
+        let blocks = this.model.blocks();
         let initial = |i: usize| *blocks[i].initial_pose();
         match cells {
             "surfaces" => voussoir::io::vtk::write_block_surfaces(&path, blocks, initial).py(),
@@ -1047,23 +1155,25 @@ contact_resultant, energy or unbalanced_ratio"
 
     /// Writes the sub-contacts (points with forces, stresses, status) as a ParaView file
     /// (``.vtu``) at ``path``.
-    fn write_vtk_subcontacts(&self, path: PathBuf) -> PyResult<()> {
-        voussoir::io::vtk::write_subcontacts(&path, &self.model).py()
+    fn write_vtk_subcontacts(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let this = self.lock(py);
+        voussoir::io::vtk::write_subcontacts(&path, &this.model).py()
     }
 
     /// The model's definition (parameters, damping, laws, blocks as they are now, monitors) as
     /// scene JSON (``docs/scene-format.md``). With Coulomb laws only, the laws are written as a
     /// Rust ``Scene<CoulombSlip>`` reads them; otherwise with their kind (``Scene<AnyLaw>``).
-    fn to_scene_json(&self) -> PyResult<String> {
-        let recorder = self.samples.recorder(&self.model).py()?;
-        scene_json(&Scene::from_model(&self.model).with_recorder(&recorder)).py()
+    fn to_scene_json(&self, py: Python<'_>) -> PyResult<String> {
+        let this = self.lock(py);
+        let recorder = this.samples.recorder(&this.model).py()?;
+        scene_json(&Scene::from_model(&this.model).with_recorder(&recorder)).py()
     }
 
     /// Writes ``to_scene_json()`` to a file, atomically: into a temporary file beside it, then
     /// renamed over it (a failed write leaves the previous file whole). A symbolic link is
     /// written through (its target is replaced, the link kept).
-    fn save_scene(&self, path: PathBuf) -> PyResult<()> {
-        let text = self.to_scene_json()?;
+    fn save_scene(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let text = self.to_scene_json(py)?;
         voussoir::io::write_atomically(&path, text.as_bytes()).py()
     }
 
@@ -1078,9 +1188,10 @@ contact_resultant, energy or unbalanced_ratio"
         let model = scene.build().py()?;
         let recorder = scene.recorder(&model).py()?;
         let mut m = Self::wrap(model);
-        m.samples.interval = recorder.interval();
+        let samples = &mut m.inner.get_mut().unwrap_or_else(|p| p.into_inner()).samples;
+        samples.interval = recorder.interval();
         for (name, monitor) in recorder.monitors() {
-            m.samples.add(name, *monitor)?;
+            samples.add(name, *monitor)?;
         }
         Ok(m)
     }
@@ -1093,13 +1204,15 @@ contact_resultant, energy or unbalanced_ratio"
 
     /// The full state as checkpoint JSON (a run restored from it continues bit-identically).
     /// Monitors and histories are not in it.
-    fn to_checkpoint_string(&self) -> PyResult<String> {
-        self.model.to_checkpoint_string().py()
+    fn to_checkpoint_string(&self, py: Python<'_>) -> PyResult<String> {
+        let this = self.lock(py);
+        this.model.to_checkpoint_string().py()
     }
 
     /// Writes a checkpoint file.
-    fn save_checkpoint(&self, path: PathBuf) -> PyResult<()> {
-        self.model.save_checkpoint(&path).py()
+    fn save_checkpoint(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let this = self.lock(py);
+        this.model.save_checkpoint(&path).py()
     }
 
     /// A model from checkpoint JSON (of this package, or of a Rust model with one law type).
@@ -1119,13 +1232,14 @@ contact_resultant, energy or unbalanced_ratio"
         Self::from_checkpoint_string(&read(&path)?)
     }
 
-    fn __repr__(&self) -> String {
+    fn __repr__(&self, py: Python<'_>) -> String {
+        let this = self.lock(py);
         format!(
             "Model({} blocks, {} contacts, step {}, t = {} s)",
-            self.model.blocks().len(),
-            self.model.contacts().len(),
-            self.model.step_count(),
-            self.model.time()
+            this.model.blocks().len(),
+            this.model.contacts().len(),
+            this.model.step_count(),
+            this.model.time()
         )
     }
 }

@@ -38,8 +38,8 @@ impl PySeries {
     }
 
     /// Writes a frame of the model.
-    fn write_frame(&mut self, model: PyRef<'_, PyModel>) -> PyResult<()> {
-        self.inner.write_frame(&model.model).py()
+    fn write_frame(&mut self, py: Python<'_>, model: PyRef<'_, PyModel>) -> PyResult<()> {
+        self.inner.write_frame(&model.lock(py).model).py()
     }
 
     /// The blocks' ``.pvd`` collection.
