@@ -35,7 +35,7 @@ fn density_kwargs<'py>(py: Python<'py>, density: SubcontactDensity) -> PyResult<
 /// >>> import voussoir as vs
 /// >>> c = vs.check_density_convergence(lambda subcontacts_per_edge: 1.0 + 0.1 / subcontacts_per_edge)
 /// >>> c["refined_density"], round(c["relative_change"], 5)
-/// ({'subcontacts_per_edge': 29}, 0.00321)
+/// ({'subcontacts_per_edge': 29}, 0.0032)
 #[pyfunction]
 #[pyo3(signature = (run, *, subcontacts_per_edge=15, subcontact_spacing=None))]
 pub fn check_density_convergence<'py>(

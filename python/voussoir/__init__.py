@@ -3,7 +3,8 @@
 The Python face of the Rust library of the same name (PyO3): build models from blocks and
 generators, run them (the GIL released; Ctrl-C and a progress callback between steps), read the
 results as numpy arrays, write ParaView and CSV files, save and load scenes and checkpoints, and
-run the reference arch's benchmarks (``voussoir.scenarios``).
+run the reference arch's benchmarks (``voussoir.scenarios``), and find collapse loads by
+limit analysis (``voussoir.limit``).
 
 Joint laws are the shipped ones (``CoulombSlip``, ``LinearElastic``); a law of your own is
 written in Rust (``docs/custom-law.md``), not in Python.
@@ -19,6 +20,7 @@ from ._voussoir import (
     VoussoirIOError,
     __version__,
     check_density_convergence,
+    limit,
 )
 from . import build, scenarios, scenes
 
@@ -33,6 +35,7 @@ __all__ = [
     "__version__",
     "build",
     "check_density_convergence",
+    "limit",
     "scenarios",
     "scenes",
 ]

@@ -386,3 +386,24 @@ def check_density_convergence(
     argument; return ``value``, ``refined``, ``relative_change``, ``density`` and
     ``refined_density``."""
     ...
+
+LiveLoad = Union[Dict[str, Any], Tuple[int, Sequence[float], Sequence[float]]]
+
+def limit(
+    model: Model,
+    live_loads: Sequence[LiveLoad],
+    *,
+    fixity: Optional[Dict[int, FixitySpec]] = None,
+    friction: Literal["cone", "pyramid"] = "cone",
+    facets: int = 16,
+    check_dead_load: bool = True,
+    max_iterations: int = 200,
+) -> Dict[str, Any]:
+    """The collapse multiplier of ``live_loads`` (``{"block", "point", "force"}``: the force
+    ``multiplier * force`` at ``point``) for the model's rigid blocks as they stand, no-tension
+    Coulomb joints, by limit analysis (a second-order cone programme); the model must have been
+    stepped once. Returns ``multiplier``, ``status``, ``iterations``, ``carries_dead_load``,
+    ``blocks`` (``centroid``, ``velocity``, ``angular_velocity``: the mechanism) and
+    ``contacts`` (per contact: ``blocks``, ``normal``, ``points``, ``normal_force``,
+    ``shear_force``, ``opening``, ``sliding``, ``resultant``, ``application_point``)."""
+    ...
