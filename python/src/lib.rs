@@ -12,6 +12,7 @@ mod errors;
 mod laws;
 mod limit;
 mod model;
+mod motion;
 mod scenarios;
 mod series;
 
@@ -28,6 +29,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<blocks::PyBlock>()?;
     m.add_class::<model::PyModel>()?;
     m.add_class::<series::PySeries>()?;
+    m.add_class::<motion::PyTimeHistory>()?;
     m.add_function(wrap_pyfunction!(blocks::arch, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::running_bond_wall, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::multi_leaf_wall, m)?)?;

@@ -632,6 +632,31 @@ impl PyModel {
         this.model.set_fixity(id, f).py()
     }
 
+    /// Makes a block's translations follow base-motion histories from now on (the histories'
+    /// ``t = 0`` is the model's current time), replacing any motion the block had: ``x``, ``y``,
+    /// ``z`` are ``TimeHistory`` objects (or None: that axis stands still) of ``kind``
+    /// ``"acceleration"`` (m/s², from rest), ``"velocity"`` (m/s) or ``"displacement"`` (m,
+    /// starting at 0). With no history at all the motion is removed and the axes it drove are
+    /// fixed. The driven axes must be fixed or prescribed (a shaking table: ``fixed=True``);
+    /// every step they get the velocity that carries the block to the motion's displacement at
+    /// the end of the step, and their reactions are booked as boundary work.
+    #[pyo3(signature = (block, x=None, y=None, z=None, *, kind="acceleration"))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_base_motion(
+        &self,
+        py: Python<'_>,
+        block: Int,
+        x: Option<PyRef<'_, crate::motion::PyTimeHistory>>,
+        y: Option<PyRef<'_, crate::motion::PyTimeHistory>>,
+        z: Option<PyRef<'_, crate::motion::PyTimeHistory>>,
+        kind: &str,
+    ) -> PyResult<()> {
+        let motion = crate::motion::base_motion(kind, [x, y, z])?;
+        let mut this = self.lock(py);
+        let id = this.id(&block, "block index")?;
+        this.model.set_base_motion(id, motion).py()
+    }
+
     /// Sets the load on a block: a force (N) at its centroid and a moment (N·m).
     #[pyo3(signature = (block, force=None, moment=None))]
     fn set_load(
