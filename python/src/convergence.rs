@@ -73,3 +73,61 @@ pub fn check_density_convergence<'py>(
     out.set_item("refined_density", density_kwargs(py, refined_density)?)?;
     Ok(out)
 }
+
+/// check_servo_convergence(run, *, increment, max_unbalanced_ratio=1e-3)
+/// --
+///
+/// Runs a quasi-static analysis with a servo's increment and threshold and again with both
+/// halved, and reports how much the quantity it returns (a peak load) changed: the check that
+/// a quasi-static answer does not depend on the loading (Rust: ``Servo::check_convergence``).
+///
+/// ``run`` is called with the keyword arguments ``increment`` and ``max_unbalanced_ratio`` (as
+/// ``Model.push_over`` takes them), builds and runs the whole analysis, and returns a number.
+///
+/// Returns a dict: ``value``, ``refined``, ``relative_change``, ``servo`` and
+/// ``refined_servo`` (the keyword arguments of each run).
+///
+/// >>> import voussoir as vs
+/// >>> c = vs.check_servo_convergence(lambda increment, max_unbalanced_ratio: 1.0 + max_unbalanced_ratio, increment=1e-5)
+/// >>> round(c["relative_change"], 6), c["refined_servo"]["increment"]
+/// (0.0005, 5e-06)
+#[pyfunction]
+#[pyo3(signature = (run, *, increment, max_unbalanced_ratio=1e-3))]
+pub fn check_servo_convergence<'py>(
+    py: Python<'py>,
+    run: &Bound<'py, PyAny>,
+    increment: f64,
+    max_unbalanced_ratio: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    if !run.is_callable() {
+        return Err(pyo3::exceptions::PyTypeError::new_err(
+            "check_servo_convergence: run must be callable",
+        ));
+    }
+    let servo = voussoir::loading::Servo::new(
+        voussoir::ids::BlockId(0),
+        voussoir::math::Vector::X,
+        increment,
+        max_unbalanced_ratio,
+    )
+    .map_err(crate::errors::to_py)?;
+    let kwargs = |s: &voussoir::loading::Servo| -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("increment", s.increment)?;
+        d.set_item("max_unbalanced_ratio", s.max_unbalanced_ratio)?;
+        Ok(d)
+    };
+    let refined = servo.refined();
+    let call = |s: &voussoir::loading::Servo| -> PyResult<f64> { run.call((), Some(&kwargs(s)?))?.extract::<f64>() };
+    let c = Convergence {
+        value: call(&servo)?,
+        refined: call(&refined)?,
+    };
+    let out = PyDict::new(py);
+    out.set_item("value", c.value)?;
+    out.set_item("refined", c.refined)?;
+    out.set_item("relative_change", c.relative_change())?;
+    out.set_item("servo", kwargs(&servo)?)?;
+    out.set_item("refined_servo", kwargs(&refined)?)?;
+    Ok(out)
+}

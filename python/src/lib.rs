@@ -38,6 +38,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(blocks::dome, m)?)?;
     m.add_function(wrap_pyfunction!(series::benchmark_wall, m)?)?;
     m.add_function(wrap_pyfunction!(convergence::check_density_convergence, m)?)?;
+    m.add_function(wrap_pyfunction!(convergence::check_servo_convergence, m)?)?;
     m.add_function(wrap_pyfunction!(limit::limit, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_static, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_impact, m)?)?;

@@ -632,6 +632,93 @@ impl PyModel {
         this.model.set_fixity(id, f).py()
     }
 
+    /// Pushes ``block`` along ``direction`` under servo control until the load it applies has
+    /// peaked and fallen (a push-over to the capacity, as 3DEC's load-capacity run; Rust:
+    /// ``voussoir::loading::PushOver``): the block advances by ``increment`` (m) in each step
+    /// that starts with the unbalanced-force ratio at most ``max_unbalanced_ratio`` and stands
+    /// still otherwise, so that the answer has no loading rate. Every ``sample_travel``
+    /// (default: ``increment``) of travel, at a settled state, the load the block applies
+    /// along ``direction`` (the sum of its contact forces) is recorded. The run stops at
+    /// ``max_travel``, or once the load (averaged over ``smoothing_window`` of travel) has
+    /// stayed below ``stop_fraction`` of its peak for ``fallen_travel`` (default 50
+    /// increments), or after ``max_steps``. The block's translations along ``direction`` must
+    /// be prescribed (``fixity={"translation": [0.0, "fixed", "fixed"]}`` for x); use local
+    /// damping. Check the answer with ``check_servo_convergence``. The model's monitors record
+    /// at the push-over's samples.
+    ///
+    /// Returns a dict: ``peak_load`` (N, the capacity), ``travel_at_peak`` (m),
+    /// ``raw_peak_load``, ``stop`` (``"max_travel"``, ``"fallen"`` or ``"max_steps"``) and
+    /// ``curve`` (arrays ``time``, ``step``, ``travel``, ``load``, ``smoothed_load``).
+    #[pyo3(signature = (block, direction, increment, *, max_unbalanced_ratio=1e-3, max_travel=0.01, stop_fraction=0.5, fallen_travel=None, sample_travel=None, smoothing_window=0.0, max_steps=100_000_000))]
+    #[allow(clippy::too_many_arguments)]
+    fn push_over<'py>(
+        &self,
+        py: Python<'py>,
+        block: Int,
+        direction: &Bound<'py, PyAny>,
+        increment: f64,
+        max_unbalanced_ratio: f64,
+        max_travel: f64,
+        stop_fraction: f64,
+        fallen_travel: Option<f64>,
+        sample_travel: Option<f64>,
+        smoothing_window: f64,
+        max_steps: u64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let direction = vec3(direction, "direction")?;
+        let mut guard = self.lock(py);
+        let id = guard.id(&block, "block index")?;
+        let servo = voussoir::loading::Servo::new(id, direction, increment, max_unbalanced_ratio).py()?;
+        let mut push = voussoir::loading::PushOver::new(servo);
+        push.max_travel = max_travel;
+        push.stop_fraction = stop_fraction;
+        push.smoothing_window = smoothing_window;
+        if let Some(t) = fallen_travel {
+            push.fallen_travel = t;
+        }
+        if let Some(t) = sample_travel {
+            push.sample_travel = t;
+        }
+        let this = &mut *guard;
+        let (model, samples) = (&mut this.model, &mut this.samples);
+        let result = py.detach(move || {
+            push.run(model, max_steps, |m, _| {
+                samples.after_step(m);
+                std::ops::ControlFlow::Continue(())
+            })
+        });
+        let interrupted = self.take_interrupt();
+        drop(guard);
+        if let Some(e) = interrupted {
+            return Err(e);
+        }
+        let r = result.py()?;
+        let out = PyDict::new(py);
+        out.set_item("peak_load", r.peak_load)?;
+        out.set_item("travel_at_peak", r.travel_at_peak)?;
+        out.set_item("raw_peak_load", r.raw_peak_load)?;
+        out.set_item(
+            "stop",
+            match r.stop {
+                voussoir::loading::PushOverStop::MaxTravel => "max_travel",
+                voussoir::loading::PushOverStop::Fallen => "fallen",
+                voussoir::loading::PushOverStop::Callback => "callback",
+                voussoir::loading::PushOverStop::MaxSteps => "max_steps",
+            },
+        )?;
+        let curve = PyDict::new(py);
+        curve.set_item("time", array1(py, r.curve.iter().map(|s| s.time).collect()))?;
+        curve.set_item("step", array1(py, r.curve.iter().map(|s| s.step).collect()))?;
+        curve.set_item("travel", array1(py, r.curve.iter().map(|s| s.travel).collect()))?;
+        curve.set_item("load", array1(py, r.curve.iter().map(|s| s.load).collect()))?;
+        curve.set_item(
+            "smoothed_load",
+            array1(py, r.curve.iter().map(|s| s.smoothed_load).collect()),
+        )?;
+        out.set_item("curve", curve)?;
+        Ok(out)
+    }
+
     /// Makes a block's translations follow base-motion histories from now on (the histories'
     /// ``t = 0`` is the model's current time), replacing any motion the block had: ``x``, ``y``,
     /// ``z`` are ``TimeHistory`` objects (or None: that axis stands still) of ``kind``

@@ -21,6 +21,7 @@ from ._voussoir import (
     VoussoirIOError,
     __version__,
     check_density_convergence,
+    check_servo_convergence,
     limit,
 )
 from . import build, scenarios, scenes
@@ -37,6 +38,7 @@ __all__ = [
     "__version__",
     "build",
     "check_density_convergence",
+    "check_servo_convergence",
     "limit",
     "scenarios",
     "scenes",

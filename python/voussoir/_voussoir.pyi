@@ -168,6 +168,22 @@ class Model:
     def set_fixity(self, block: int, fixity: FixitySpec) -> None: ...
     # The block's translations follow the histories from now on (kind "acceleration" from
     # rest, "velocity", or "displacement" from 0); no history removes the motion.
+    # Push-over to the capacity under servo control (no loading rate); returns peak_load,
+    # travel_at_peak, raw_peak_load, stop and curve (time, step, travel, load, smoothed_load).
+    def push_over(
+        self,
+        block: int,
+        direction: Sequence[float],
+        increment: float,
+        *,
+        max_unbalanced_ratio: float = 1e-3,
+        max_travel: float = 0.01,
+        stop_fraction: float = 0.5,
+        fallen_travel: Optional[float] = None,
+        sample_travel: Optional[float] = None,
+        smoothing_window: float = 0.0,
+        max_steps: int = 100_000_000,
+    ) -> Dict[str, Any]: ...
     def set_base_motion(
         self,
         block: int,
@@ -413,6 +429,13 @@ def check_density_convergence(
     (``2 n - 1`` per edge, or half the spacing), passing the density as ``Model``'s keyword
     argument; return ``value``, ``refined``, ``relative_change``, ``density`` and
     ``refined_density``."""
+    ...
+
+def check_servo_convergence(
+    run: Callable[..., float], *, increment: float, max_unbalanced_ratio: float = 1e-3
+) -> Dict[str, Any]:
+    """Run ``run(increment=..., max_unbalanced_ratio=...)`` and again with both halved; return
+    ``value``, ``refined``, ``relative_change``, ``servo`` and ``refined_servo``."""
     ...
 
 LiveLoad = Union[Dict[str, Any], Tuple[int, Sequence[float], Sequence[float]]]

@@ -76,7 +76,9 @@
 //! ```
 
 mod excitation;
+mod pushover;
 mod servo;
 
 pub use excitation::{BaseMotion, MotionKind, TimeHistory};
+pub use pushover::{PushOver, PushOverResult, PushOverSample, PushOverStop};
 pub use servo::{Convergence, Servo};
