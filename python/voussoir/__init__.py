@@ -24,7 +24,7 @@ from ._voussoir import (
     check_servo_convergence,
     limit,
 )
-from . import build, scenarios, scenes
+from . import build, scenarios, scenes, study
 
 __all__ = [
     "Block",
@@ -42,4 +42,5 @@ __all__ = [
     "limit",
     "scenarios",
     "scenes",
+    "study",
 ]
