@@ -24,7 +24,7 @@ from ._voussoir import (
     check_servo_convergence,
     limit,
 )
-from . import build, scenarios, scenes, study
+from . import build, fragility, scenarios, scenes, study
 
 __all__ = [
     "Block",
@@ -37,6 +37,7 @@ __all__ = [
     "VoussoirIOError",
     "__version__",
     "build",
+    "fragility",
     "check_density_convergence",
     "check_servo_convergence",
     "limit",

@@ -45,7 +45,8 @@ __all__ = ["grid", "run", "case_key"]
 def grid(**axes: Sequence[Any]) -> List[Dict[str, Any]]:
     """The cases of a full factorial grid, the last axis varying fastest::
 
-        >>> grid(phi=[30, 35], kn=[1e9, 4e9])
+        >>> import voussoir as vs
+        >>> vs.study.grid(phi=[30, 35], kn=[1e9, 4e9])
         [{'phi': 30, 'kn': 1000000000.0}, {'phi': 30, 'kn': 4000000000.0}, {'phi': 35, 'kn': 1000000000.0}, {'phi': 35, 'kn': 4000000000.0}]
     """
     names = list(axes)
