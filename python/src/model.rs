@@ -976,7 +976,11 @@ impl PyModel {
     /// The contacts, as a dict of arrays (one row per contact): ``blocks`` (m, 2) ints (a < b),
     /// ``normal`` (m, 3) unit normal a → b, ``normal_force`` (m,) N (compression positive),
     /// ``force`` (m, 3) resultant on b (N), ``moment_a``, ``moment_b`` (m, 3) its moments about
-    /// the centroids (N·m), ``subcontact_count`` (m,) ints.
+    /// the centroids (N·m), ``shear_force`` (m, 3) the resultant's component in the joint
+    /// plane, ``application_point`` (m, 3) the centre of the sub-contacts' normal forces
+    /// (where each acts within its cell), at which the resultant gives the contact's moment
+    /// about any axis in the joint plane (NaN for a contact without compression),
+    /// ``subcontact_count`` (m,) ints.
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let this = self.lock(py);
         let cs: Vec<_> = this.model.contacts().collect();
@@ -1003,6 +1007,37 @@ impl PyModel {
         d.set_item("force", array_n3(py, cs.iter().map(|c| c.resultant())))?;
         d.set_item("moment_a", array_n3(py, cs.iter().map(|c| c.wrench().moment_a)))?;
         d.set_item("moment_b", array_n3(py, cs.iter().map(|c| c.wrench().moment_b)))?;
+        d.set_item(
+            "shear_force",
+            array_n3(
+                py,
+                cs.iter().map(|c| {
+                    let (f, n) = (c.resultant(), c.normal());
+                    f - n * n.dot(f)
+                }),
+            ),
+        )?;
+        d.set_item(
+            "application_point",
+            array_n3(
+                py,
+                cs.iter().map(|c| {
+                    let (mut total, mut moment) = (0.0, voussoir::math::Vector::ZERO);
+                    for s in c.subcontacts() {
+                        let n = s.normal_force();
+                        if n > 0.0 {
+                            total += n;
+                            moment += s.normal_force_point() * n;
+                        }
+                    }
+                    if total > 0.0 {
+                        moment / total
+                    } else {
+                        voussoir::math::Vector::splat(f64::NAN)
+                    }
+                }),
+            ),
+        )?;
         d.set_item(
             "subcontact_count",
             array1(py, cs.iter().map(|c| c.subcontact_count() as i64).collect()),

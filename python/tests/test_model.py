@@ -29,6 +29,22 @@ def test_readme_example_equilibrium(model):
     assert model.unbalanced_force_ratio < 1e-5
 
 
+def test_a_contact_resultant_acts_where_its_moment_says(model):
+    """Pushed sideways at its centroid's height (0.1 m) by P, a block's base reaction moves
+    towards the leading edge by e = P · 0.1 / W (moment balance about the base): the contact's
+    application point, 0.2 + e along x. Its shear force is the push."""
+    model.set_load(1, force=(PUSH, 0, 0))
+    model.run_to_equilibrium(1e-6, 100_000)
+    c = model.contacts()
+    e = PUSH * 0.1 / WEIGHT
+    assert c["application_point"][0] == pytest.approx([0.2 + e, 0.15, 0.0], abs=2e-4)
+    assert c["shear_force"][0] == pytest.approx([-PUSH, 0, 0], rel=1e-3, abs=1e-3 * WEIGHT)
+    # Without compression, no point.
+    model.set_load(1, force=(0, 0, 3 * WEIGHT))
+    model.run_steps(2000)
+    assert np.isnan(model.contacts()["application_point"]).all() or model.contact_count == 0
+
+
 def test_arrays(model):
     model.run_steps(20)
     n = len(model)
