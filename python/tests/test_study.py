@@ -102,3 +102,18 @@ def test_serial_runs_and_bad_cases():
         vs.study.run(pushed_block, [CASES[0], CASES[0]], client="serial")
     with pytest.raises(TypeError, match="list of values"):
         vs.study.grid(phi=30)
+
+
+def test_the_static_sensitivity_cases_are_the_command_lines():
+    """The 24 cases of ``cargo run --example arch_static`` (its summary.json labels), and one of
+    them run through the study gives what ``scenarios.arch_static`` gives."""
+    cases = vs.study.arch_static_cases()
+    labels = [c["label"] for c in cases]
+    assert len(cases) == 24 and labels[0] == "baseline" and labels[-1] == "rate 0.005 m/s"
+    assert labels[1:4] == ["friction 25°", "friction 26°", "friction 27°"]
+    assert "kn 2 GPa/m" in labels and "small displacements" in labels and "width 0.20 m" in labels
+    quick = {"per_edge": 5, "max_displacement": 0.002}
+    table = vs.study.arch_static_sensitivity(client="serial", progress=False, **quick)
+    assert len(table) == 24 and (table["error"] == "").all(), table[table["error"] != ""]
+    direct = vs.scenarios.arch_static(**dict(cases[0], **quick))
+    assert table["peak_load_kn"][0] == direct["peak_load_kn"]

@@ -39,7 +39,7 @@ import tempfile
 import time
 from typing import Any, Callable, Dict, Iterable, List, Mapping, Optional, Sequence
 
-__all__ = ["grid", "run", "case_key"]
+__all__ = ["grid", "run", "case_key", "arch_static_cases", "arch_static_case", "arch_static_sensitivity"]
 
 
 def grid(**axes: Sequence[Any]) -> List[Dict[str, Any]]:
@@ -261,3 +261,46 @@ def _table(cases: List[Dict[str, Any]], outcomes: List[Dict[str, Any]]):
         row["error"] = outcome.get("error", "") or ""
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def arch_static_cases() -> List[Dict[str, Any]]:
+    """The cases of ``cargo run --release --example arch_static`` (arch/src/cli/arch_static.rs,
+    ``paper_cases``), as keyword arguments of ``voussoir.scenarios.arch_static``: the baseline
+    (φ 30.5°, kn 4 GPa/m, ks 0.4 kn, width 0.15 m, large displacements, servo loading), the
+    friction sweep 25°–40°, kn 2 and 8 GPa/m (ks scaled with it), small displacements, width
+    0.20 m, and the rate study at 0.05, 0.01 and 0.005 m/s."""
+    base = {"label": "baseline", "friction_deg": 30.5, "kn": 4e9, "ks": 1.6e9, "width": 0.15, "mode": "large"}
+    cases = [dict(base)]
+    for phi in range(25, 41):
+        if phi != 30.5:
+            cases.append(dict(base, label=f"friction {phi}°", friction_deg=float(phi)))
+    for kn in (2e9, 8e9):
+        cases.append(dict(base, label=f"kn {kn / 1e9:g} GPa/m", kn=kn, ks=kn * base["ks"] / base["kn"]))
+    cases.append(dict(base, label="small displacements", mode="small"))
+    cases.append(dict(base, label="width 0.20 m", width=0.20))
+    for rate in (5e-2, 1e-2, 5e-3):
+        cases.append(dict(base, label=f"rate {rate:g} m/s", rate=rate))
+    return cases
+
+
+def arch_static_case(**case: Any) -> Dict[str, Any]:
+    """One case of the static study (``voussoir.scenarios.arch_static(**case)``): its peak load
+    (kN), the plate's displacement there (mm), its limit analysis (kN) and whether it slides."""
+    import voussoir as vs
+
+    r = vs.scenarios.arch_static(**case)
+    return {
+        "peak_load_kn": r["peak_load_kn"],
+        "disp_at_peak_mm": r["disp_at_peak_mm"],
+        "raw_peak_load_kn": r["raw_peak_load_kn"],
+        "steps": r["steps"],
+    }
+
+
+def arch_static_sensitivity(store: Optional[str] = None, client: Any = None, *, progress: bool = True, **common: Any):
+    """The reference arch's static sensitivity study of ``cargo run --release --example
+    arch_static`` (``arch_static_cases``, each with ``common`` keywords added) as a study on
+    Dask: its table (one row per case: the case's keywords, ``peak_load_kn``,
+    ``disp_at_peak_mm``, ``raw_peak_load_kn``, ``steps``, ``error``)."""
+    cases = [dict(c, **common) for c in arch_static_cases()]
+    return run(arch_static_case, cases, store=store, client=client, progress=progress)
