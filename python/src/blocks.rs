@@ -152,6 +152,15 @@ impl PyBlock {
             self.inner.shape().vertices().iter().map(|v| pose.transform_point(*v)),
         )
     }
+    /// The faces, each the list of its vertices' indices (rows of ``vertices``) in
+    /// counter-clockwise order seen from outside (outward normal by the right-hand rule): the
+    /// polygons of the block's surface, as COMPAS meshes and ``Model.add_polyhedron(faces=...)``
+    /// take them.
+    #[getter]
+    fn faces(&self) -> Vec<Vec<u32>> {
+        let shape = self.inner.shape();
+        (0..shape.faces().len()).map(|f| shape.face_loop(f).to_vec()).collect()
+    }
     /// Fixity as a dict ``{"translation": [...], "rotation": [...]}``.
     #[getter]
     fn fixity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {

@@ -948,6 +948,21 @@ impl PyModel {
         )
     }
 
+    /// Each block's rotation since its initial pose (the turn that takes its initial
+    /// orientation to the current one, world axes) as rotation vectors (axis times angle,
+    /// rad), an (n, 3) array: what a voussoir has turned, without composing ``rotations()``
+    /// (principal frame to world) with the initial orientation.
+    fn rotations_from_initial<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let this = self.lock(py);
+        array_n3(
+            py,
+            this.model
+                .blocks()
+                .iter()
+                .map(|b| (b.state().pose.rotation * b.initial_pose().rotation.inverse()).to_scaled_axis()),
+        )
+    }
+
     /// Orientations as rotation matrices (principal frame to world), an (n, 3, 3) array.
     fn rotation_matrices<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
         let this = self.lock(py);

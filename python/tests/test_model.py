@@ -45,6 +45,26 @@ def test_a_contact_resultant_acts_where_its_moment_says(model):
     assert np.isnan(model.contacts()["application_point"]).all() or model.contact_count == 0
 
 
+def test_block_faces_and_rotations_from_initial():
+    """A block's faces are its surface (outward by the right-hand rule: the polygon areas add
+    up to the surface, and each normal points away from the centroid); a block turned by a
+    known angle reports it since its initial pose."""
+    b = vs.Block.cuboid("c", (0, 0, 0), (0.4, 0.3, 0.2), 2000.0)
+    v, faces = b.vertices, b.faces
+    assert len(faces) == 6 and sorted(len(f) for f in faces) == [4] * 6
+    area = 0.0
+    for f in faces:
+        p = v[f]
+        n = sum(np.cross(p[k], p[(k + 1) % len(p)]) for k in range(len(p))) / 2
+        area += np.linalg.norm(n)
+        assert np.dot(n, p.mean(axis=0) - b.centroid) > 0
+    assert area == pytest.approx(2 * (0.4 * 0.3 + 0.4 * 0.2 + 0.3 * 0.2))
+    m = vs.Model(gravity=(0, 0, 0))
+    m.add_cuboid("c", (0, 0, 0), (0.4, 0.3, 0.2), 2000.0, angular_velocity=(0, 0, 1.0))
+    m.run_until_time(0.3)
+    assert m.rotations_from_initial()[0] == pytest.approx([0, 0, m.time], abs=1e-9)
+
+
 def test_arrays(model):
     model.run_steps(20)
     n = len(model)
