@@ -7,6 +7,18 @@ use plotters::prelude::*;
 
 use voussoir::error::{Error, Result};
 
+/// The curves' colours, in order: dark, saturated and told apart by colour-blind readers
+/// (Okabe–Ito, without its yellow, which was all but invisible on white).
+const CURVE_COLORS: [RGBColor; 7] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+    RGBColor(0, 0, 0),
+];
+
 /// One named curve.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Curve {
@@ -282,13 +294,20 @@ impl LinePlot {
             .draw()
             .map_err(err)?;
         for (k, c) in self.curves.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
+            let color = CURVE_COLORS[k % CURVE_COLORS.len()];
             chart
                 .draw_series(LineSeries::new(drawable_points(c), color.stroke_width(2)))
                 .map_err(err)?
                 .label(c.label.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            // Where the curve ends (a run stopped by a collapse, or at its end): a dot.
+            if let Some(last) = drawable_points(c).last() {
+                chart
+                    .draw_series(std::iter::once(Circle::new(last, 4, color.filled())))
+                    .map_err(err)?;
+            }
         }
+        let mut marker = 0usize;
         for r in self.drawable_references() {
             match r {
                 Reference::Horizontal { label, y } => {
@@ -301,15 +320,32 @@ impl LinePlot {
                         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
                 }
                 Reference::Point { label, x, y } => {
-                    chart
-                        .draw_series(std::iter::once(Cross::new(
-                            (clamp(*x), clamp(*y)),
-                            7,
-                            BLACK.stroke_width(2),
-                        )))
-                        .map_err(err)?
+                    // Each point its own symbol, so that the legend tells them apart.
+                    let at = (clamp(*x), clamp(*y));
+                    let style = BLACK.stroke_width(2);
+                    let kind = marker % 4;
+                    marker += 1;
+                    let series = match kind {
+                        0 => chart.draw_series(std::iter::once(EmptyElement::at(at) + Cross::new((0, 0), 7, style))),
+                        1 => chart.draw_series(std::iter::once(
+                            EmptyElement::at(at) + TriangleMarker::new((0, 0), 8, style),
+                        )),
+                        2 => chart.draw_series(std::iter::once(EmptyElement::at(at) + Circle::new((0, 0), 7, style))),
+                        _ => chart.draw_series(std::iter::once(
+                            EmptyElement::at(at) + Rectangle::new([(-6, -6), (6, 6)], style),
+                        )),
+                    }
+                    .map_err(err)?;
+                    series
                         .label(label.as_str())
-                        .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
+                        .legend(move |(x, y)| -> DynElement<'static, DB, (i32, i32)> {
+                            match kind {
+                                0 => Cross::new((x + 10, y), 5, style).into_dyn(),
+                                1 => TriangleMarker::new((x + 10, y), 6, style).into_dyn(),
+                                2 => Circle::new((x + 10, y), 5, style).into_dyn(),
+                                _ => Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], style).into_dyn(),
+                            }
+                        });
                 }
             }
         }
