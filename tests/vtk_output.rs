@@ -382,3 +382,35 @@ fn csv_histories_quote_monitor_names() -> Result<()> {
     std::fs::remove_dir_all(&dir).ok();
     Ok(())
 }
+
+/// A series whose times count from its first frame: 0, then the model time elapsed since; the
+/// default counts the model's time (which includes any settling before the first frame).
+#[test]
+fn a_series_may_count_time_from_its_first_frame() -> Result<()> {
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0)?);
+    model.add_block(common::fixed_slab("slab"))?;
+    model.add_block(common::cube("cube", Vector::ZERO))?;
+    model.run_steps(50)?;
+    let t0 = model.time();
+    let dir = std::env::temp_dir().join(format!("voussoir-vtk-origin-{}", std::process::id()));
+    let mut relative = Series::new(&dir, "relative").with_time_from_first_frame();
+    let mut absolute = Series::new(&dir, "absolute");
+    for _ in 0..2 {
+        relative.write_frame(&model)?;
+        absolute.write_frame(&model)?;
+        model.run_steps(10)?;
+    }
+    let times = |pvd: std::path::PathBuf| -> Vec<f64> {
+        let text = std::fs::read_to_string(pvd).expect("pvd");
+        text.split("timestep=\"")
+            .skip(1)
+            .map(|rest| rest.split('"').next().expect("value").parse().expect("number"))
+            .collect()
+    };
+    let (r, a) = (times(relative.blocks_pvd()), times(absolute.blocks_pvd()));
+    assert!(t0 > 0.0 && r[0] == 0.0 && a[0] == t0, "{r:?} {a:?}");
+    assert!((r[1] - (a[1] - t0)).abs() < 1e-15, "{r:?} {a:?}");
+    drop((relative, absolute));
+    std::fs::remove_dir_all(&dir).ok();
+    Ok(())
+}

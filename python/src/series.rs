@@ -13,7 +13,9 @@ use crate::model::PyModel;
 /// (points) of the model as a frame and rewrites the ``.pvd`` collections (``blocks_pvd``),
 /// which ParaView opens as a time series; ``meshio.read`` opens each frame's files. With
 /// ``subcontacts_every=n`` the sub-contacts, the large files, are written on every n-th frame
-/// only (the first, then every n-th), the blocks on every frame. One series writes a name in a
+/// only (the first, then every n-th), the blocks on every frame. With
+/// ``time_from_first_frame=True`` the collections' times count from the first frame (a run's
+/// start) instead of the model's time (which includes any settling before). One series writes a name in a
 /// folder at a time (a lock file ``.<name>.lock`` from the first frame until the series is
 /// freed): a second one, in this process or another, raises ``VoussoirIOError``; so does a
 /// frame after the folder was deleted or emptied mid-run.
@@ -25,16 +27,18 @@ pub struct PySeries {
 #[pymethods]
 impl PySeries {
     #[new]
-    #[pyo3(signature = (folder, name="model", *, subcontacts_every=1))]
-    fn new(folder: PathBuf, name: &str, subcontacts_every: usize) -> PyResult<Self> {
+    #[pyo3(signature = (folder, name="model", *, subcontacts_every=1, time_from_first_frame=false))]
+    fn new(folder: PathBuf, name: &str, subcontacts_every: usize, time_from_first_frame: bool) -> PyResult<Self> {
         if subcontacts_every == 0 {
             return Err(pyo3::exceptions::PyValueError::new_err(
                 "subcontacts_every must be at least 1 (every frame)",
             ));
         }
-        Ok(Self {
-            inner: voussoir::io::vtk::Series::new(folder, name).with_subcontacts_every(subcontacts_every),
-        })
+        let mut inner = voussoir::io::vtk::Series::new(folder, name).with_subcontacts_every(subcontacts_every);
+        if time_from_first_frame {
+            inner = inner.with_time_from_first_frame();
+        }
+        Ok(Self { inner })
     }
 
     /// Writes a frame of the model.

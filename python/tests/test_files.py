@@ -38,6 +38,14 @@ def test_paraview(tmp_path, model):
     assert len(ET.parse(sparse.blocks_pvd).getroot().findall(".//DataSet")) == 5
     with pytest.raises(ValueError, match="at least 1"):
         vs.ParaviewSeries(tmp_path / "x", "demo", subcontacts_every=0)
+    # Times from the first frame: 0 and the time between the frames.
+    relative = vs.ParaviewSeries(tmp_path / "rel", "demo", time_from_first_frame=True)
+    t0 = model.time
+    relative.write_frame(model)
+    model.run_steps(10)
+    relative.write_frame(model)
+    times = [float(d.get("timestep")) for d in ET.parse(relative.blocks_pvd).getroot().findall(".//DataSet")]
+    assert times == [0.0, pytest.approx(model.time - t0, rel=1e-12)] and t0 > 0
 
 
 def test_paraview_files_read_by_meshio(tmp_path, model):

@@ -392,6 +392,10 @@ pub struct Series {
     frames: Vec<(Real, String, Option<String>)>,
     /// Sub-contacts are written on every this many frames (1: every frame).
     subcontacts_every: usize,
+    /// Whether the collections' times count from the first frame (else the model's time).
+    from_first_frame: bool,
+    /// The model's time at the first frame.
+    origin: Real,
     /// The lock file this series holds (from its first frame).
     lock: Option<PathBuf>,
     /// This series' number in the process, written in its lock file.
@@ -410,6 +414,8 @@ impl Clone for Series {
             name: self.name.clone(),
             frames: self.frames.clone(),
             subcontacts_every: self.subcontacts_every,
+            from_first_frame: self.from_first_frame,
+            origin: self.origin,
             lock: None,
             id: SERIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
@@ -512,6 +518,8 @@ impl Series {
             name: name.to_owned(),
             frames: Vec::new(),
             subcontacts_every: 1,
+            from_first_frame: false,
+            origin: 0.0,
             lock: None,
             id: SERIES.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
@@ -594,6 +602,15 @@ impl Series {
         self
     }
 
+    /// The same series with the times of its `.pvd` collections counted from its first frame
+    /// (a drop from its release, a push from its start) instead of the model's time, which
+    /// includes the settling before.
+    #[must_use]
+    pub fn with_time_from_first_frame(mut self) -> Self {
+        self.from_first_frame = true;
+        self
+    }
+
     /// A new, empty series written into `dir`, its name checked by [`check_series_name`].
     ///
     /// # Errors
@@ -626,7 +643,15 @@ impl Series {
         if let Some(contacts) = &contacts {
             write_subcontacts(&self.dir.join(contacts), model)?;
         }
-        self.frames.push((model.time(), blocks, contacts));
+        if self.frames.is_empty() {
+            self.origin = model.time();
+        }
+        let time = if self.from_first_frame {
+            model.time() - self.origin
+        } else {
+            model.time()
+        };
+        self.frames.push((time, blocks, contacts));
         self.write_collections()
     }
 

@@ -228,8 +228,12 @@ impl Outputs {
     ) -> voussoir::Result<T> {
         match name.filter(|_| self.paraview) {
             Some(name) => {
-                let mut series =
-                    vtk::Series::new(self.dir.join("paraview"), name).with_subcontacts_every(subcontacts_every);
+                // Times from the first frame: a drop's from its release, a push's from its
+                // start, as the histories and plots count them (not the model's, which include
+                // the settling).
+                let mut series = vtk::Series::new(self.dir.join("paraview"), name)
+                    .with_subcontacts_every(subcontacts_every)
+                    .with_time_from_first_frame();
                 run(Some(every), &mut |m| series.write_frame(m))
             }
             None => run(None, &mut |_| Ok(())),
