@@ -19,6 +19,17 @@ def read(path):
     return r.GetOutput()
 
 
+def measured(grid, quantity):
+    """The sum over the cells of ``quantity`` ("Volume" or "Area") as VTK measures it."""
+    q = vtk.vtkCellSizeFilter()
+    q.SetInputData(grid)
+    q.SetComputeVolume(quantity == "Volume")
+    q.SetComputeArea(quantity == "Area")
+    q.Update()
+    values = q.GetOutput().GetCellData().GetArray(quantity)
+    return sum(values.GetValue(i) for i in range(values.GetNumberOfTuples()))
+
+
 def main():
     blocks, contacts, pvd, surfaces = sys.argv[1:5]
     n_blocks, volume, n_subs, area = int(sys.argv[5]), float(sys.argv[6]), int(sys.argv[7]), float(sys.argv[8])
@@ -28,12 +39,7 @@ def main():
     types = {g.GetCellType(i) for i in range(g.GetNumberOfCells())}
     assert types == {vtk.VTK_POLYHEDRON}, types
     # Total volume of the polyhedron cells, measured by VTK itself.
-    q = vtk.vtkCellSizeFilter()
-    q.SetInputData(g)
-    q.SetComputeVolume(True)
-    q.Update()
-    vols = q.GetOutput().GetCellData().GetArray("Volume")
-    total = sum(vols.GetValue(i) for i in range(vols.GetNumberOfTuples()))
+    total = measured(g, "Volume")
     assert abs(total - volume) < 1e-9 * volume, (total, volume)
     ids = g.GetCellData().GetArray("block_id")
     assert [int(ids.GetValue(i)) for i in range(n_blocks)] == list(range(n_blocks))
@@ -44,12 +50,7 @@ def main():
     assert s.GetNumberOfCells() == n_faces, (s.GetNumberOfCells(), n_faces)
     types = {s.GetCellType(i) for i in range(s.GetNumberOfCells())}
     assert types <= {vtk.VTK_TRIANGLE, vtk.VTK_QUAD, vtk.VTK_POLYGON}, types
-    q = vtk.vtkCellSizeFilter()
-    q.SetInputData(s)
-    q.SetComputeArea(True)
-    q.Update()
-    areas = q.GetOutput().GetCellData().GetArray("Area")
-    total_surface = sum(areas.GetValue(i) for i in range(areas.GetNumberOfTuples()))
+    total_surface = measured(s, "Area")
     assert abs(total_surface - surface) < 1e-9 * surface, (total_surface, surface)
     ids = s.GetCellData().GetArray("block_id")
     assert sorted({int(ids.GetValue(i)) for i in range(n_faces)}) == list(range(n_blocks))

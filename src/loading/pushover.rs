@@ -63,7 +63,8 @@ pub struct PushOver {
     pub stop_fraction: Real,
     /// How long the load must stay below [`PushOver::stop_fraction`] of its peak (m of travel).
     pub fallen_travel: Real,
-    /// The travel between two samples of the curve (m); at least the servo's increment.
+    /// The travel between two samples of the curve (m); one at or below the servo's increment
+    /// samples the first settled state after every advance.
     pub sample_travel: Real,
     /// The travel over which the load is averaged for the peak (m); 0: the peak of the settled
     /// states themselves (which scatter about the curve by the servo's threshold).
