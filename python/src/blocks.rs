@@ -216,6 +216,35 @@ pub fn arch(
     voussoir_material: u16,
     abutment_material: u16,
 ) -> PyResult<Vec<PyBlock>> {
+    let spec = arch_spec(
+        span,
+        rise,
+        thickness,
+        width,
+        voussoirs,
+        density,
+        abutment_outer_width,
+        abutment_depth,
+        voussoir_material,
+        abutment_material,
+    );
+    Ok(wrap(Arch::new(&spec).py()?.blocks))
+}
+
+/// The arch generator's specification from `arch`'s arguments (also `arch_joints`'s).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn arch_spec(
+    span: f64,
+    rise: f64,
+    thickness: f64,
+    width: f64,
+    voussoirs: usize,
+    density: f64,
+    abutment_outer_width: f64,
+    abutment_depth: f64,
+    voussoir_material: u16,
+    abutment_material: u16,
+) -> ArchSpec {
     let mut spec = ArchSpec::reference(width);
     spec.span = span;
     spec.rise = rise;
@@ -228,7 +257,7 @@ pub fn arch(
     };
     spec.voussoir_material = MaterialId(voussoir_material);
     spec.abutment_material = MaterialId(abutment_material);
-    Ok(wrap(Arch::new(&spec).py()?.blocks))
+    spec
 }
 
 /// A running-bond wall on a fixed base block (the first block), bricks in courses along x,

@@ -241,3 +241,8 @@ pub fn json_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<B
     let text = serde_json::to_string(value).map_err(|e| bad(e.to_string()))?;
     py.import("json")?.call_method1("loads", (text,))
 }
+
+/// `data` as a `voussoir._results.Result` named `kind`: a dict with a short `repr`.
+pub fn result<'py>(py: Python<'py>, kind: &str, data: Bound<'py, PyDict>) -> PyResult<Bound<'py, PyAny>> {
+    py.import("voussoir._results")?.getattr("Result")?.call1((kind, data))
+}

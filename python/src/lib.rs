@@ -11,6 +11,7 @@ mod documents;
 mod errors;
 mod laws;
 mod limit;
+mod mechanism;
 mod model;
 mod motion;
 mod scenarios;
@@ -40,6 +41,8 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(convergence::check_density_convergence, m)?)?;
     m.add_function(wrap_pyfunction!(convergence::check_servo_convergence, m)?)?;
     m.add_function(wrap_pyfunction!(limit::limit, m)?)?;
+    m.add_function(wrap_pyfunction!(mechanism::classify_joints, m)?)?;
+    m.add_function(wrap_pyfunction!(mechanism::arch_joints, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_static, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::arch_impact, m)?)?;
     m.add_function(wrap_pyfunction!(scenarios::impact_setups, m)?)?;

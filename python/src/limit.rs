@@ -65,7 +65,7 @@ pub fn limit<'py>(
     facets: usize,
     check_dead_load: bool,
     max_iterations: u32,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<Bound<'py, PyAny>> {
     let friction = match friction {
         "cone" => FrictionModel::Cone,
         "pyramid" => FrictionModel::Pyramid { facets },
@@ -90,7 +90,11 @@ pub fn limit<'py>(
     };
     // The model is free again; the solve lets the GIL go.
     let result = py.detach(|| problem.solve(&live, &options)).py()?;
-    result_to_py(py, &result, check_dead_load.then_some(true))
+    crate::convert::result(
+        py,
+        "LimitResult",
+        result_to_py(py, &result, check_dead_load.then_some(true))?,
+    )
 }
 
 /// The live loads from Python: dicts or `(block, point, force)` sequences.

@@ -22,6 +22,7 @@ from ._voussoir import (
     __version__,
     check_density_convergence,
     check_servo_convergence,
+    classify_joints,
     limit,
 )
 from . import build, fragility, scenarios, scenes, study
@@ -40,6 +41,7 @@ __all__ = [
     "fragility",
     "check_density_convergence",
     "check_servo_convergence",
+    "classify_joints",
     "limit",
     "scenarios",
     "scenes",

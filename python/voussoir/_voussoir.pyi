@@ -186,6 +186,7 @@ class Model:
         sample_travel: Optional[float] = None,
         smoothing_window: float = 0.0,
         max_steps: int = 100_000_000,
+        progress: bool = False,
     ) -> Dict[str, Any]: ...
     def set_base_motion(
         self,
@@ -201,14 +202,20 @@ class Model:
     def set_prescribed_velocity(self, block: int, velocity: Vec3) -> None: ...
     # running
     def step(self) -> None: ...
-    def run_steps(self, n: int, callback: Optional[Progress] = None, every: int = 1000) -> bool: ...
-    def run_until_time(self, t: float, callback: Optional[Progress] = None, every: int = 1000) -> bool: ...
+    def run_steps(
+        self, n: int, callback: Optional[Progress] = None, every: int = 1000, *, progress: bool = False
+    ) -> bool: ...
+    def run_until_time(
+        self, t: float, callback: Optional[Progress] = None, every: int = 1000, *, progress: bool = False
+    ) -> bool: ...
     def run_to_equilibrium(
         self,
         ratio: float = 1e-5,
         max_steps: int = 1_000_000,
         callback: Optional[Progress] = None,
         every: int = 1000,
+        *,
+        progress: bool = False,
     ) -> int: ...
     # state
     def __len__(self) -> int: ...
@@ -337,6 +344,23 @@ def arch(
     voussoir_material: int = 0,
     abutment_material: int = 0,
 ) -> List[Block]: ...
+def arch_joints(
+    *,
+    span: float = 1.2,
+    rise: float = 0.4,
+    thickness: float = 0.2,
+    width: float = 0.15,
+    voussoirs: int = 13,
+    density: float = 2446.4831804281343,
+    abutment_outer_width: float = 0.20,
+    abutment_depth: float = 0.30,
+    voussoir_material: int = 0,
+    abutment_material: int = 0,
+    first_block: int = 0,
+) -> List[Dict[str, Any]]:
+    """The joints of ``arch(...)``'s arch for ``classify_joints``: ``index``, ``blocks``,
+    ``intrados``, ``extrados`` (mid-width edge points) and ``points`` (the joint face's corners)."""
+    ...
 def running_bond_wall(
     *,
     bricks_per_course: int = 10,
@@ -465,4 +489,20 @@ def limit(
     ``blocks`` (``centroid``, ``velocity``, ``angular_velocity``: the mechanism) and
     ``contacts`` (per contact: ``blocks``, ``normal``, ``points``, ``normal_force``,
     ``shear_force``, ``opening``, ``sliding``, ``resultant``, ``application_point``)."""
+    ...
+
+JointSpec = Dict[str, Any]
+
+def classify_joints(
+    model: Model,
+    joints: Sequence[JointSpec],
+    *,
+    open_fraction: float = 0.5,
+    edge_band: float = 0.25,
+    slip: float = 5e-4,
+) -> Dict[str, Any]:
+    """Measure ``joints`` (``{"blocks": (a, b), "intrados", "extrados", "index"?}``) and name the
+    mechanism: ``joint``, ``open_fraction``, ``compression_position``, ``slip``,
+    ``normal_force``, ``hinge`` (None/"intrados"/"extrados"), ``sliding``, ``hinges``,
+    ``sliding_joints``, ``description``."""
     ...
