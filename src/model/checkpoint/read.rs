@@ -1,204 +1,25 @@
-//! Checkpoint and restart: the full state of a model (blocks, contacts, sub-contact history, law
-//! state, energies) as JSON, restored so that the run continues bit-identically. Recorders are
-//! the caller's: their [`crate::monitor::History`] serialises on its own (and is checked for
-//! consistency as it is read).
-//! Compiled with the `serde` feature.
-//!
-//! A checkpoint carries a checksum of its content and the name of its law type; loading one
-//! checks everything it can against everything else (see [`Model::from_checkpoint_str`]), so
-//! that a corrupted or edited file is refused with a typed error rather than run.
+//! Reading a checkpoint: the header, the checksum and the law type first, then the snapshot,
+//! checked against everything it can be checked against before a model is rebuilt from it
+//! (see [`Model::from_checkpoint_str`]), and the file.
 
 use std::path::Path;
 
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use super::checkpoint_tested::{check_slacks, tested_pairs, TestedEntry};
-use super::{Model, ModelParameters};
-use crate::block::{Block, RigidBlock, Wrench};
-use crate::contact::{
-    AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
+use super::{
+    checksum_of, law_type_name, pose_ok, ContactEntry, Header, Snapshot, CHECKSUM, FORMAT, MAX_COUNT, MIN_STORED_BOUND,
+    VERSION,
 };
+use crate::block::Block;
+use crate::contact::{ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
-use crate::geometry::{ContactKind, SubKey};
 use crate::ids::BlockId;
-use crate::integrate::{CentralDifference, CriticalStep, Damping, TimeStep};
-use crate::law::{ConstitutiveLaw, LawTable};
-use crate::law::{JointForce, JointStatus};
-use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
-use crate::model::Energies;
-
-const FORMAT: &str = "voussoir-checkpoint";
-/// Version 9 stores joints through [`ContactEntry`], apart from the step's storage layout, so
-/// that a layout change no longer changes the format. Version 10 adds the checksum and the law
-/// type; version 9 files (which have neither, so that corruption could not be told) are refused.
-/// Version 11 adds the pairs the narrow phase tested, with their relative poses, on which
-/// re-detection depends, and the blocks' stability bounds, which are re-evaluated block by block.
-/// Version 12 has node contacts (`"Nodes"`) where 11 had point contacts (`"Point"`, with a
-/// plane), and the refinement's travel cap (`refine_travel`).
-const VERSION: u32 = 13;
-/// The checksum's field: `"crc32:"` and eight hexadecimal digits.
-const CHECKSUM: &str = "checksum";
-/// The largest step count (or detection count) a checkpoint may hold: 2⁵³, where `f64` stops
-/// counting exactly; far beyond any run (years at a microsecond a step), far below where the
-/// counter would overflow.
-const MAX_COUNT: u64 = 1 << 53;
-/// A stored stability bound below this fraction of the one the blocks and contacts give on
-/// load is refused: it would allow a step the contacts cannot take.
-const MIN_STORED_BOUND: Real = 0.8;
-
-/// The fields every version has, read before the rest (other fields are skipped).
-#[derive(Deserialize)]
-struct Header {
-    format: String,
-    version: u32,
-    #[serde(default)]
-    law_type: Option<String>,
-}
-
-#[derive(Serialize, Deserialize)]
-#[serde(bound(
-    serialize = "L: Serialize, L::State: Serialize",
-    deserialize = "L: DeserializeOwned, L::State: DeserializeOwned"
-))]
-struct Snapshot<L: ConstitutiveLaw> {
-    format: String,
-    version: u32,
-    /// The law type's serde name ([`law_type_name`]), `None` when it has none.
-    law_type: Option<String>,
-    params: ModelParameters,
-    damping: Damping,
-    blocks: Vec<RigidBlock>,
-    joints: LawTable<L>,
-    /// The contacts, sorted by block pair, each with its sub-contacts.
-    contacts: Vec<ContactEntry<L::State>>,
-    ref_poses: Vec<Pose>,
-    /// The pairs the narrow phase tested, sorted, with the relative pose of each at its test.
-    tested: Vec<TestedEntry>,
-    dt: Real,
-    critical: Option<CriticalStep>,
-    /// Each block's bound of its squared natural frequency (1/s²) as last evaluated: the
-    /// critical step and the impact probe read them.
-    bounds: Vec<Real>,
-    step: u64,
-    time: Real,
-    energy: Energies,
-    started: bool,
-    unbalanced_ratio: Option<Real>,
-    detections: u64,
-    /// Last step's reaction and damping wrench per block: the energy bookkeeping books each of
-    /// them half in the next step.
-    #[serde(default)]
-    last_forces: Vec<(Wrench, Wrench)>,
-    /// A full re-detection (and step re-evaluation) requested by a change of laws, parameters,
-    /// fixity or blocks before the save and not yet done.
-    #[serde(default)]
-    pending_detection: bool,
-    /// The last step's duration and the impact refinement's state (absent: a constant step).
-    #[serde(default)]
-    drift: Real,
-    #[serde(default)]
-    refine_until: Real,
-    #[serde(default)]
-    refine_omega2: Real,
-    /// Whether the refinement also caps the travel per step (a node contact asked for it).
-    #[serde(default)]
-    refine_travel: bool,
-    /// The contacts under impact refinement (sorted block pairs).
-    #[serde(default)]
-    refining: Vec<(u32, u32)>,
-    /// Base motions ([`Model::set_base_motion`]), with the model time each started at.
-    #[serde(default)]
-    motions: Vec<super::excitation::AppliedMotion>,
-}
-
-/// A joint as checkpoints store it: its geometry, law, the step's running sums and its
-/// sub-contacts, independent of how the step lays them out in memory.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ContactEntry<S> {
-    blocks: (u32, u32),
-    kind: ContactKind,
-    host_is_a: bool,
-    law: u32,
-    normal: Vector,
-    tangent: Vector,
-    anchors: AnchorPlane,
-    /// Whether the sub-contacts may hold dashpot forces: it selects the sub-contact loop, and
-    /// with it the order of the sums.
-    dashpots: bool,
-    normal_force: Real,
-    /// Force and first moments of the spring forces as the step summed them (a recomputation
-    /// could sum in another order): `[F, F_x, F_y]`.
-    springs: [Vector; 3],
-    spread_energy: Real,
-    /// Centroids and host rotation at detection (small-displacement mode).
-    reference_centroids: (Vector, Vector),
-    reference_host_rotation: Rotation,
-    area: Real,
-    bound_area: Real,
-    /// Resultant and moments as of the last step.
-    wrench: ContactWrench,
-    subcontacts: Vec<SubContactEntry<S>>,
-}
-
-/// A sub-contact as checkpoints store it.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SubContactEntry<S> {
-    key: SubKey,
-    plane: Vector2,
-    area: Real,
-    gap: Real,
-    force: JointForce,
-    slip: Real,
-    half: [f32; 2],
-    status: JointStatus,
-    state: S,
-    dashpot: Vector,
-}
-
-impl<L: ConstitutiveLaw> Model<L> {
-    /// Contact `k` as a checkpoint stores it.
-    fn contact_entry(&self, k: usize) -> ContactEntry<L::State> {
-        let (p, r) = (&self.state.pairs[k], &self.state.references[k]);
-        let range = p.range();
-        ContactEntry {
-            blocks: (p.a, p.b),
-            kind: p.kind,
-            host_is_a: p.host_is_a,
-            law: p.law,
-            normal: p.normal,
-            tangent: p.tangent,
-            anchors: p.anchors,
-            dashpots: p.dashpots,
-            normal_force: p.normal_force,
-            springs: [p.springs.force, p.springs.per_x, p.springs.per_y],
-            spread_energy: p.spread_energy,
-            reference_centroids: (r.ref_a, r.ref_b),
-            reference_host_rotation: r.ref_host_rotation,
-            area: r.area,
-            bound_area: r.bound_area,
-            wrench: self.state.wrenches[k],
-            subcontacts: self.state.subs[range.clone()]
-                .iter()
-                .zip(&self.state.sub_records[range])
-                .map(|(s, rec)| SubContactEntry {
-                    key: rec.key,
-                    plane: s.plane,
-                    area: s.area,
-                    gap: s.gap,
-                    force: s.force,
-                    slip: s.slip,
-                    half: s.half,
-                    status: s.status,
-                    state: s.state.clone(),
-                    dashpot: rec.dashpot,
-                })
-                .collect(),
-        }
-    }
-}
+use crate::integrate::{CentralDifference, CriticalStep, TimeStep};
+use crate::law::ConstitutiveLaw;
+use crate::math::{is_finite_vector, Real, Vector};
+use crate::model::checkpoint_tested::{check_slacks, tested_pairs};
+use crate::model::{Model, ModelParameters};
 
 /// The step's storage rebuilt from checkpointed joints: contacts, their references and
 /// wrenches, the sub-contacts and their records (each contact's range in order).
@@ -277,91 +98,6 @@ where
     L: ConstitutiveLaw + Serialize + DeserializeOwned,
     L::State: Serialize + DeserializeOwned,
 {
-    /// The full state as JSON text (numbers round-trip exactly).
-    ///
-    /// The integrator is stored as its damping model and restored as [`CentralDifference`];
-    /// a model with a custom integrator (one whose
-    /// [`Integrator::checkpoint_damping`](crate::Integrator::checkpoint_damping) is `None`)
-    /// is refused rather than restored with another.
-    ///
-    /// # Errors
-    /// [`Error::Unsupported`] for a custom integrator; [`Error::Io`] if serialisation fails (it
-    /// does not for the shipped laws).
-    pub fn to_checkpoint_string(&self) -> Result<String> {
-        let Some(damping) = self.state.integrator.checkpoint_damping() else {
-            return Err(Error::Unsupported {
-                what: format!(
-                    "checkpoint of a model with a custom integrator ({:?}), which a checkpoint cannot restore",
-                    self.state.integrator
-                ),
-            });
-        };
-        let snap = Snapshot::<L> {
-            format: FORMAT.into(),
-            version: VERSION,
-            law_type: law_type_name::<L>().map(str::to_owned),
-            params: self.state.params,
-            damping,
-            blocks: self.state.blocks.clone(),
-            joints: self.state.laws.clone(),
-            contacts: (0..self.state.pairs.len()).map(|k| self.contact_entry(k)).collect(),
-            ref_poses: self.state.ref_poses.clone(),
-            tested: self
-                .state
-                .tested
-                .iter()
-                .map(|t| TestedEntry {
-                    blocks: (t.a, t.b),
-                    relative: t.relative,
-                    slack: t.slack,
-                })
-                .collect(),
-            dt: self.state.dt,
-            critical: self.state.critical,
-            bounds: self.pipeline.bounds.iter().map(|b| b.omega_squared).collect(),
-            step: self.state.step,
-            time: self.state.time,
-            energy: self.energies(),
-            started: self.state.started,
-            unbalanced_ratio: self
-                .state
-                .unbalanced_ratio
-                .is_finite()
-                .then_some(self.state.unbalanced_ratio),
-            detections: self.state.detections,
-            last_forces: self.state.records.iter().map(|r| (r.reaction, r.damping)).collect(),
-            drift: self.state.drift,
-            refine_until: self.state.refine_until,
-            refine_omega2: self.state.refine_omega2,
-            refine_travel: self.state.refine_travel,
-            refining: self.state.refining.clone(),
-            motions: self.state.motions.clone(),
-            pending_detection: self.state.changes.need_full_detection() || !self.state.refixed.is_empty(),
-        };
-        let io = |e: serde_json::Error| Error::Io {
-            path: "(checkpoint)".into(),
-            message: e.to_string(),
-        };
-        let mut value = serde_json::to_value(&snap).map_err(io)?;
-        // A non-finite energy is written as null, which would not load: what saves must load.
-        if let Some((term, _)) = value["energy"]
-            .as_object()
-            .and_then(|m| m.iter().find(|(_, v)| v.is_null()))
-        {
-            return Err(Error::NonFinite {
-                what: format!(
-                    "energy term `{term}` of the model (a velocity, load or force beyond f64's range): a checkpoint \
-                     of it would not load"
-                ),
-            });
-        }
-        let checksum = checksum_of(&value);
-        if let serde_json::Value::Object(map) = &mut value {
-            map.insert(CHECKSUM.into(), checksum.into());
-        }
-        serde_json::to_string(&value).map_err(io)
-    }
-
     /// Restores a model from [`Model::to_checkpoint_string`] text.
     ///
     /// ```
@@ -392,7 +128,7 @@ where
     ///   compact JSON of the document without that field, keys sorted). Any change to a value,
     ///   by corruption or by hand, gives [`Error::CheckpointChecksum`]; formatting (spaces, key
     ///   order) does not count. Edit a checkpoint on purpose, then
-    ///   [`reseal_checkpoint`] it.
+    ///   [`reseal_checkpoint`](super::reseal_checkpoint) it.
     /// - **Version and law type**: another format version is refused naming both versions (files
     ///   of version 9, which have no checksum, included); a file written by a model of another
     ///   law type gives [`Error::CheckpointLawType`] naming both (a law type is named by its
@@ -746,7 +482,7 @@ where
         model.state.changes.clear();
         let redetect = !model.state.started || snap.pending_detection;
         if redetect {
-            model.state.changes.insert(super::changes::Changes::DETECTION);
+            model.state.changes.insert(crate::model::changes::Changes::DETECTION);
         }
         model.state.rebuild_block_index(&mut model.pipeline);
         // The time step: the stored bounds must give the stored critical step, and none may
@@ -789,15 +525,6 @@ where
         Ok(model)
     }
 
-    /// Writes [`Model::to_checkpoint_string`] to a file.
-    ///
-    /// # Errors
-    /// [`Error::Io`] naming the file.
-    pub fn save_checkpoint(&self, path: &Path) -> Result<()> {
-        let text = self.to_checkpoint_string()?;
-        crate::file::write_atomically(path, text.as_bytes())
-    }
-
     /// Reads a checkpoint file.
     ///
     /// # Errors
@@ -814,11 +541,6 @@ fn orthonormal(a: Vector, b: Vector) -> bool {
     (a.length_squared() - 1.0).abs() <= tolerance
         && (b.length_squared() - 1.0).abs() <= tolerance
         && a.dot(b).abs() <= tolerance
-}
-
-/// Whether a pose is finite with a unit rotation (to 1e-9, as blocks are checked).
-pub(super) fn pose_ok(p: &Pose) -> bool {
-    is_finite_vector(p.translation) && p.rotation.is_finite() && (p.rotation.length() - 1.0).abs() <= 1e-9
 }
 
 /// The run's counters, clock and step: finite, not negative, and counters far from overflow.
@@ -908,168 +630,6 @@ fn check_time_step(
         );
     }
     Ok(())
-}
-
-/// The checksum of a checkpoint document (without its checksum field): CRC-32 (IEEE) of its
-/// compact JSON with every object's keys sorted, as `crc32:` and eight hexadecimal digits.
-fn checksum_of(value: &serde_json::Value) -> String {
-    let mut text = String::new();
-    canonical(value, &mut text);
-    format!("crc32:{:08x}", crc32fast::hash(text.as_bytes()))
-}
-
-/// Compact JSON with sorted keys, whatever order the map keeps them in.
-fn canonical(value: &serde_json::Value, out: &mut String) {
-    use serde_json::Value;
-    match value {
-        Value::Object(map) => {
-            let mut keys: Vec<&String> = map.keys().collect();
-            keys.sort_unstable();
-            out.push('{');
-            for (i, k) in keys.into_iter().enumerate() {
-                if i > 0 {
-                    out.push(',');
-                }
-                out.push_str(&Value::String(k.clone()).to_string());
-                out.push(':');
-                canonical(&map[k], out);
-            }
-            out.push('}');
-        }
-        Value::Array(items) => {
-            out.push('[');
-            for (i, v) in items.iter().enumerate() {
-                if i > 0 {
-                    out.push(',');
-                }
-                canonical(v, out);
-            }
-            out.push(']');
-        }
-        scalar => out.push_str(&scalar.to_string()),
-    }
-}
-
-/// Recomputes the checksum of a checkpoint edited on purpose, so that it loads again (its content
-/// is then checked as any checkpoint's is).
-///
-/// ```
-/// use voussoir::prelude::*;
-/// let mut model: Model = Model::new(ModelParameters::default())?;
-/// model.add_block(RigidBlock::cuboid("b", Vector::ZERO, Vector::splat(0.1), 2000.0)?)?;
-/// let text = model.to_checkpoint_string()?;
-/// let edited = text.replace("\"name\":\"b\"", "\"name\":\"stone\"");
-/// assert!(matches!(Model::<CoulombSlip>::from_checkpoint_str(&edited), Err(Error::CheckpointChecksum { .. })));
-/// let resealed = voussoir::model::reseal_checkpoint(&edited)?;
-/// assert_eq!(Model::<CoulombSlip>::from_checkpoint_str(&resealed)?.blocks()[0].name(), "stone");
-/// # Ok::<(), voussoir::Error>(())
-/// ```
-///
-/// # Errors
-/// [`Error::Checkpoint`] for text that is not a JSON object.
-pub fn reseal_checkpoint(text: &str) -> Result<String> {
-    let corrupt = |message: String| Error::Checkpoint {
-        path: "(document)".into(),
-        message,
-    };
-    let mut value: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| corrupt(format!("not a complete JSON document: {e}")))?;
-    let Some(map) = value.as_object_mut() else {
-        return Err(corrupt("not a JSON object".into()));
-    };
-    map.remove(CHECKSUM);
-    let checksum = checksum_of(&value);
-    if let serde_json::Value::Object(map) = &mut value {
-        map.insert(CHECKSUM.into(), checksum.into());
-    }
-    serde_json::to_string(&value).map_err(|e| corrupt(e.to_string()))
-}
-
-/// The law type's name as its serde derive gives it (the struct or enum name, or its
-/// `#[serde(rename)]`): stable across builds, unlike `std::any::type_name`. `None` for a
-/// `Deserialize` that does not name its type.
-fn law_type_name<L: DeserializeOwned>() -> Option<&'static str> {
-    match L::deserialize(NameOnly) {
-        Err(NameFound(name)) => name,
-        Ok(_) => None,
-    }
-}
-
-/// A deserializer with no data, which stops at the first type name serde hands it.
-struct NameOnly;
-
-/// The name [`NameOnly`] found (the "error" that stops the deserialisation).
-#[derive(Debug)]
-struct NameFound(Option<&'static str>);
-
-impl std::fmt::Display for NameFound {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "type name {:?}", self.0)
-    }
-}
-
-impl std::error::Error for NameFound {}
-
-impl serde::de::Error for NameFound {
-    fn custom<T: std::fmt::Display>(_: T) -> Self {
-        NameFound(None)
-    }
-}
-
-impl<'de> serde::Deserializer<'de> for NameOnly {
-    type Error = NameFound;
-
-    fn deserialize_any<V: serde::de::Visitor<'de>>(self, _: V) -> std::result::Result<V::Value, NameFound> {
-        Err(NameFound(None))
-    }
-
-    fn deserialize_struct<V: serde::de::Visitor<'de>>(
-        self,
-        name: &'static str,
-        _: &'static [&'static str],
-        _: V,
-    ) -> std::result::Result<V::Value, NameFound> {
-        Err(NameFound(Some(name)))
-    }
-
-    fn deserialize_enum<V: serde::de::Visitor<'de>>(
-        self,
-        name: &'static str,
-        _: &'static [&'static str],
-        _: V,
-    ) -> std::result::Result<V::Value, NameFound> {
-        Err(NameFound(Some(name)))
-    }
-
-    fn deserialize_newtype_struct<V: serde::de::Visitor<'de>>(
-        self,
-        name: &'static str,
-        _: V,
-    ) -> std::result::Result<V::Value, NameFound> {
-        Err(NameFound(Some(name)))
-    }
-
-    fn deserialize_unit_struct<V: serde::de::Visitor<'de>>(
-        self,
-        name: &'static str,
-        _: V,
-    ) -> std::result::Result<V::Value, NameFound> {
-        Err(NameFound(Some(name)))
-    }
-
-    fn deserialize_tuple_struct<V: serde::de::Visitor<'de>>(
-        self,
-        name: &'static str,
-        _: usize,
-        _: V,
-    ) -> std::result::Result<V::Value, NameFound> {
-        Err(NameFound(Some(name)))
-    }
-
-    serde::forward_to_deserialize_any! {
-        bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes byte_buf option
-        unit seq tuple map identifier ignored_any
-    }
 }
 
 /// Whether the sub-contacts of a node contact between blocks of shapes `shapes` name nodes of

@@ -1,0 +1,156 @@
+//! Writing a checkpoint: each contact as its transfer record, the snapshot of the whole state,
+//! its checksum, and the file.
+
+use std::path::Path;
+
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+use super::{checksum_of, law_type_name, ContactEntry, Snapshot, SubContactEntry, CHECKSUM, FORMAT, VERSION};
+use crate::error::{Error, Result};
+use crate::law::ConstitutiveLaw;
+use crate::model::checkpoint_tested::TestedEntry;
+use crate::model::Model;
+
+impl<L: ConstitutiveLaw> Model<L> {
+    /// Contact `k` as a checkpoint stores it.
+    fn contact_entry(&self, k: usize) -> ContactEntry<L::State> {
+        let (p, r) = (&self.state.pairs[k], &self.state.references[k]);
+        let range = p.range();
+        ContactEntry {
+            blocks: (p.a, p.b),
+            kind: p.kind,
+            host_is_a: p.host_is_a,
+            law: p.law,
+            normal: p.normal,
+            tangent: p.tangent,
+            anchors: p.anchors,
+            dashpots: p.dashpots,
+            normal_force: p.normal_force,
+            springs: [p.springs.force, p.springs.per_x, p.springs.per_y],
+            spread_energy: p.spread_energy,
+            reference_centroids: (r.ref_a, r.ref_b),
+            reference_host_rotation: r.ref_host_rotation,
+            area: r.area,
+            bound_area: r.bound_area,
+            wrench: self.state.wrenches[k],
+            subcontacts: self.state.subs[range.clone()]
+                .iter()
+                .zip(&self.state.sub_records[range])
+                .map(|(s, rec)| SubContactEntry {
+                    key: rec.key,
+                    plane: s.plane,
+                    area: s.area,
+                    gap: s.gap,
+                    force: s.force,
+                    slip: s.slip,
+                    half: s.half,
+                    status: s.status,
+                    state: s.state.clone(),
+                    dashpot: rec.dashpot,
+                })
+                .collect(),
+        }
+    }
+}
+
+impl<L> Model<L>
+where
+    L: ConstitutiveLaw + Serialize + DeserializeOwned,
+    L::State: Serialize + DeserializeOwned,
+{
+    /// The full state as JSON text (numbers round-trip exactly).
+    ///
+    /// The integrator is stored as its damping model and restored as
+    /// [`CentralDifference`](crate::integrate::CentralDifference); a model with a custom
+    /// integrator (one whose
+    /// [`Integrator::checkpoint_damping`](crate::Integrator::checkpoint_damping) is `None`) is
+    /// refused rather than restored with another.
+    ///
+    /// # Errors
+    /// [`Error::Unsupported`] for a custom integrator; [`Error::Io`] if serialisation fails (it
+    /// does not for the shipped laws).
+    pub fn to_checkpoint_string(&self) -> Result<String> {
+        let Some(damping) = self.state.integrator.checkpoint_damping() else {
+            return Err(Error::Unsupported {
+                what: format!(
+                    "checkpoint of a model with a custom integrator ({:?}), which a checkpoint cannot restore",
+                    self.state.integrator
+                ),
+            });
+        };
+        let snap = Snapshot::<L> {
+            format: FORMAT.into(),
+            version: VERSION,
+            law_type: law_type_name::<L>().map(str::to_owned),
+            params: self.state.params,
+            damping,
+            blocks: self.state.blocks.clone(),
+            joints: self.state.laws.clone(),
+            contacts: (0..self.state.pairs.len()).map(|k| self.contact_entry(k)).collect(),
+            ref_poses: self.state.ref_poses.clone(),
+            tested: self
+                .state
+                .tested
+                .iter()
+                .map(|t| TestedEntry {
+                    blocks: (t.a, t.b),
+                    relative: t.relative,
+                    slack: t.slack,
+                })
+                .collect(),
+            dt: self.state.dt,
+            critical: self.state.critical,
+            bounds: self.pipeline.bounds.iter().map(|b| b.omega_squared).collect(),
+            step: self.state.step,
+            time: self.state.time,
+            energy: self.energies(),
+            started: self.state.started,
+            unbalanced_ratio: self
+                .state
+                .unbalanced_ratio
+                .is_finite()
+                .then_some(self.state.unbalanced_ratio),
+            detections: self.state.detections,
+            last_forces: self.state.records.iter().map(|r| (r.reaction, r.damping)).collect(),
+            drift: self.state.drift,
+            refine_until: self.state.refine_until,
+            refine_omega2: self.state.refine_omega2,
+            refine_travel: self.state.refine_travel,
+            refining: self.state.refining.clone(),
+            motions: self.state.motions.clone(),
+            pending_detection: self.state.changes.need_full_detection() || !self.state.refixed.is_empty(),
+        };
+        let io = |e: serde_json::Error| Error::Io {
+            path: "(checkpoint)".into(),
+            message: e.to_string(),
+        };
+        let mut value = serde_json::to_value(&snap).map_err(io)?;
+        // A non-finite energy is written as null, which would not load: what saves must load.
+        if let Some((term, _)) = value["energy"]
+            .as_object()
+            .and_then(|m| m.iter().find(|(_, v)| v.is_null()))
+        {
+            return Err(Error::NonFinite {
+                what: format!(
+                    "energy term `{term}` of the model (a velocity, load or force beyond f64's range): a checkpoint \
+                     of it would not load"
+                ),
+            });
+        }
+        let checksum = checksum_of(&value);
+        if let serde_json::Value::Object(map) = &mut value {
+            map.insert(CHECKSUM.into(), checksum.into());
+        }
+        serde_json::to_string(&value).map_err(io)
+    }
+
+    /// Writes [`Model::to_checkpoint_string`] to a file.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn save_checkpoint(&self, path: &Path) -> Result<()> {
+        let text = self.to_checkpoint_string()?;
+        crate::file::write_atomically(path, text.as_bytes())
+    }
+}

@@ -1,0 +1,229 @@
+//! Reading a model: blocks, laws, contacts (as views), counters, the step, energies, reactions
+//! and contact wrenches, timings and damping. None of these changes the model's state.
+
+use rayon::prelude::*;
+
+use super::{motion, Energies, Model, ModelParameters, Timings};
+use crate::block::{Block, BlockId, RigidBlock, Wrench};
+use crate::contact::{ContactView, DisplacementMode};
+use crate::error::{Error, Result};
+use crate::integrate::{CriticalStep, Damping};
+use crate::law::{ConstitutiveLaw, LawTable};
+use crate::math::Real;
+
+impl<L: ConstitutiveLaw> Model<L> {
+    /// The global parameters.
+    pub fn parameters(&self) -> &ModelParameters {
+        &self.state.params
+    }
+
+    /// A block by id.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn block(&self, id: BlockId) -> Result<&RigidBlock> {
+        self.state.blocks.get(id.index()).ok_or(Error::UnknownBlock {
+            id,
+            count: self.state.blocks.len(),
+        })
+    }
+
+    /// All blocks, indexed by [`BlockId::index`].
+    pub fn blocks(&self) -> &[RigidBlock] {
+        &self.state.blocks
+    }
+
+    /// The joint laws.
+    pub fn law_table(&self) -> &LawTable<L> {
+        &self.state.laws
+    }
+
+    /// The current contacts, each with its sub-contacts.
+    pub fn contacts(&self) -> impl ExactSizeIterator<Item = ContactView<'_, L::State>> + '_ {
+        (0..self.state.pairs.len()).map(move |k| self.view(k))
+    }
+
+    /// The contact between two blocks, if any.
+    pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<ContactView<'_, L::State>> {
+        let key = (a.0.min(b.0), a.0.max(b.0));
+        self.state
+            .pairs
+            .binary_search_by_key(&key, |p| (p.a, p.b))
+            .ok()
+            .map(|k| self.view(k))
+    }
+
+    pub(super) fn view(&self, k: usize) -> ContactView<'_, L::State> {
+        let p = &self.state.pairs[k];
+        let (sa, sb) = (
+            &self.state.blocks[p.a as usize].state,
+            &self.state.blocks[p.b as usize].state,
+        );
+        let nodes = matches!(p.kind, crate::geometry::ContactKind::Nodes).then(|| crate::contact::NodeGeometry {
+            states: [sa, sb],
+            rotations: [
+                crate::math::Matrix::from_quat(sa.pose.rotation),
+                crate::math::Matrix::from_quat(sb.pose.rotation),
+            ],
+            shapes: [
+                self.state.blocks[p.a as usize].shape(),
+                self.state.blocks[p.b as usize].shape(),
+            ],
+        });
+        let law = &self.state.laws.laws()[p.law as usize];
+        let exact = matches!(p.kind, crate::geometry::ContactKind::FaceFace { .. })
+            && self.state.params.mode == DisplacementMode::Large
+            && law.elastic_regime().is_some_and(|r| r.normal_stiffness > 0.0);
+        let cells = exact.then(|| crate::contact::CellGeometry {
+            law: law as &dyn crate::contact::TensionFree<L::State>,
+            coefficients: crate::contact::face_gap_coefficients(p, &sa.pose, &sb.pose),
+        });
+        ContactView::new(
+            p,
+            &self.state.subs[p.range()],
+            &self.state.sub_records[p.range()],
+            p.frame(&self.state.references[k], &sa.pose, &sb.pose, self.state.params.mode),
+            self.state.wrenches[k],
+            (nodes, cells),
+        )
+    }
+
+    /// Total number of sub-contacts.
+    pub fn subcontact_count(&self) -> usize {
+        self.state.pairs.iter().map(|p| p.count as usize).sum()
+    }
+
+    /// Steps taken.
+    pub fn step_count(&self) -> u64 {
+        self.state.step
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> Real {
+        self.state.time
+    }
+
+    /// The time step in use (s); zero before the first step.
+    pub fn dt(&self) -> Real {
+        self.state.dt
+    }
+
+    /// The duration of the last step (s): [`dt`](Self::dt), or shorter while the step was refined
+    /// around an impact (see [`ModelParameters::impact_step`]); `dt` before the first step.
+    pub fn last_step(&self) -> Real {
+        if self.state.drift > 0.0 {
+            self.state.drift
+        } else {
+            self.state.dt
+        }
+    }
+
+    /// The critical time step and the block that limits it (after the first step).
+    pub fn critical_step(&self) -> Option<CriticalStep> {
+        self.state.critical
+    }
+
+    /// Energies since the start.
+    ///
+    /// The elastic energy stored in the joints is not needed to step, so it is summed over the
+    /// sub-contacts here, when asked for: a call costs about one pass over the sub-contacts.
+    pub fn energies(&self) -> Energies {
+        let mut e = self.state.energy;
+        e.elastic = self.elastic_energy();
+        e
+    }
+
+    /// Elastic energy in the joint springs (J): per contact in sub-contact order, contacts in
+    /// fixed chunks, chunks in order, so the sum does not depend on the thread count.
+    pub(super) fn elastic_energy(&self) -> Real {
+        let laws = self.state.laws.laws();
+        let chunk_sums: Vec<Real> = self
+            .state
+            .pairs
+            .par_chunks(1024)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .map(|p| {
+                        let law = &laws[p.law as usize];
+                        self.state.subs[p.range()]
+                            .iter()
+                            .map(|s| law.elastic_energy(s.area, &s.force, &s.state))
+                            .sum::<Real>()
+                            + p.spread_energy
+                    })
+                    .sum::<Real>()
+            })
+            .collect();
+        chunk_sums.iter().sum()
+    }
+
+    /// The accumulated energy terms without the elastic and friction terms (which
+    /// [`Model::energies`] fills in).
+    pub(crate) fn energy_accumulators(&self) -> &Energies {
+        &self.state.energy
+    }
+
+    /// Number of contact detections run so far.
+    pub fn detection_count(&self) -> u64 {
+        self.state.detections
+    }
+
+    /// Number of block pairs the narrow phase tested since the model was built or restored: at
+    /// a detection, only the pairs with a block that moved beyond the re-detection trigger whose
+    /// relative pose changed beyond it since their last test (`docs/theory.md` §2.3). A
+    /// statistic, like [`Model::timings`]; a checkpoint does not store it.
+    pub fn pair_tests(&self) -> u64 {
+        self.pipeline.detection.tests
+    }
+
+    /// Unbalanced-force ratio of the last step: the largest out-of-balance force on a free block
+    /// divided by the mean contact force (infinite before the first step or without contacts).
+    pub fn unbalanced_force_ratio(&self) -> Real {
+        self.state.unbalanced_ratio
+    }
+
+    /// Force and moment the supports or prescribed velocities applied to a block in the last step.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn reaction(&self, id: BlockId) -> Result<Wrench> {
+        self.block(id)?;
+        Ok(self.state.records[id.index()].reaction)
+    }
+
+    /// Total contact force and moment (about its centroid) on a block in the last step.
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn contact_wrench(&self, id: BlockId) -> Result<Wrench> {
+        self.block(id)?;
+        Ok(self.contact_wrench_of(id.index()))
+    }
+
+    pub(super) fn contact_wrench_of(&self, i: usize) -> Wrench {
+        // Before the first detection (no step yet, or a block added since), the block has no
+        // contacts the model knows of.
+        let offsets = &self.pipeline.block_offsets;
+        let (Some(&start), Some(&end)) = (offsets.get(i), offsets.get(i + 1)) else {
+            return Wrench::default();
+        };
+        let entries = &self.pipeline.block_contacts[start as usize..end as usize];
+        motion::add_contact_wrenches(Wrench::default(), entries, &self.state.wrenches)
+    }
+
+    /// Time spent per stage (wall clock).
+    pub fn timings(&self) -> &Timings {
+        &self.pipeline.timings
+    }
+
+    /// Restarts the stage timers.
+    pub fn reset_timings(&mut self) {
+        self.pipeline.timings = Timings::default();
+    }
+
+    /// The integrator's damping model.
+    pub fn damping(&self) -> Damping {
+        self.state.integrator.damping()
+    }
+}
