@@ -184,7 +184,6 @@ impl<'a, S> ContactView<'a, S> {
         self.pair.kind
     }
     /// Whether the sub-contacts are anchored to block `a` (else `b`).
-    #[cfg(feature = "limit")]
     pub(crate) fn host_is_a(&self) -> bool {
         self.pair.host_is_a
     }

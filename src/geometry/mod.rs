@@ -7,7 +7,6 @@ mod narrow_phase;
 mod polyhedron;
 
 pub use broad_phase::BroadPhase;
-#[cfg(feature = "limit")]
 pub(crate) use narrow_phase::contact_polygon;
 pub(crate) use narrow_phase::nodes::{deepest_two, NodeId};
 pub use narrow_phase::{

@@ -8,7 +8,7 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use crate::block::{Block, Fixity, RigidBlock, Wrench};
+use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::error::{Error, Result};
 use crate::integrate::Damping;
 use crate::law::{ConstitutiveLaw, MaterialId};
@@ -50,6 +50,11 @@ pub struct BlockSpec {
     /// [..]}, null, null]}`; the driven axes must be fixed or prescribed in `fixity`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion: Option<crate::loading::BaseMotion>,
+    /// Time-varying load from time 0, replacing `load` (see [`Model::set_load_history`]):
+    /// `{"load": {"force": [..], "moment": [..]}, "history": {"times": [..], "values": [..]}}`,
+    /// the wrench scaled by the history's factor.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub load_history: Option<crate::loading::LoadHistory>,
 }
 
 /// The joint law between two materials.
@@ -58,6 +63,16 @@ pub struct BlockSpec {
 pub struct JointSpec<L> {
     /// The two materials (either order).
     pub materials: [MaterialId; 2],
+    /// The law and its parameters.
+    pub law: L,
+}
+
+/// The joint law of one interface: the joint between two blocks, whatever their materials.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InterfaceSpec<L> {
+    /// The two blocks (indices into `blocks`, either order).
+    pub blocks: [BlockId; 2],
     /// The law and its parameters.
     pub law: L,
 }
@@ -84,6 +99,10 @@ pub struct Scene<L> {
     pub damping: Damping,
     /// Joint laws per pair of materials.
     pub joints: Vec<JointSpec<L>>,
+    /// Joint laws of single interfaces (pairs of blocks), which take precedence over their
+    /// materials'; optional.
+    #[serde(default = "Vec::new", skip_serializing_if = "Vec::is_empty")]
+    pub interfaces: Vec<InterfaceSpec<L>>,
     /// The blocks, in id order.
     pub blocks: Vec<BlockSpec>,
     /// Monitors.
@@ -100,7 +119,7 @@ fn one() -> u64 {
 
 /// The fields of a scene file, for messages.
 const SCENE_FIELDS: &str = "with the fields \"joints\" and \"blocks\" (required) and \"parameters\", \
-                            \"damping\", \"monitors\", \"monitor_interval\" (optional)";
+                            \"damping\", \"interfaces\", \"monitors\", \"monitor_interval\" (optional)";
 
 /// serde's message for a struct given as an array (`invalid length 2, expected struct
 /// BlockSpec with 5 elements`) rephrased: the value must be a JSON object with named fields.
@@ -116,7 +135,7 @@ fn struct_as_array_message(message: &str) -> String {
 
 impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
     /// Parses a scene from JSON text: a JSON object with the fields `joints` and `blocks`
-    /// (required) and `parameters`, `damping`, `monitors`, `monitor_interval` (optional), see
+    /// (required) and `parameters`, `damping`, `interfaces`, `monitors`, `monitor_interval` (optional), see
     /// `docs/scene-format.md`. Syntax and type errors name the path of the field; a file that is
     /// not a JSON object (`[]`, a number, nothing) says so.
     ///
@@ -210,6 +229,7 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                     load: b.load(),
                     // A scene starts at time 0: the motion from the start of its history.
                     motion: model.base_motions().find(|m| m.0.index() == i).map(|m| m.1.clone()),
+                    load_history: model.load_histories().find(|h| h.0.index() == i).map(|h| h.1.clone()),
                 }
             })
             .collect();
@@ -221,6 +241,14 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                 .entries()
                 .map(|(a, b, law)| JointSpec {
                     materials: [a, b],
+                    law: law.clone(),
+                })
+                .collect(),
+            interfaces: model
+                .law_table()
+                .interface_entries()
+                .map(|(a, b, law)| InterfaceSpec {
+                    blocks: [a, b],
                     law: law.clone(),
                 })
                 .collect(),
@@ -311,6 +339,29 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                     .set_base_motion(id, Some(motion.clone()))
                     .map_err(at(format!("{path}.motion")))?;
             }
+            if let Some(load) = &b.load_history {
+                model
+                    .set_load_history(id, Some(load.clone()))
+                    .map_err(at(format!("{path}.load_history")))?;
+            }
+        }
+        for (k, j) in self.interfaces.iter().enumerate() {
+            let pair = (j.blocks[0].min(j.blocks[1]), j.blocks[0].max(j.blocks[1]));
+            if let Some(first) = self.interfaces[..k]
+                .iter()
+                .position(|o| (o.blocks[0].min(o.blocks[1]), o.blocks[0].max(o.blocks[1])) == pair)
+            {
+                return Err(Error::Checkpoint {
+                    path: format!("interfaces[{k}].blocks"),
+                    message: format!(
+                        "the interface of blocks {} and {} already has a law at interfaces[{first}]",
+                        pair.0 .0, pair.1 .0
+                    ),
+                });
+            }
+            model
+                .set_interface_law(j.blocks[0], j.blocks[1], j.law.clone())
+                .map_err(at(format!("interfaces[{k}]")))?;
         }
         Ok(model)
     }

@@ -10,6 +10,7 @@ mod any;
 pub mod conformance;
 mod coulomb;
 mod elastic;
+mod table;
 
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
@@ -17,6 +18,7 @@ use serde::{Deserialize, Serialize};
 pub use any::{AnyLaw, AnyState};
 pub use coulomb::{CoulombSlip, CoulombState};
 pub use elastic::LinearElastic;
+pub use table::LawTable;
 
 pub use crate::ids::MaterialId;
 
@@ -348,87 +350,4 @@ pub(crate) fn check_law<L: ConstitutiveLaw>(law: &L) -> Result<()> {
     crate::error::non_negative("stiffness().normal", k.normal)?;
     crate::error::non_negative("stiffness().shear", k.shear)?;
     Ok(())
-}
-
-/// The joint law of each pair of block materials (the pair is unordered).
-///
-/// ```
-/// use voussoir::law::{CoulombSlip, LawTable, MaterialId};
-/// let stone = MaterialId(0);
-/// let steel = MaterialId(1);
-/// let mut joints = LawTable::new();
-/// joints.insert(stone, stone, CoulombSlip::dry(4e9, 1.6e9, 30.5)?)?;
-/// joints.insert(stone, steel, CoulombSlip::dry(4e9, 1.6e9, 0.0)?)?;
-/// assert!(joints.get(steel, stone).is_some());
-/// # Ok::<(), voussoir::Error>(())
-/// ```
-#[derive(Debug, Clone)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub struct LawTable<L> {
-    laws: Vec<L>,
-    /// `((min material, max material), law index)`, sorted.
-    index: Vec<((MaterialId, MaterialId), u32)>,
-}
-
-impl<L> Default for LawTable<L> {
-    fn default() -> Self {
-        Self {
-            laws: Vec::new(),
-            index: Vec::new(),
-        }
-    }
-}
-
-impl<L: ConstitutiveLaw> LawTable<L> {
-    /// An empty table.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Sets the law between materials `a` and `b` (either order), replacing any previous one.
-    ///
-    /// # Errors
-    /// The law's own [`ConstitutiveLaw::validate`] error; [`crate::Error::InvalidParameter`]
-    /// for a stiffness that is negative or not finite (the critical step rests on it).
-    pub fn insert(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
-        check_law(&law)?;
-        let key = (a.min(b), a.max(b));
-        match self.index.binary_search_by_key(&key, |e| e.0) {
-            Ok(k) => self.laws[self.index[k].1 as usize] = law,
-            Err(k) => {
-                self.index.insert(k, (key, self.laws.len() as u32));
-                self.laws.push(law);
-            }
-        }
-        Ok(())
-    }
-
-    /// The law between `a` and `b`.
-    pub fn get(&self, a: MaterialId, b: MaterialId) -> Option<&L> {
-        self.index_of(a, b).map(|i| &self.laws[i as usize])
-    }
-
-    pub(crate) fn index_of(&self, a: MaterialId, b: MaterialId) -> Option<u32> {
-        let key = (a.min(b), a.max(b));
-        self.index
-            .binary_search_by_key(&key, |e| e.0)
-            .ok()
-            .map(|k| self.index[k].1)
-    }
-
-    /// The `(material, material, law)` entries, sorted by material pair.
-    pub fn entries(&self) -> impl Iterator<Item = (MaterialId, MaterialId, &L)> + '_ {
-        self.index.iter().map(|&((a, b), i)| (a, b, &self.laws[i as usize]))
-    }
-
-    /// Checks the table's internal indices (after deserialisation).
-    #[cfg(feature = "serde")]
-    pub(crate) fn check(&self) -> bool {
-        self.index.iter().all(|e| (e.1 as usize) < self.laws.len()) && self.index.windows(2).all(|w| w[0].0 < w[1].0)
-    }
-
-    /// All laws, indexed as contacts refer to them.
-    pub fn laws(&self) -> &[L] {
-        &self.laws
-    }
 }

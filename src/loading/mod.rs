@@ -76,9 +76,11 @@
 //! ```
 
 mod excitation;
+mod load_history;
 mod pushover;
 mod servo;
 
 pub use excitation::{BaseMotion, MotionKind, TimeHistory};
+pub use load_history::LoadHistory;
 pub use pushover::{PushOver, PushOverResult, PushOverSample, PushOverStop};
 pub use servo::{Convergence, Servo};

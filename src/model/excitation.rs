@@ -1,12 +1,14 @@
-//! Base excitation in the step: the blocks with a [`BaseMotion`] get, before they move, the
-//! prescribed velocity that carries them to the motion's displacement at the end of the step.
+//! Excitations in the step: the blocks with a [`BaseMotion`] get, before they move, the
+//! prescribed velocity that carries them to the motion's displacement at the end of the step;
+//! the blocks with a [`LoadHistory`] get the load of the current time.
 
 use super::{Model, ModelState};
+use crate::block::Wrench;
 use crate::block::{Block, Dof, Fixity};
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::law::ConstitutiveLaw;
-use crate::loading::BaseMotion;
+use crate::loading::{BaseMotion, LoadHistory};
 use crate::math::Real;
 
 const AXES: [&str; 3] = ["x", "y", "z"];
@@ -22,7 +24,37 @@ pub(crate) struct AppliedMotion {
     pub start: Real,
 }
 
+/// A time-varying load applied to a block, with the model time its history starts at.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub(crate) struct AppliedLoad {
+    pub block: u32,
+    pub load: LoadHistory,
+    /// Model time of the history's `t = 0` (s).
+    pub start: Real,
+}
+
 impl<L: ConstitutiveLaw> ModelState<L> {
+    /// Sets the loads of the blocks with a load history to their value at the current time
+    /// `t_n`, before the forces are gathered, and books the load work with the trapezoidal
+    /// rule: the gather books `F_n·v_{n−½}·Δt_{n−½}` as for a constant load, and the
+    /// difference to `½(F_{n−1} + F_n)·v_{n−½}·Δt_{n−½}` is added here (`F_{n−1}` the load
+    /// the block had; nothing on the first step, where the gather books `½ F_0`).
+    pub(super) fn apply_load_histories(&mut self) {
+        for h in &self.load_histories {
+            let block = &mut self.blocks[h.block as usize];
+            let new = h.load.at(self.time - h.start);
+            let old: Wrench = block.load;
+            if self.step > 0 {
+                let (v, om) = (block.state.velocity, block.state.angular_velocity);
+                self.energy.load_work +=
+                    0.5 * ((old.force - new.force).dot(v) + (old.moment - new.moment).dot(om)) * self.drift;
+            }
+            block.load = new;
+        }
+    }
+
     /// Sets the prescribed velocities of the driven axes for a step of `drift` from the
     /// current time: the mean velocity of the motion over the step, so that the block's
     /// displacement at the end of the step is the motion's exactly.
@@ -134,6 +166,58 @@ impl<L: ConstitutiveLaw> Model<L> {
             }
         }
         Ok(())
+    }
+
+    /// Makes a block's load follow `load` from now on (its history's `t = 0` is the model's
+    /// current time): at every step the block carries `load.at(t − t₀)` instead of a constant
+    /// load (a ramp, a pulse, an impact force record; 3DEC's load histories). `None` removes
+    /// the history, leaving the block with the load it last had; [`Model::set_load`] also
+    /// replaces it with a constant load. The load's work is booked with the trapezoidal rule,
+    /// as every force's (`docs/theory.md` §6).
+    ///
+    /// ```
+    /// use voussoir::loading::{LoadHistory, TimeHistory};
+    /// use voussoir::prelude::*;
+    ///
+    /// let params = ModelParameters { gravity: Vector::ZERO, ..ModelParameters::default() };
+    /// let mut model: Model = Model::new(params)?;
+    /// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+    /// model.set_damping(Damping::None)?;
+    /// let id = model.add_block(RigidBlock::cuboid("free", Vector::ZERO, Vector::splat(0.2), 2500.0)?)?;
+    /// // A force ramped from 0 to 100 N over 0.1 s on a free 20 kg block: x = F t³ / (6 m T).
+    /// let ramp = TimeHistory::new(vec![0.0, 0.1], vec![0.0, 1.0])?;
+    /// let force = Wrench { force: Vector::new(100.0, 0.0, 0.0), moment: Vector::ZERO };
+    /// model.set_load_history(id, Some(LoadHistory::new(force, ramp)?))?;
+    /// model.run_until_time(0.1)?;
+    /// let t = model.time();
+    /// let exact = 100.0 * t.powi(3) / (6.0 * 20.0 * 0.1);
+    /// let x = model.block(id)?.state().pose.translation.x - 0.1;
+    /// assert!((x - exact).abs() < 2e-3 * exact, "{x} vs {exact}");
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`].
+    pub fn set_load_history(&mut self, id: BlockId, load: Option<LoadHistory>) -> Result<()> {
+        self.block(id)?;
+        self.state.load_histories.retain(|h| h.block != id.0);
+        if let Some(load) = load {
+            self.state.load_histories.push(AppliedLoad {
+                block: id.0,
+                load,
+                start: self.state.time,
+            });
+            self.state.load_histories.sort_by_key(|h| h.block);
+        }
+        Ok(())
+    }
+
+    /// The load histories applied, with their blocks and the model time each started at.
+    pub fn load_histories(&self) -> impl Iterator<Item = (BlockId, &LoadHistory, Real)> {
+        self.state
+            .load_histories
+            .iter()
+            .map(|h| (BlockId(h.block), &h.load, h.start))
     }
 
     /// The base motions applied, with their blocks and the model time each history started at.

@@ -141,6 +141,8 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     pub detections: u64,
     /// Base motions, by block ([`Model::set_base_motion`]).
     pub motions: Vec<excitation::AppliedMotion>,
+    /// Time-varying loads, by block ([`Model::set_load_history`]).
+    pub load_histories: Vec<excitation::AppliedLoad>,
 }
 
 /// Wall-clock time spent per stage since the model was built or [`Model::reset_timings`] (s).

@@ -53,6 +53,48 @@ impl<L: ConstitutiveLaw> Model<L> {
             .map(|k| self.view(k))
     }
 
+    /// The **contact polygon** of `contact` (world, m): for a face–face joint, the part of the
+    /// other face within the contact tolerance of the host face's plane, projected on it and
+    /// clipped by the host face (the area its sub-contacts can carry; `docs/theory.md` §2.2);
+    /// for a node contact (vertex, edge, tilted faces), the 2-D hull of its sub-contacts in the
+    /// plane normal to the contact normal — a polygon, a segment or a point. Corners in order
+    /// around the polygon. The limit analysis takes its joints from these polygons.
+    ///
+    /// ```
+    /// use voussoir::prelude::*;
+    ///
+    /// let mut model: Model = Model::new(ModelParameters::default())?;
+    /// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+    /// let base = Vector::new(-1.0, -1.0, -0.2);
+    /// model.add_block(RigidBlock::cuboid("base", base, Vector::new(1.0, 1.0, 0.0), 2500.0)?.with_fixity(Fixity::FIXED))?;
+    /// model.add_block(RigidBlock::cuboid("block", Vector::ZERO, Vector::new(0.4, 0.3, 0.2), 2500.0)?)?;
+    /// model.step()?;
+    /// let contact = model.contacts().next().unwrap();
+    /// let polygon = model.contact_polygon(&contact);
+    /// assert_eq!(polygon.len(), 4); // the block's 0.4 × 0.3 m face
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    pub fn contact_polygon(&self, contact: &ContactView<'_, L::State>) -> Vec<crate::math::Vector> {
+        let (a, b) = contact.blocks();
+        let (ba, bb) = (&self.state.blocks[a.index()], &self.state.blocks[b.index()]);
+        let points: Vec<crate::math::Vector> = contact.points().collect();
+        crate::geometry::contact_polygon(
+            crate::geometry::BlockGeometry {
+                shape: ba.shape(),
+                pose: &ba.state().pose,
+            },
+            crate::geometry::BlockGeometry {
+                shape: bb.shape(),
+                pose: &bb.state().pose,
+            },
+            contact.kind(),
+            contact.host_is_a(),
+            contact.normal(),
+            &points,
+            self.state.params.contact.tolerance,
+        )
+    }
+
     pub(super) fn view(&self, k: usize) -> ContactView<'_, L::State> {
         let p = &self.state.pairs[k];
         let (sa, sb) = (

@@ -48,6 +48,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 unbalanced_ratio: Real::INFINITY,
                 detections: 0,
                 motions: Vec::new(),
+                load_histories: Vec::new(),
             },
             pipeline: Pipeline::default(),
         })
@@ -84,6 +85,23 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The law's validation error.
     pub fn set_joint_law(&mut self, a: MaterialId, b: MaterialId, law: L) -> Result<()> {
         self.state.laws.insert(a, b, law)?;
+        self.state.changes.insert(Changes::LAWS);
+        Ok(())
+    }
+
+    /// Sets the joint law of the interface between blocks `a` and `b` (either order), which
+    /// takes precedence over the law of their materials (a weaker bed joint, a mortared
+    /// interface, a steel plate on one stone: per-interface properties, as 3DEC gives them).
+    /// Takes effect at the next step, as [`Model::set_joint_law`].
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`]; as [`LawTable::insert_interface`].
+    ///
+    /// [`LawTable::insert_interface`]: crate::law::LawTable::insert_interface
+    pub fn set_interface_law(&mut self, a: BlockId, b: BlockId, law: L) -> Result<()> {
+        self.block(a)?;
+        self.block(b)?;
+        self.state.laws.insert_interface(a, b, law)?;
         self.state.changes.insert(Changes::LAWS);
         Ok(())
     }
@@ -149,7 +167,8 @@ impl<L: ConstitutiveLaw> Model<L> {
         Ok(())
     }
 
-    /// Sets the constant external load (force, and moment about the centroid) on a block.
+    /// Sets the constant external load (force, and moment about the centroid) on a block,
+    /// replacing any load history ([`Model::set_load_history`]) it had.
     ///
     /// # Errors
     /// [`Error::UnknownBlock`], [`Error::NonFinite`].
@@ -160,6 +179,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             });
         }
         self.block_mut(id)?.load = load;
+        self.state.load_histories.retain(|h| h.block != id.0);
         Ok(())
     }
 

@@ -62,6 +62,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // The first step's half step before is as long as the step itself (also when cut).
         let previous = if first { previous.min(drift) } else { previous };
         self.apply_base_motions(drift);
+        self.apply_load_histories();
         let forces = std::time::Instant::now();
         let (diverged, too_far) = self.advance_blocks(pipeline, 0.5 * (previous + drift), drift);
         self.drift = drift;

@@ -192,6 +192,28 @@ impl PyModel {
             .transpose()
     }
 
+    /// Sets the joint law of the interface between blocks ``a`` and ``b`` (either order): it
+    /// takes precedence over the law of their materials (per-interface properties, as 3DEC and
+    /// ``compas_3dec`` give them). Takes effect at the next step.
+    fn set_interface_law(&self, py: Python<'_>, a: Int, b: Int, law: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut this = self.lock(py);
+        let (a, b) = (this.id(&a, "block a")?, this.id(&b, "block b")?);
+        let law = law_from_py(law)?;
+        this.model.set_interface_law(a, b, law).py()
+    }
+
+    /// The joint law of the interface between blocks ``a`` and ``b`` if it has its own (set
+    /// with ``set_interface_law``), or None.
+    fn interface_law<'py>(&self, py: Python<'py>, a: Int, b: Int) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let this = self.lock(py);
+        let (a, b) = (this.id(&a, "block a")?, this.id(&b, "block b")?);
+        this.model
+            .law_table()
+            .get_interface(a, b)
+            .map(|l| law_to_py(py, l))
+            .transpose()
+    }
+
     /// Sets the damping: ``"none"``; ``"local"`` (Cundall, ``alpha`` in [0, 1), default 0.8);
     /// ``"rayleigh"`` with ``ratio`` (of critical) at ``frequency`` (Hz), mass and stiffness
     /// parts equal, or with the coefficients ``mass`` (1/s) and ``stiffness`` (s);
@@ -512,7 +534,57 @@ impl PyModel {
         this.model.set_base_motion(id, motion).py()
     }
 
-    /// Sets the load on a block: a force (N) at its centroid and a moment (N·m).
+    /// Makes a block's load vary in time from now on: ``force`` (N, at its centroid) and
+    /// ``moment`` (N·m) scaled by the factor ``history`` (a ``TimeHistory``; its ``t = 0`` is
+    /// the model's current time; the factor is 0 before its first sample and keeps its last
+    /// value after its last, so that a ramp to 1 holds the full load). ``history=None``
+    /// removes the history and leaves the block with the load it last had; ``set_load``
+    /// replaces it with a constant load. Rust: ``Model::set_load_history``.
+    ///
+    /// >>> import voussoir as vs
+    /// >>> m = vs.Model(gravity=(0, 0, 0))
+    /// >>> m.set_damping("none")
+    /// >>> b = m.add_cuboid("block", (0, 0, 0), (0.2, 0.2, 0.2), 2500.0)  # 20 kg
+    /// >>> m.set_load_history(b, vs.TimeHistory([0.0, 0.1], [0.0, 1.0]), force=(100, 0, 0))
+    /// >>> m.run_until_time(0.1)
+    /// True
+    /// >>> x = float(m.displacements()[b, 0])  # F t³ / (6 m T) for a ramp to F over T
+    /// >>> abs(x / (100 * m.time ** 3 / (6 * 20 * 0.1)) - 1) < 2e-3
+    /// True
+    #[pyo3(signature = (block, history, force=None, moment=None))]
+    fn set_load_history(
+        &self,
+        py: Python<'_>,
+        block: Int,
+        history: Option<PyRef<'_, crate::motion::PyTimeHistory>>,
+        force: Option<&Bound<'_, PyAny>>,
+        moment: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let load = match history {
+            Some(h) => {
+                let w = Wrench {
+                    force: vec3_or_zero(force, "force")?,
+                    moment: vec3_or_zero(moment, "moment")?,
+                };
+                Some(voussoir::loading::LoadHistory::new(w, h.inner.clone()).py()?)
+            }
+            None => None,
+        };
+        let mut this = self.lock(py);
+        let id = this.id(&block, "block index")?;
+        this.model.set_load_history(id, load).py()
+    }
+
+    /// The block's load now: ``{"force": (3,), "moment": (3,)}`` (a load history's value at
+    /// the last step).
+    fn load<'py>(&self, py: Python<'py>, block: Int) -> PyResult<Bound<'py, PyDict>> {
+        let this = self.lock(py);
+        let w = this.model.block(this.id(&block, "block index")?).py()?.load();
+        state::wrench(py, w)
+    }
+
+    /// Sets the constant load on a block, replacing any load history: a force (N) at its
+    /// centroid and a moment (N·m).
     #[pyo3(signature = (block, force=None, moment=None))]
     fn set_load(
         &self,

@@ -168,6 +168,9 @@ impl PyModel {
     /// plane, ``application_point`` (m, 3) the centre of the sub-contacts' normal forces
     /// (where each acts within its cell), at which the resultant gives the contact's moment
     /// about any axis in the joint plane (NaN for a contact without compression),
+    /// ``polygon`` a list of (k, 3) arrays, the corners of each contact polygon (m, in order
+    /// around it: the area a face-to-face joint's sub-contacts can carry; for a vertex or edge
+    /// contact, the hull of its sub-contacts, possibly a segment or a point),
     /// ``subcontact_count`` (m,) ints.
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let this = self.lock(py);
@@ -225,6 +228,12 @@ impl PyModel {
                     }
                 }),
             ),
+        )?;
+        d.set_item(
+            "polygon",
+            cs.iter()
+                .map(|c| array_n3(py, this.model.contact_polygon(c).into_iter()))
+                .collect::<Vec<_>>(),
         )?;
         d.set_item(
             "subcontact_count",
@@ -326,7 +335,7 @@ fn status_name(s: JointStatus) -> &'static str {
     }
 }
 
-fn wrench<'py>(py: Python<'py>, w: Wrench) -> PyResult<Bound<'py, PyDict>> {
+pub(super) fn wrench<'py>(py: Python<'py>, w: Wrench) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("force", vector(py, w.force))?;
     d.set_item("moment", vector(py, w.moment))?;

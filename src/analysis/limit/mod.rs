@@ -52,7 +52,6 @@ mod result;
 
 use crate::block::{Block, BlockId, Dof, Fixity};
 use crate::error::{non_negative, Error, Result};
-use crate::geometry::{contact_polygon, BlockGeometry};
 use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, LinearElastic};
 use crate::math::{Real, Vector};
 use crate::model::Model;
@@ -297,23 +296,7 @@ impl LimitProblem {
                 ),
             })?;
             let s = JointStrength::new(s.friction, s.cohesion)?;
-            let (ba, bb) = (&model.blocks()[ia], &model.blocks()[ib]);
-            let points: Vec<Vector> = view.points().collect();
-            let vertices = contact_polygon(
-                BlockGeometry {
-                    shape: ba.shape(),
-                    pose: &ba.state().pose,
-                },
-                BlockGeometry {
-                    shape: bb.shape(),
-                    pose: &bb.state().pose,
-                },
-                view.kind(),
-                view.host_is_a(),
-                view.normal(),
-                &points,
-                model.parameters().contact.tolerance,
-            );
+            let vertices = model.contact_polygon(&view);
             if vertices.is_empty() {
                 continue;
             }

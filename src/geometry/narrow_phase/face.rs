@@ -5,7 +5,6 @@ use glam::DVec2;
 use super::super::clip::{area_centroid, clip_convex, clip_rect, second_moments};
 use super::super::polyhedron::Polyhedron;
 use super::*;
-#[cfg(feature = "limit")]
 use crate::math::plane_basis;
 use crate::math::{Real, Vector};
 
@@ -243,7 +242,6 @@ pub(super) fn face_face_hosted(
 /// node contact, or a face-face polygon that came out degenerate, the 2-D hull of `points`
 /// (the sub-contacts) in the plane normal to `normal`: a polygon, a segment or a point.
 /// Corners closer than 1e-9 of the polygon's extent are merged, collinear ones dropped.
-#[cfg(feature = "limit")]
 pub(crate) fn contact_polygon(
     a: BlockGeometry<'_>,
     b: BlockGeometry<'_>,
@@ -306,7 +304,6 @@ pub(crate) fn contact_polygon(
 
 /// The polygon `points` clipped to `height(p) <= limit` (Sutherland–Hodgman on one plane),
 /// and whether anything was cut.
-#[cfg(feature = "limit")]
 fn clip_by_height(points: &[Vector], height: impl Fn(Vector) -> Real, limit: Real) -> (Vec<Vector>, bool) {
     let h: Vec<Real> = points.iter().map(|&p| height(p) - limit).collect();
     if h.iter().all(|&h| h <= 0.0) {

@@ -13,16 +13,12 @@ use crate::error::{in_range, positive, Result};
 use crate::math::{Pose, Real, Vector};
 
 mod face;
-#[cfg(feature = "limit")]
 mod hull;
 pub(crate) mod nodes;
 
-#[cfg(feature = "limit")]
 pub(crate) use face::contact_polygon;
 use face::*;
 pub(crate) use face::{face_frame, PARALLEL_ANGLE};
-#[cfg(feature = "limit")]
-#[cfg(feature = "limit")]
 use hull::hull2d;
 use nodes::node_contact;
 

@@ -114,6 +114,10 @@ struct Snapshot<L: ConstitutiveLaw> {
     /// time each started at.
     #[serde(default)]
     motions: Vec<super::excitation::AppliedMotion>,
+    /// Load histories ([`Model::set_load_history`](super::Model::set_load_history)), with the
+    /// model time each started at.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    load_histories: Vec<super::excitation::AppliedLoad>,
 }
 
 /// A joint as checkpoints store it: its geometry, law, the step's running sums and its

@@ -467,6 +467,21 @@ where
                 last.start = start;
             }
         }
+        for (k, h) in snap.load_histories.into_iter().enumerate() {
+            if !(h.start.is_finite() && h.start <= snap.time) {
+                return Err(corrupt(
+                    &format!("load_histories[{k}].start"),
+                    "not a finite time before the checkpoint's",
+                ));
+            }
+            let (block, start) = (BlockId(h.block), h.start);
+            model
+                .set_load_history(block, Some(h.load))
+                .map_err(|e| corrupt(&format!("load_histories[{k}]"), &e.to_string()))?;
+            if let Some(last) = model.state.load_histories.iter_mut().find(|a| a.block == block.0) {
+                last.start = start;
+            }
+        }
         model.state.refining.sort_unstable();
         model.state.refining.dedup();
         model.state.step = snap.step;

@@ -119,6 +119,7 @@ where
             refine_travel: self.state.refine_travel,
             refining: self.state.refining.clone(),
             motions: self.state.motions.clone(),
+            load_histories: self.state.load_histories.clone(),
             pending_detection: self.state.changes.need_full_detection() || !self.state.refixed.is_empty(),
         };
         let io = |e: serde_json::Error| Error::Io {

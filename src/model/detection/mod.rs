@@ -510,11 +510,12 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             })
     }
 
-    /// The index of the joint law between blocks `i` and `j`.
+    /// The index of the joint law between blocks `i` and `j`: their interface's own, else
+    /// their materials'.
     fn law_index(&self, i: u32, j: u32) -> Result<u32> {
         let (bi, bj) = (&self.blocks[i as usize], &self.blocks[j as usize]);
         self.laws
-            .index_of(bi.material(), bj.material())
+            .index_for((BlockId(i), bi.material()), (BlockId(j), bj.material()))
             .ok_or(Error::MissingJointLaw {
                 a: bi.material(),
                 b: bj.material(),
