@@ -1,0 +1,182 @@
+"""compas_voussoir against the voussoir library's own reference arch, closed forms and the
+Results conventions of compas_dem."""
+
+import math
+
+import numpy as np
+import pytest
+
+compas_dem = pytest.importorskip("compas_dem")
+
+from compas.datastructures import Mesh  # noqa: E402
+from compas_dem.models import BlockModel  # noqa: E402
+from compas_dem.problem import Problem  # noqa: E402
+from compas_dem.templates import ArchTemplate  # noqa: E402
+
+import compas_voussoir as cv  # noqa: E402
+import voussoir as vs  # noqa: E402
+
+DENSITY = 2446.4831804281343  # 24 kN/m³, the reference arch's
+STEEL = 7850.0
+WIDTH = 0.15
+
+
+def to_compas(points):
+    """voussoir's arch frame (x span, y up, z across) to compas_dem's (x span, y across, z up)."""
+    p = np.asarray(points, dtype=float)
+    return p[:, [0, 2, 1]]
+
+
+def mesh_of(block):
+    # The swap of y and z is a reflection: the face loops turn the other way.
+    return Mesh.from_vertices_and_faces(to_compas(block.vertices).tolist(), [f[::-1] for f in block.faces])
+
+
+def reference_arch():
+    """The reference arch of ``cargo run --example arch_static`` as a compas_dem model: the 13
+    voussoirs of compas_dem's ``ArchTemplate``, the two abutments of ``voussoir.build.arch``
+    (supports) and the steel loading plate on voussoir 5's extrados. Returns the model, the
+    plate's graph node and the stones' graph nodes."""
+    model = BlockModel.from_template(ArchTemplate(rise=0.4, span=1.2, thickness=0.2, depth=WIDTH, n=13))
+    blocks = vs.build.arch(width=WIDTH)
+    # ArchTemplate's voussoirs are build.arch's, vertex for vertex (numbered from the right).
+    for element, block in zip(model.elements(), reversed(blocks[1:-1])):
+        mine = np.asarray(element.modelgeometry.to_vertices_and_faces()[0])
+        theirs = to_compas(block.vertices)
+        assert max(np.min(np.linalg.norm(theirs - p, axis=1)) for p in mine) < 1e-12
+    for abutment in (blocks[0], blocks[-1]):
+        model.add_support_from_mesh(mesh_of(abutment))
+    # The plate: 0.10 × 0.02 m, seated on the middle of voussoir 5's extrados, turned with it.
+    joints = vs.build.arch_joints(width=WIDTH)
+    e4, e5 = np.asarray(joints[4]["extrados"]), np.asarray(joints[5]["extrados"])
+    mid, chord = 0.5 * (e4 + e5), e5 - e4
+    n = np.array([-chord[1], chord[0], 0.0]) / np.hypot(chord[0], chord[1])
+    t = chord / np.linalg.norm(chord)
+    corners = []
+    for a in (-0.05, 0.05):
+        for b in (0.0, 0.02):
+            for z in (0.0, WIDTH):
+                p = mid + a * t + b * n
+                corners.append([p[0], p[1], z])
+    plate = vs.Block.from_vertices("plate", corners, STEEL)
+    plate_node = model.add_block_from_mesh(mesh_of(plate))
+    return model, plate_node
+
+
+def reference_problem(phi=30.5):
+    model, plate = reference_arch()
+    problem = Problem(model)
+    problem.set_contact_model("MohrCoulomb", phi=phi)
+    problem.set_joint_model(kn=4e9, kt=1.6e9)
+    live = problem.add_boundary_condition("Live")
+    centroid = np.mean(np.asarray(model.graph.node_element(plate).modelgeometry.to_vertices_and_faces()[0]), axis=0)
+    problem.add_point_load_at_point(plate, list(centroid), [0.0, 0.0, -1.0], boundary_condition=live)
+    return model, plate, problem
+
+
+# The plate moves in the arch's plane only (as in arch_static's limit analysis).
+PLATE_IN_PLANE = {"translation": ["free", "fixed", "free"], "rotation": ["fixed", "free", "fixed"]}
+
+
+def test_limit_load_of_the_reference_arch():
+    """Through compas_dem, the limit load (multiplier + the plate's weight) is arch_static's
+    2.755 kN at φ 30.5° (the library and LMGC90 agree on it to four digits)."""
+    model, plate, problem = reference_problem()
+    r = cv.solve(problem, analysis="limit", live="Live", density=DENSITY, densities={plate: STEEL}, fixity={plate: PLATE_IN_PLANE})
+    weight = STEEL * 0.1 * 0.02 * WIDTH * 9.81
+    load = r.metadata["multiplier"] + weight
+    assert load == pytest.approx(2755.0, rel=0.005), load
+    assert r.metadata["carries_dead_load"] is True
+    # Every contact at collapse: a polygon whose corner forces add up to the resultant.
+    for edge in r.edges():
+        fn = np.asarray(r.force_normal(edge))
+        assert fn.sum() == pytest.approx(r.resultant_local(edge)[2], rel=1e-9, abs=1e-9)
+        assert r.face_contact(edge) or r.edge_contact(edge) or r.point_contact(edge)
+
+
+def test_dem_capacity_of_the_reference_arch():
+    """A push-over of the plate through compas_dem: the capacity is arch_static's baseline,
+    2.798 kN, within 3 %."""
+    model, plate, problem = reference_problem()
+    push = {"block": plate, "direction": (0.0, 0.0, -1.0), "increment": 2e-5, "max_travel": 0.004,
+            "fixity": {"translation": ["free", "fixed", 0.0], "rotation": ["fixed", "free", "fixed"]}}
+    r = cv.solve(problem, analysis="capacity", capacity=push, density=DENSITY, densities={plate: STEEL})
+    assert r.metadata["peak_load"] == pytest.approx(2798.0, rel=0.03), r.metadata["peak_load"]
+
+
+def test_static_results_follow_compas_dem_conventions():
+    """Settled under its weight: the abutments carry the arch's weight, each contact's
+    force_point reproduces the contact's moment, transformations are rigid motions."""
+    model, plate, problem = reference_problem()
+    r = cv.solve(problem, analysis="static", density=DENSITY, densities={plate: STEEL})
+    assert r.metadata["unbalanced_ratio"] < 1e-5
+    conv = cv.to_voussoir(problem, density=DENSITY, densities={plate: STEEL})
+    weight = sum(conv.model.block(i).mass for i in range(len(conv.model)) if not conv.model.block(i).is_fixed) * 9.81
+    supports = {e.graphnode for e in model.elements() if e.is_support}
+    vertical = 0.0
+    for edge in r.edges():
+        u, v = edge
+        if (u in supports) != (v in supports):
+            F = np.asarray(r.resultant_global(edge))  # on edge[0]
+            vertical += F[2] if u in supports else -F[2]  # the force on the support, downward negative
+        # Moment about the frame's origin: the corner normal forces give the resultant's.
+        frame = r.contact_frame(edge)
+        pts = np.asarray(r.contact_point(edge))
+        fn = np.asarray(r.force_normal(edge))
+        n = np.asarray(frame.zaxis)
+        if r.face_contact(edge) and fn.sum() > 0:
+            p = np.asarray(r.force_point(edge))
+            moment_corners = np.cross(pts - p, np.outer(fn, n)).sum(axis=0)
+            assert np.linalg.norm(moment_corners) < 1e-6 * fn.sum(), moment_corners
+    assert -vertical == pytest.approx(weight, rel=1e-3)
+    T = np.asarray(r.transformation(plate).matrix)
+    assert np.allclose(T[:3, :3] @ T[:3, :3].T, np.eye(3), atol=1e-12)
+
+
+def test_a_shaken_wall_round_trips_its_results():
+    """A two-block wall on a support shaken at 0.3 g for 0.2 s: Results with every block and
+    contact, which survive compas's JSON round trip."""
+    import compas
+    from compas.geometry import Box
+
+    boxes = [Box.from_corner_corner_height([-1, -0.5, -0.2], [1, 0.5, -0.2], 0.2)]
+    boxes += [Box.from_corner_corner_height([-0.4 + 0.4 * k, -0.1, 0.0], [0.0 + 0.4 * k, 0.1, 0.0], 0.3) for k in range(2)]
+    model = BlockModel.from_boxes(boxes)
+    model.add_support(0)
+    problem = Problem(model)
+    problem.set_contact_model("MohrCoulomb", phi=35.0)
+    problem.add_boundary_condition("Gravity")
+    record = vs.TimeHistory.sine(0.3 * 9.81, 5.0, 0.2, 400)
+    r = cv.solve(problem, analysis="shaking", ground_motion={"x": record}, density=2000.0)
+    assert r.metadata["shaking_duration"] == pytest.approx(0.2, abs=1e-3)
+    assert set(r.nodes()) == {0, 1, 2}
+    back = compas.json_loads(compas.json_dumps(r))
+    for node in r.nodes():
+        assert np.allclose(back.transformation(node).matrix, r.transformation(node).matrix)
+    for edge in r.edges():
+        assert back.resultant_global(edge) == r.resultant_global(edge)
+    # The support moved with the ground: x(0.2 s) of a sine acceleration from rest.
+    w = 2 * math.pi * 5.0
+    exact = 0.3 * 9.81 / w**2 * (w * 0.2 - math.sin(w * 0.2))
+    assert r.displacement(0)[0] == pytest.approx(exact, rel=1e-3)
+
+
+def test_corner_forces_put_the_resultant_at_its_point():
+    corners = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    f = cv.corner_normal_forces(corners, 10.0, [0.8, 0.3, 0.0])
+    assert f.sum() == pytest.approx(10.0)
+    assert (f[:, None] * np.asarray(corners)).sum(axis=0) / 10.0 == pytest.approx([0.8, 0.3, 0.0])
+
+
+def test_bad_problems_are_refused_with_what_is_missing():
+    model = BlockModel.from_template(ArchTemplate(rise=0.4, span=1.2, thickness=0.2, depth=0.15, n=5))
+    problem = Problem(model)
+    with pytest.raises(ValueError, match="contact model"):
+        cv.solve(problem, density=2000.0)
+    problem.set_contact_model("MohrCoulomb", phi=30.0)
+    with pytest.raises(ValueError, match="density"):
+        cv.solve(problem)
+    with pytest.raises(ValueError, match="analysis"):
+        cv.solve(problem, analysis="quasi", density=2000.0)
+    with pytest.raises(ValueError, match="live"):
+        cv.solve(problem, analysis="limit", density=2000.0)
