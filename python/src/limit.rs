@@ -10,7 +10,7 @@ use crate::errors::bad;
 use crate::errors::OrPy;
 use crate::model::PyModel;
 
-/// limit(model, live_loads, *, fixity=None, friction="cone", facets=16, check_dead_load=True, max_iterations=200)
+/// limit(model, live_loads, *, fixity=None, friction="cone", facets=16, check_dead_load=True, max_iterations=200, joints=None, mechanism_tolerance=0.001)
 /// --
 ///
 /// The collapse load of the model's blocks as they stand, by limit analysis (Rust:
@@ -27,6 +27,9 @@ use crate::model::PyModel;
 /// (``facets`` planes inscribed, a linear programme, a lower bound by at most
 /// ``1 - cos(pi / facets)``). ``check_dead_load``: also check that the dead loads alone are
 /// carried (a second solve); a structure that stands only when pushed raises ``VoussoirError``.
+/// ``joints``: joints to classify in the mechanism, as ``classify_joints`` takes them (e.g.
+/// ``voussoir.build.arch_joints()``); a joint hinges or slides where its relative motion at
+/// collapse exceeds ``mechanism_tolerance`` of the largest.
 ///
 /// Returns a dict:
 ///
@@ -41,7 +44,11 @@ use crate::model::PyModel;
 ///   relative motion at each corner), ``resultant`` (the force on b) and
 ///   ``application_point`` (the centre of the normal forces, where the resultant gives the
 ///   corners' moment about any axis in the joint plane; None for a contact without
-///   compression).
+///   compression);
+/// - with ``joints``: ``joints``, one dict per joint (``joint``, ``opening_intrados``,
+///   ``opening_extrados``, ``sliding``: the mechanism's rates; ``hinge``: None,
+///   ``"intrados"`` or ``"extrados"``; ``is_sliding``), and ``mechanism``, e.g.
+///   ``"hinges 4e 8i; sliding 13"``.
 ///
 /// >>> import voussoir as vs
 /// >>> m = vs.Model()
@@ -54,7 +61,7 @@ use crate::model::PyModel;
 /// >>> round(r["multiplier"] / (2600 * 0.024 * 9.81), 4)  # slides: tan 30°
 /// 0.5774
 #[pyfunction]
-#[pyo3(signature = (model, live_loads, *, fixity=None, friction="cone", facets=16, check_dead_load=true, max_iterations=200))]
+#[pyo3(signature = (model, live_loads, *, fixity=None, friction="cone", facets=16, check_dead_load=true, max_iterations=200, joints=None, mechanism_tolerance=1e-3))]
 #[allow(clippy::too_many_arguments)]
 pub fn limit<'py>(
     py: Python<'py>,
@@ -65,7 +72,14 @@ pub fn limit<'py>(
     facets: usize,
     check_dead_load: bool,
     max_iterations: u32,
+    joints: Option<&Bound<'py, PyAny>>,
+    mechanism_tolerance: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
+    if !(mechanism_tolerance.is_finite() && mechanism_tolerance > 0.0) {
+        return Err(bad(format!(
+            "mechanism_tolerance = {mechanism_tolerance}: must be positive and finite"
+        )));
+    }
     let friction = match friction {
         "cone" => FrictionModel::Cone,
         "pyramid" => FrictionModel::Pyramid { facets },
@@ -76,9 +90,10 @@ pub fn limit<'py>(
         check_dead_load,
         max_iterations,
     };
-    let (problem, live) = {
+    let (problem, live, refs) = {
         let this = model.lock(py);
         let count = this.model.blocks().len();
+        let refs = joints.map(|j| crate::mechanism::joint_refs(j, count)).transpose()?;
         let mut problem = LimitProblem::from_model(&this.model).py()?;
         if let Some(overrides) = fixity {
             for (block, spec) in overrides.iter() {
@@ -86,15 +101,37 @@ pub fn limit<'py>(
                 problem.set_fixity(id, crate::convert::fixity(Some(&spec))?).py()?;
             }
         }
-        (problem, live_loads_of(live_loads, count)?)
+        (problem, live_loads_of(live_loads, count)?, refs)
     };
     // The model is free again; the solve lets the GIL go.
     let result = py.detach(|| problem.solve(&live, &options)).py()?;
-    crate::convert::result(
-        py,
-        "LimitResult",
-        result_to_py(py, &result, check_dead_load.then_some(true))?,
-    )
+    let d = result_to_py(py, &result, check_dead_load.then_some(true))?;
+    if let Some(refs) = refs {
+        let (motions, mechanism) = {
+            let this = model.lock(py);
+            result.classify(&this.model, &refs, mechanism_tolerance)
+        };
+        let list = PyList::empty(py);
+        for m in motions {
+            let e = PyDict::new(py);
+            e.set_item("joint", m.joint)?;
+            e.set_item("opening_intrados", m.opening_intrados)?;
+            e.set_item("opening_extrados", m.opening_extrados)?;
+            e.set_item("sliding", m.sliding)?;
+            e.set_item(
+                "hinge",
+                m.hinge.map(|h| match h {
+                    voussoir::analysis::HingeSide::Intrados => "intrados",
+                    voussoir::analysis::HingeSide::Extrados => "extrados",
+                }),
+            )?;
+            e.set_item("is_sliding", m.is_sliding)?;
+            list.append(e)?;
+        }
+        d.set_item("joints", list)?;
+        d.set_item("mechanism", mechanism.describe())?;
+    }
+    crate::convert::result(py, "LimitResult", d)
 }
 
 /// The live loads from Python: dicts or `(block, point, force)` sequences.

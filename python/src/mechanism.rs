@@ -107,7 +107,7 @@ pub fn classify_joints<'py>(
 }
 
 /// The joints from Python: a list of dicts `{"blocks", "intrados", "extrados", "index"?}`.
-fn joint_refs(obj: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<JointRef>> {
+pub(crate) fn joint_refs(obj: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<JointRef>> {
     let list = obj.cast::<PySequence>().map_err(|_| {
         bad("joints: expected a list of {\"blocks\": (a, b), \"intrados\": (x, y, z), \"extrados\": (x, y, z)} dicts")
     })?;

@@ -106,3 +106,37 @@ def test_docstring_examples_run():
         for t in tests:
             runner.run(t)
     assert runner.failures == 0, runner.summarize()
+
+
+def test_the_limit_analysis_names_its_mechanism():
+    """The reference arch (φ 30.5°) under a point load on voussoir 5's extrados: the limit
+    analysis's mechanism, classified at the arch's joints, slides at joints 4, 5 and 13 as
+    arch_static's table reports it ("no hinges; sliding 4 5 13")."""
+    m = vs.Model(gravity=(0, -9.81, 0))
+    m.set_joint_law(0, 0, vs.CoulombSlip.dry(4e9, 1.6e9, 30.5))
+    m.add_blocks(vs.build.arch())
+    m.run_steps(1)
+    joints = vs.build.arch_joints()
+    e4, e5 = joints[4]["extrados"], joints[5]["extrados"]
+    point = 0.5 * (e4 + e5)
+    r = vs.limit(m, [{"block": 5, "point": point, "force": (0, -1, 0)}], joints=joints)
+    assert len(r["joints"]) == 14
+    assert r["multiplier"] == pytest.approx(2755.0, rel=0.005)  # arch_static's limit load
+    assert r["mechanism"] == "no hinges; sliding 4 5 13"
+    sliding = [j["joint"] for j in r["joints"] if j["is_sliding"]]
+    assert sliding == [4, 5, 13] and all(j["hinge"] is None for j in r["joints"])
+    with pytest.raises(vs.VoussoirError, match="mechanism_tolerance"):
+        vs.limit(m, [{"block": 5, "point": point, "force": (0, -1, 0)}], joints=joints, mechanism_tolerance=0.0)
+
+
+def test_contact_tangent_components():
+    m, _ = standing_block(40.0)
+    m.set_load(1, force=(0.2 * WEIGHT, 0, 0))
+    m.run_to_equilibrium(1e-6, 200_000)
+    c = m.contacts()
+    n, t1, t2 = c["normal"][0], c["tangent1"][0], c["tangent2"][0]
+    assert np.allclose(np.cross(n, t1), t2)
+    f = c["force"][0]
+    assert np.allclose(c["tangent_force"][0], [f @ t1, f @ t2])
+    # The block's base carries the push: the tangential force on the block is the load.
+    assert np.hypot(*c["tangent_force"][0]) == pytest.approx(0.2 * WEIGHT, rel=1e-4)

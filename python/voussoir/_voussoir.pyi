@@ -14,6 +14,7 @@ Dof = Union[Literal["free", "fixed"], float]
 FixitySpec = Union[bool, None, Literal["fixed", "free"], Dict[str, Sequence[Dof]]]
 Path = Union[str, "PathLike[str]"]
 Progress = Callable[[int, float], Optional[bool]]
+JointSpec = Dict[str, Any]
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
@@ -491,6 +492,8 @@ def limit(
     facets: int = 16,
     check_dead_load: bool = True,
     max_iterations: int = 200,
+    joints: Optional[Sequence[JointSpec]] = None,
+    mechanism_tolerance: float = 1e-3,
 ) -> Dict[str, Any]:
     """The collapse multiplier of ``live_loads`` (``{"block", "point", "force"}``: the force
     ``multiplier * force`` at ``point``) for the model's rigid blocks as they stand, no-tension
@@ -498,10 +501,11 @@ def limit(
     stepped once. Returns ``multiplier``, ``status``, ``iterations``, ``carries_dead_load``,
     ``blocks`` (``centroid``, ``velocity``, ``angular_velocity``: the mechanism) and
     ``contacts`` (per contact: ``blocks``, ``normal``, ``points``, ``normal_force``,
-    ``shear_force``, ``opening``, ``sliding``, ``resultant``, ``application_point``)."""
+    ``shear_force``, ``opening``, ``sliding``, ``resultant``, ``application_point``); with
+    ``joints`` (as ``classify_joints`` takes them) also ``joints`` (per joint: opening rates,
+    sliding, ``hinge``, ``is_sliding``) and ``mechanism`` (e.g. ``"hinges 4e 8i"``)."""
     ...
 
-JointSpec = Dict[str, Any]
 
 def classify_joints(
     model: Model,

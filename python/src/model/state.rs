@@ -168,6 +168,8 @@ impl PyModel {
     /// plane, ``application_point`` (m, 3) the centre of the sub-contacts' normal forces
     /// (where each acts within its cell), at which the resultant gives the contact's moment
     /// about any axis in the joint plane (NaN for a contact without compression),
+    /// ``tangent1``, ``tangent2`` (m, 3) the joint's tangent axes (``normal`` × ``tangent1`` =
+    /// ``tangent2``) and ``tangent_force`` (m, 2) the resultant's components along them (N),
     /// ``polygon`` a list of (k, 3) arrays, the corners of each contact polygon (m, in order
     /// around it: the area a face-to-face joint's sub-contacts can carry; for a vertex or edge
     /// contact, the hull of its sub-contacts, possibly a segment or a point),
@@ -227,6 +229,18 @@ impl PyModel {
                         voussoir::math::Vector::splat(f64::NAN)
                     }
                 }),
+            ),
+        )?;
+        let axes: Vec<_> = cs.iter().map(|c| c.axes()).collect();
+        d.set_item("tangent1", array_n3(py, axes.iter().map(|a| a.tangent)))?;
+        d.set_item("tangent2", array_n3(py, axes.iter().map(|a| a.tangent_2())))?;
+        d.set_item(
+            "tangent_force",
+            array_nk::<2>(
+                py,
+                cs.iter()
+                    .zip(&axes)
+                    .map(|(c, a)| [c.resultant().dot(a.tangent), c.resultant().dot(a.tangent_2())]),
             ),
         )?;
         d.set_item(
