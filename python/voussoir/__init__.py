@@ -25,7 +25,7 @@ from ._voussoir import (
     classify_joints,
     limit,
 )
-from . import build, fragility, scenarios, scenes, study
+from . import build, draw, fragility, scenarios, scenes, study
 
 __all__ = [
     "Block",
@@ -38,6 +38,7 @@ __all__ = [
     "VoussoirIOError",
     "__version__",
     "build",
+    "draw",
     "fragility",
     "check_density_convergence",
     "check_servo_convergence",
