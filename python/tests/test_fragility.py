@@ -48,3 +48,24 @@ def test_synthetic_records_are_reproducible_and_shaped():
 def test_a_gently_shaken_arch_stands():
     r = fragility.arch_case(0, 0.05, duration=0.5)
     assert not r["collapsed"] and r["peak_drift_m"] < 1e-3 and r["time_s"] == pytest.approx(0.5, abs=1e-3)
+
+
+def test_a_users_record_from_csv_shakes_the_arch_as_the_same_synthetic_one(tmp_path):
+    """A record written to CSV (in g, with a header) and read back through ``load_record`` drives
+    the arch bit for bit as the synthetic record it came from; a study mixes both kinds."""
+    t, a = fragility.kanai_tajimi(0, duration=0.5)
+    path = tmp_path / "record.csv"
+    with open(path, "w") as f:
+        f.write("time [s],acceleration [g]\n")
+        for ti, ai in zip(t, a):
+            f.write(f"{float(ti)!r},{float(0.3 * ai)!r}\n")
+    t2, a2 = fragility.load_record(path)
+    assert np.array_equal(t2, t) and np.allclose(a2, a, rtol=0, atol=1e-15)
+    mine = fragility.arch_case(str(path), 0.05)
+    theirs = fragility.arch_case(0, 0.05, duration=0.5)
+    assert mine["time_s"] == pytest.approx(0.5, abs=1e-3)
+    assert mine["peak_drift_m"] == pytest.approx(theirs["peak_drift_m"], rel=1e-9, abs=1e-12)
+    flat = tmp_path / "flat.csv"
+    flat.write_text("t,a\n0,0\n1,0\n")
+    with pytest.raises(ValueError, match="zero"):
+        fragility.load_record(flat)

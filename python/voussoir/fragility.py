@@ -20,7 +20,7 @@ from typing import Any, Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
-__all__ = ["kanai_tajimi", "arch_case", "fit_lognormal", "arch_fragility", "svg", "COLLAPSE_DROP_M"]
+__all__ = ["kanai_tajimi", "load_record", "arch_case", "fit_lognormal", "arch_fragility", "svg", "COLLAPSE_DROP_M"]
 
 #: A run collapses when a voussoir's centroid has dropped by more than half the ring thickness
 #: (0.1 m of the reference arch's 0.2 m), the rule of the impact benchmark.
@@ -76,8 +76,24 @@ def kanai_tajimi(
     return t, acc / np.abs(acc).max()
 
 
+def load_record(path, *, time_column: int = 0, value_column: int = 1) -> Tuple[np.ndarray, np.ndarray]:
+    """A user's accelerogram from a CSV file (a header line, then numbers; the columns are
+    chosen by index), as ``(times from 0, accelerations with a unit peak)``, ready to be scaled
+    to a PGA as the synthetic records are. The units of the file do not matter (only the shape
+    is kept); raises ``ValueError`` for a record without motion and ``VoussoirError`` (a
+    ``ValueError``) for a malformed file, with the line."""
+    import voussoir as vs
+
+    h = vs.TimeHistory.from_csv(path, time_column=time_column, value_column=value_column, scale=1.0)
+    t, a = np.asarray(h.times, dtype=float), np.asarray(h.values, dtype=float)
+    peak = float(np.max(np.abs(a)))
+    if peak == 0.0:
+        raise ValueError(f"record {path}: every acceleration is zero")
+    return t - t[0], a / peak
+
+
 def arch_case(
-    record: int,
+    record,
     pga_g: float,
     *,
     duration: float = 6.0,
@@ -87,8 +103,9 @@ def arch_case(
     subcontacts_per_edge: int = 7,
 ) -> Dict[str, Any]:
     """The reference arch (``build.arch()``: 1.2 m span, 0.4 m rise, 0.2 m ring) on abutments
-    shaken along the span by ``kanai_tajimi(record, duration=duration)`` scaled to ``pga_g``
-    (in g), dry joints (``friction_deg``, ``kn``, ks = 0.4 kn), stiffness-proportional
+    shaken along the span by ``kanai_tajimi(record, duration=duration)`` (``record`` an int,
+    the seed) or by the accelerogram of the CSV file ``record`` (a path: ``load_record``, its
+    own length) scaled to ``pga_g`` (in g), dry joints (``friction_deg``, ``kn``, ks = 0.4 kn), stiffness-proportional
     damping ``damping_ratio`` at 5 Hz. Returns ``collapsed`` (a voussoir's centroid dropped by
     more than ``COLLAPSE_DROP_M``; the run stops then), ``peak_drift_m`` (the largest
     horizontal displacement of a voussoir's centroid relative to the abutments),
@@ -103,7 +120,11 @@ def arch_case(
     m.set_damping("local", alpha=0.8)
     m.run_to_equilibrium(1e-5, 200_000)
     m.set_damping("rayleigh_stiffness", ratio=damping_ratio, frequency=5.0)
-    t, a = kanai_tajimi(record, duration=duration)
+    if isinstance(record, (int, np.integer)):
+        t, a = kanai_tajimi(int(record), duration=duration)
+    else:
+        t, a = load_record(record)
+        duration = float(t[-1])
     history = vs.TimeHistory(t.tolist(), (a * pga_g * 9.81).tolist())
     for b in abutments:
         m.set_base_motion(b, x=history)
@@ -185,7 +206,7 @@ def fit_lognormal(intensity: Sequence[float], collapsed: Sequence[bool]) -> Dict
 
 
 def arch_fragility(
-    records: int = 4,
+    records=4,
     levels: Sequence[float] = (1.0, 1.5, 2.0, 2.5, 3.0),
     *,
     store: Optional[str] = None,
@@ -194,7 +215,8 @@ def arch_fragility(
     **case: Any,
 ):
     """The seismic fragility of the reference arch: ``records`` synthetic ground motions
-    (seeds 0 to ``records − 1``) × ``levels`` (PGA in g; the small, thick arch rocks through
+    (an int: seeds 0 to ``records − 1``; or a list of seeds and CSV paths, users' records)
+    × ``levels`` (PGA in g; the small, thick arch rocks through
     1.5 g and falls from 2.5 g in 4 s records — measured on records 0 and 1 —, a size effect of
     rocking: its static collapse acceleration is far lower), each an ``arch_case`` (``case``:
     its keywords), run as a ``voussoir.study``; returns ``(table, fit)``, ``fit`` from
@@ -202,7 +224,8 @@ def arch_fragility(
     did)."""
     from . import study
 
-    cases = study.grid(record=list(range(records)), pga_g=list(levels))
+    chosen = list(range(records)) if isinstance(records, (int, np.integer)) else [r if isinstance(r, (int, np.integer)) else str(r) for r in records]
+    cases = study.grid(record=chosen, pga_g=list(levels))
     cases = [dict(c, **case) for c in cases]
     table = study.run(arch_case, cases, store=store, client=client, progress=progress)
     ok = table[table["error"] == ""]
