@@ -92,6 +92,9 @@ def test_limit_load_of_the_reference_arch():
         fn = np.asarray(r.force_normal(edge))
         assert fn.sum() == pytest.approx(r.resultant_local(edge)[2], rel=1e-9, abs=1e-9)
         assert r.face_contact(edge) or r.edge_contact(edge) or r.point_contact(edge)
+        assert len(r.status(edge)) == len(r.contact_point(edge))
+    # The mechanism slides at three joints (arch_static: "sliding 4 5 13"): some corners slide.
+    assert any(s == "sliding" for e in r.edges() for s in r.status(e))
 
 
 def test_dem_capacity_of_the_reference_arch():
@@ -129,6 +132,8 @@ def test_static_results_follow_compas_dem_conventions():
             moment_corners = np.cross(pts - p, np.outer(fn, n)).sum(axis=0)
             assert np.linalg.norm(moment_corners) < 1e-6 * fn.sum(), moment_corners
     assert -vertical == pytest.approx(weight, rel=1e-3)
+    statuses = {s for e in r.edges() for s in r.status(e)}
+    assert statuses <= {"elastic", "sliding", "open"} and "elastic" in statuses
     T = np.asarray(r.transformation(plate).matrix)
     assert np.allclose(T[:3, :3] @ T[:3, :3].T, np.eye(3), atol=1e-12)
 

@@ -13,6 +13,8 @@ Per contact (graph edge, oriented as in the model's graph when it has the edge):
   ``resultant_local``: ``[F_u, F_v, F_n]`` in the frame, ``F_n`` positive in compression;
 - ``force_point``: where the resultant acts (the centre of the normal forces), at which it
   gives the contact's moment about any axis in the joint plane; ``force_magnitude``;
+- ``status`` per corner: DEM, that of the nearest sub-contact (``"elastic"``, ``"sliding"``,
+  ``"open"``); limit analysis, the mechanism's (``"sliding"``, ``"open"``, ``"closed"``);
 - ``force_normal``, ``force_tangent1``, ``force_tangent2`` and ``contact_data``
   (``FrictionContact``/``EdgeContact``/``VertexContact`` with ``c_np``, ``c_nn``, ``c_u``,
   ``c_v`` at the corners): corner forces that add up to the resultant and, for the normal
@@ -73,7 +75,9 @@ def corner_normal_forces(corners, total, point):
     return f
 
 
-def _set_contact(results, edge, corners, normal, force_on_first, normal_force, point, fn_corners=None, ft_corners=None):
+def _set_contact(
+    results, edge, corners, normal, force_on_first, normal_force, point, fn_corners=None, ft_corners=None, status=None
+):
     """One contact's entries; ``normal`` from edge[0] to edge[1], ``force_on_first`` on edge[0]."""
     t1, t2, n = _frame(normal)
     F = np.asarray(force_on_first, dtype=float)
@@ -104,6 +108,8 @@ def _set_contact(results, edge, corners, normal, force_on_first, normal_force, p
     results.set_edge(edge, "force_normal", [f["c_np"] - f["c_nn"] for f in forces])
     results.set_edge(edge, "force_tangent1", [f["c_u"] for f in forces])
     results.set_edge(edge, "force_tangent2", [f["c_v"] for f in forces])
+    if status is not None:
+        results.set_edge(edge, "status", list(status))
     if k >= 3:
         results.set_edge(edge, "contact_polygon", cg.Polygon(corners))
         fc = FrictionContact(points=corners)
@@ -127,6 +133,8 @@ def from_model(problem, model, conversion, metadata=None):
     for i, n in conversion.node.items():
         results.set_node(n, "transformation", _transformation(conversion.rotations[i], conversion.centroids[i], rotations[i], positions[i]))
     c = m.contacts()
+    sub = m.subcontacts()
+    sub_contact, sub_point, sub_status = np.asarray(sub["contact"]), np.asarray(sub["point"]), list(sub["status"])
     for k, (a, b) in enumerate(c["blocks"]):
         u, v = conversion.node[int(a)], conversion.node[int(b)]
         edge, added = _edge(model.graph, u, v)
@@ -137,7 +145,14 @@ def from_model(problem, model, conversion, metadata=None):
         normal = -c["normal"][k] if flip else c["normal"][k]
         on_first = c["force"][k] if flip else -c["force"][k]
         point = c["application_point"][k]
-        _set_contact(results, edge, c["polygon"][k], normal, on_first, float(c["normal_force"][k]), point)
+        # Each corner's status: that of the sub-contact nearest to it ("elastic", "sliding",
+        # "open"): at a hinge the corners on the opening side are open.
+        mine = np.flatnonzero(sub_contact == k)
+        status = [
+            sub_status[mine[int(np.argmin(np.linalg.norm(sub_point[mine] - q, axis=1)))]] if len(mine) else "open"
+            for q in np.asarray(c["polygon"][k]).reshape(-1, 3)
+        ]
+        _set_contact(results, edge, c["polygon"][k], normal, on_first, float(c["normal_force"][k]), point, status=status)
     results.metadata.update(metadata or {})
     return results
 
@@ -174,6 +189,17 @@ def from_limit(problem, model, conversion, limit, metadata=None):
         if flip:
             sign = -1.0  # the force on edge[1] = a is minus the force on b
         ft = [(sign * float(s @ t1), sign * float(s @ t2)) for s in shear]
+        # Each corner's status in the mechanism: sliding (which, with associative friction,
+        # also opens it by tan φ of the slip), opening, or closed (rates beyond 1e-6 of the
+        # largest of the whole mechanism).
+        rate = max(
+            (float(np.max(np.hypot(c["opening"], c["sliding"]))) for c in limit["contacts"] if len(c["opening"])),
+            default=0.0,
+        )
+        status = [
+            "sliding" if abs(sl) > 1e-6 * rate else "open" if o > 1e-6 * rate else "closed"
+            for o, sl in zip(contact["opening"], contact["sliding"])
+        ]
         _set_contact(
             results,
             edge,
@@ -184,6 +210,7 @@ def from_limit(problem, model, conversion, limit, metadata=None):
             contact["application_point"],
             fn_corners=list(contact["normal_force"]),
             ft_corners=ft,
+            status=status,
         )
     results.metadata.update(metadata or {})
     return results
