@@ -9,8 +9,11 @@ Per contact (graph edge, oriented as in the model's graph when it has the edge):
   more corners / a segment / a point);
 - ``contact_polygon`` (``compas.geometry.Polygon``), ``contact_points`` (its corners),
   ``contact_frame`` (``zaxis`` the contact normal from ``edge[0]`` to ``edge[1]``);
-- ``resultant_global``: the force on ``edge[0]``'s block, as ``compas_lmgc90`` reports it;
-  ``resultant_local``: ``[F_u, F_v, F_n]`` in the frame, ``F_n`` positive in compression;
+- ``resultant_global``: the force on ``edge[1]``'s block, the block the frame's ``zaxis``
+  points into (as compas_dem's CRA, RBE, PRD and BLA report it; ``metadata["force_on"]`` says
+  so; ``resultant_global · zaxis = F_n ≥ 0`` in compression, the rule that holds for every
+  backend); ``resultant_local``: ``[F_u, F_v, F_n]`` in the frame, ``F_n`` positive in
+  compression;
 - ``force_point``: where the resultant acts (the centre of the normal forces), at which it
   gives the contact's moment about any axis in the joint plane; ``force_magnitude``;
 - ``status`` per corner: DEM, that of the nearest sub-contact (``"elastic"``, ``"sliding"``,
@@ -80,10 +83,9 @@ def _set_contact(
 ):
     """One contact's entries; ``normal`` from edge[0] to edge[1], ``force_on_first`` on edge[0]."""
     t1, t2, n = _frame(normal)
-    F = np.asarray(force_on_first, dtype=float)
-    # The force on edge[0] pushes it against the normal: the local components of the force on
-    # edge[1] (−F), with F_n positive in compression.
-    Fu, Fv = float(-F @ t1), float(-F @ t2)
+    # The force on edge[1] (the block the normal points into), with F_n positive in compression.
+    F = -np.asarray(force_on_first, dtype=float)
+    Fu, Fv = float(F @ t1), float(F @ t2)
     corners = [list(map(float, p)) for p in corners]
     k = len(corners)
     if fn_corners is None:
@@ -153,6 +155,7 @@ def from_model(problem, model, conversion, metadata=None):
             for q in np.asarray(c["polygon"][k]).reshape(-1, 3)
         ]
         _set_contact(results, edge, c["polygon"][k], normal, on_first, float(c["normal_force"][k]), point, status=status)
+    results.metadata["force_on"] = "edge[1]"
     results.metadata.update(metadata or {})
     return results
 
@@ -212,5 +215,6 @@ def from_limit(problem, model, conversion, limit, metadata=None):
             ft_corners=ft,
             status=status,
         )
+    results.metadata["force_on"] = "edge[1]"
     results.metadata.update(metadata or {})
     return results
