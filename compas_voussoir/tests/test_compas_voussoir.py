@@ -238,3 +238,27 @@ def test_self_weight_reactions_against_compas_cra():
     assert thrusts[1] == pytest.approx(thrusts[0], rel=1e-3)
     assert abs(thrusts[0]) == pytest.approx(299.3, rel=2e-3)
     assert abs(cra_reaction[0]) == pytest.approx(337.5, rel=2e-3)
+
+
+def test_a_dynamic_run_slides_a_pushed_block_as_coulomb_says():
+    """A 0.2 m block on a support (μ 0.2), pushed by an instantaneous 0.5 W from rest, undamped:
+    it slides x = ½ (0.5 − μ) g t² (0.2 % measured: the shear springs' pre-slip and the
+    weight's first bounce)."""
+    from compas.geometry import Box
+
+    boxes = [
+        Box.from_corner_corner_height([-1, -0.5, -0.2], [1, 0.5, -0.2], 0.2),
+        Box.from_corner_corner_height([-0.1, -0.1, 0.0], [0.1, 0.1, 0.0], 0.2),
+    ]
+    model = BlockModel.from_boxes(boxes)
+    model.add_support(0)
+    problem = Problem(model)
+    problem.set_contact_model("MohrCoulomb", mu=0.2)
+    push = problem.add_boundary_condition("Push")
+    weight = 2000.0 * 0.008 * 9.81
+    problem.add_point_load_at_centroid(1, [0.5 * weight, 0, 0], loading_type="instantaneous", boundary_condition=push)
+    r = cv.solve(problem, analysis="dynamic", duration=0.2, damping={"kind": "none"}, density=2000.0)
+    t = r.metadata["time"]
+    assert t == pytest.approx(0.2, abs=1e-3)
+    assert r.displacement(1)[0] == pytest.approx(0.5 * (0.5 - 0.2) * 9.81 * t**2, rel=0.01)
+    assert len(r.metadata["history"]["time"]) >= 100
