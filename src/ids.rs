@@ -17,6 +17,13 @@ impl std::fmt::Display for BlockId {
     }
 }
 
+impl From<BlockId> for usize {
+    /// The index into the model's block list, as [`BlockId::index`].
+    fn from(id: BlockId) -> usize {
+        id.index()
+    }
+}
+
 impl BlockId {
     /// The index into the model's block list.
     #[inline]

@@ -247,6 +247,35 @@ impl Arch {
         [0, self.spec.voussoirs + 1]
     }
 
+    /// The [`BlockId`](crate::block::BlockId) of voussoir `k` (1-based from the left) in a model
+    /// the arch's blocks were added to first, in [`Arch::blocks`] order (as
+    /// [`Arch::joint_refs`] assumes): the id that `Model::block`, `Model::set_load` and the
+    /// loading drivers take, without converting [`Arch::voussoir`]'s index by hand.
+    ///
+    /// ```
+    /// use voussoir::build::arch::{Arch, ArchSpec};
+    /// use voussoir::prelude::*;
+    ///
+    /// let arch = Arch::new(&ArchSpec::reference(0.15))?;
+    /// let mut model: Model = Model::new(ModelParameters::default())?;
+    /// for b in arch.blocks.iter().cloned() {
+    ///     model.add_block(b)?;
+    /// }
+    /// let key = arch.voussoir_id(7);
+    /// assert_eq!(model.block(key)?.name(), arch.blocks[arch.voussoir(7)].name());
+    /// assert_eq!(arch.abutment_ids()[0], BlockId(0));
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    pub fn voussoir_id(&self, k: usize) -> crate::block::BlockId {
+        crate::block::BlockId(self.voussoir(k) as u32)
+    }
+
+    /// The [`BlockId`](crate::block::BlockId)s of the left and right abutments, as
+    /// [`Arch::voussoir_id`].
+    pub fn abutment_ids(&self) -> [crate::block::BlockId; 2] {
+        self.abutments().map(|i| crate::block::BlockId(i as u32))
+    }
+
     /// Midpoint of the extrados chord of voussoir `k` at mid-width (m).
     pub fn extrados_midpoint(&self, k: usize) -> Vector {
         let k = self.voussoir(k);

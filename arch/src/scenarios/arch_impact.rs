@@ -509,11 +509,9 @@ pub fn build(case: &ImpactCase) -> Result<ImpactModel> {
                     .with_fixity(Fixity::FIXED);
                 frame_ids.push(model.add_block(block)?);
             }
-            let targets = (1..=arch.spec.voussoirs)
-                .map(|k| BlockId(arch.voussoir(k) as u32))
-                .collect();
+            let targets = (1..=arch.spec.voussoirs).map(|k| arch.voussoir_id(k)).collect();
             let struck = (
-                BlockId(arch.voussoir(VOUSSOIR) as u32),
+                arch.voussoir_id(VOUSSOIR),
                 [Vector::new(e0.x, e0.y, mid), Vector::new(e1.x, e1.y, mid)],
             );
             Ok(ImpactModel {
@@ -747,7 +745,7 @@ pub fn run(
         .collect();
     // Blocks of the ring whose potential energy is tracked: voussoirs and seat.
     let ring: Vec<(BlockId, Real, Real)> = (1..=arch.spec.voussoirs)
-        .map(|k| BlockId(arch.voussoir(k) as u32))
+        .map(|k| arch.voussoir_id(k))
         .chain(im.seat)
         .map(|id| {
             let b = &im.model.blocks()[id.index()];
@@ -755,7 +753,7 @@ pub fn run(
         })
         .collect();
     let quarter = arch.extrados_midpoint(VOUSSOIR);
-    let q_block = BlockId(arch.voussoir(VOUSSOIR) as u32);
+    let q_block = arch.voussoir_id(VOUSSOIR);
     let q_settled = moved(&im.model, q_block, quarter);
 
     // Release: the speed of the fall at the measured gap, so that the impactor strikes at √(2gH).

@@ -499,7 +499,7 @@ pub fn run(
     let criteria = MechanismCriteria::default();
     let left = arch.extrados_midpoint(1);
     let right = arch.extrados_midpoint(arch.spec.voussoirs);
-    let (left_id, right_id) = (BlockId(1), BlockId(arch.spec.voussoirs as u32));
+    let (left_id, right_id) = (arch.voussoir_id(1), arch.voussoir_id(arch.spec.voussoirs));
     let sample_every = ((2e-5 / case.rate) / model.dt()).ceil().max(1.0) as u64;
     let step0 = model.step_count();
     let mut run = StaticRun {
