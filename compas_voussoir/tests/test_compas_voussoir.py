@@ -87,6 +87,10 @@ def test_limit_load_of_the_reference_arch():
     load = r.metadata["multiplier"] + weight
     assert load == pytest.approx(2755.0, rel=0.005), load
     assert r.metadata["carries_dead_load"] is True
+    # The same through the problem's own solver settings: the one line that changes from
+    # problem.solve().
+    problem.set_solver(cv.Voussoir(analysis="limit", live="Live", density=DENSITY, densities={plate: STEEL}, fixity={plate: PLATE_IN_PLANE}))
+    assert cv.solve(problem).metadata["multiplier"] == r.metadata["multiplier"]
     # Every contact at collapse: a polygon whose corner forces add up to the resultant.
     for edge in r.edges():
         fn = np.asarray(r.force_normal(edge))

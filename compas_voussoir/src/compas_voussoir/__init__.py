@@ -12,7 +12,7 @@ one line::
 
 from .convert import Conversion, to_voussoir
 from .results import corner_normal_forces, from_limit, from_model
-from .solve import ANALYSES, Voussoir, solve
+from .solve import ANALYSES, Voussoir, run, solve
 
 __version__ = "0.1.0"
 
@@ -23,6 +23,7 @@ __all__ = [
     "corner_normal_forces",
     "from_limit",
     "from_model",
+    "run",
     "solve",
     "to_voussoir",
 ]

@@ -62,7 +62,18 @@ def _stop_prescribed(conv, blocks):
         m.set_fixity(i, fixed)
 
 
-def solve(
+def solve(problem, model=None, **options):
+    """Solves ``problem`` over ``model`` (default: the problem's) with voussoir and returns
+    ``compas_dem.problem.Results``; the options are :func:`run`'s, taken from the problem's
+    ``Voussoir`` solver (``problem.set_solver(compas_voussoir.Voussoir(...))``) where not given
+    here. This is the one line that changes from ``problem.solve()``."""
+    configured = getattr(problem, "_solver", None)
+    if configured is not None and getattr(configured, "name", None) == "voussoir":
+        options = {**configured.parameters, **options}
+    return run(problem, model, **options)
+
+
+def run(
     problem,
     model=None,
     *,
@@ -90,7 +101,7 @@ def solve(
     ``compas_dem.problem.Results`` (see ``compas_voussoir.results`` for what each entry holds
     and its signs) with ``metadata`` saying what was run.
 
-    ``analysis`` (default: the problem's ``Voussoir`` solver's, else ``"static"``):
+    ``analysis`` (default ``"static"``):
 
     - ``"static"``: gravity and the loads (ramped over ``ramp_time`` s) with local damping,
       run to an unbalanced-force ratio below ``ratio``;
@@ -118,9 +129,7 @@ def solve(
     ``subcontacts_per_edge``; any other ``voussoir.Model`` keyword.
     """
     model = model if model is not None else problem.model
-    configured = getattr(problem, "_solver", None)
-    if analysis is None:
-        analysis = (configured.parameters.get("analysis") if configured is not None and configured.name == "voussoir" else None) or "static"
+    analysis = analysis or "static"
     if analysis not in ANALYSES:
         raise ValueError(f"analysis {analysis!r}: expected one of {ANALYSES}")
     conv = to_voussoir(
