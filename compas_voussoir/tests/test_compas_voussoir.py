@@ -191,6 +191,18 @@ def test_bad_problems_are_refused_with_what_is_missing():
         cv.solve(problem, analysis="quasi", density=2000.0)
     with pytest.raises(ValueError, match="live"):
         cv.solve(problem, analysis="limit", density=2000.0)
+    from compas.geometry import Box
+
+    boxes = [
+        Box.from_corner_corner_height([-1, -0.5, -0.2], [1, 0.5, -0.2], 0.2),
+        Box.from_corner_corner_height([-0.1, -0.1, 0.0], [0.1, 0.1, 0.0], 0.2),
+    ]
+    single = BlockModel.from_boxes(boxes)
+    single.add_support(0)
+    lonely = Problem(single)
+    lonely.set_contact_model("MohrCoulomb", phi=30.0)
+    with pytest.raises(ValueError, match="loading device"):
+        cv.solve(lonely, analysis="capacity", capacity={"block": 1, "direction": (1, 0, 0)}, density=2000.0)
 
 
 def test_self_weight_reactions_against_compas_cra():

@@ -118,11 +118,11 @@ def run(
       the push (default: the pushed axis prescribed, the others free));
       ``metadata["peak_load"]`` (N) and ``metadata["curve"]``. Push a loading device (a
       plate seated on the structure, as 3DEC and the laboratory do, and as the tests push the
-      reference arch's), not a block of the structure itself, and keep the increment small
-      against the joints' elastic slip ``μ N / (k_s A)``: a block driven along its own
-      frictional joint by increments comparable to that slip shows spikes in the load above
-      ``μ N`` (measured: a 0.2 m cube at φ 30°, kn 4 GPa/m, pushed by 2 µm increments peaks at
-      0.79 W while sliding at 0.577 W);
+      reference arch's): the servo advances only once the free blocks have settled (their
+      unbalanced-force ratio), and a block with a prescribed axis is not one of them, so a model
+      whose only moving block is the pushed one is refused (its samples would catch its joint
+      ringing: a 0.2 m cube pushed along its own joint at φ 30° peaked at 0.79 W while sliding
+      at 0.577 W);
     - ``"limit"``: limit analysis of the loads of the boundary conditions named ``live``
       (scaled by the multiplier) with the others and gravity as dead loads;
       ``metadata["multiplier"]``, ``["carries_dead_load"]``, ``["mechanism"]`` (block
@@ -240,6 +240,12 @@ def run(
             raise ValueError('analysis="capacity" needs capacity={"block": graph node, "direction": (x, y, z)}')
         c = dict(capacity)
         i = conv.index[c.pop("block")]
+        others = [j for j in range(len(m)) if j != i and not m.block(j).is_fixed]
+        if not others:
+            raise ValueError(
+                "capacity: the pushed block is the only one that moves; push a loading device (a plate seated on "
+                "the structure) so that the servo has free blocks to wait for"
+            )
         direction = np.asarray(c.pop("direction", (0.0, 0.0, -1.0)), dtype=float)
         fix = c.pop("fixity", None)
         if fix is None:
