@@ -58,3 +58,8 @@ def test_push_over_refuses_a_free_block_and_bad_settings():
         m.push_over(pusher, (1, 0, 0), 2e-6, stop_fraction=1.5)
     with pytest.raises(vs.VoussoirError, match="increment"):
         m.push_over(pusher, (1, 0, 0), -1.0)
+    # With the cube fixed, the pusher is the only block that moves: nothing for the servo to
+    # wait for.
+    m.set_fixity(cube, True)
+    with pytest.raises(vs.VoussoirError, match="without a free block"):
+        m.push_over(pusher, (1, 0, 0), 2e-6)

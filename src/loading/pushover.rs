@@ -161,7 +161,8 @@ impl PushOver {
     /// (and the model) as it is taken and may stop the run.
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for a bad setting; then as [`Servo::run`].
+    /// [`Error::InvalidParameter`] for a bad setting; [`Error::Unsupported`] for a model
+    /// without a free block (nothing for the servo to wait for); then as [`Servo::run`].
     pub fn run<L: ConstitutiveLaw>(
         &self,
         model: &mut Model<L>,
@@ -169,6 +170,18 @@ impl PushOver {
         mut on_sample: impl FnMut(&Model<L>, &PushOverSample) -> ControlFlow<()>,
     ) -> Result<PushOverResult> {
         self.check()?;
+        // The servo advances only from settled states, judged on the free blocks; with none,
+        // every state would count as settled and the samples would catch the joints ringing.
+        if !model.blocks().iter().any(|b| b.is_free()) {
+            return Err(Error::Unsupported {
+                what: format!(
+                    "push-over of block {} in a model without a free block: the servo waits for the free blocks to \
+                     settle; push a loading device (a plate seated on the structure) rather than the only block \
+                     that moves",
+                    self.servo.block
+                ),
+            });
+        }
         let block = self.servo.block;
         let start = model.block(block)?.state().pose.translation;
         let direction = self.servo.direction;
