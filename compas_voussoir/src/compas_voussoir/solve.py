@@ -43,7 +43,8 @@ def _apply_loads_and_motions(problem, model, conv, ramp_time):
         else:
             f, mo = kinds["instantaneous"]
             m.set_load(i, force=f, moment=mo)
-    for n, disp in resolve_centroidal_displacements(problem.boundary_conditions).items():
+    prescribed = resolve_centroidal_displacements(problem.boundary_conditions)
+    for n, disp in prescribed.items():
         i = conv.index[n]
         fixity = {"translation": ["free"] * 3, "rotation": ["free"] * 3}
         for key in ("translation", "rotation"):
@@ -51,12 +52,13 @@ def _apply_loads_and_motions(problem, model, conv, ramp_time):
                 if value is not None:
                     fixity[key][k] = float(value) / ramp_time
         m.set_fixity(i, fixity)
-    return [i for i in (conv.index[n] for n in resolve_centroidal_displacements(problem.boundary_conditions))]
+    return [conv.index[n] for n in prescribed]
 
 
 def _stop_prescribed(conv, blocks):
+    """Fixes the axes whose displacements were prescribed, once reached."""
+    m = conv.model
     for i in blocks:
-        m = conv.model
         f = m.block(i).fixity
         fixed = {key: ["fixed" if not isinstance(d, str) else d for d in f[key]] for key in ("translation", "rotation")}
         m.set_fixity(i, fixed)
