@@ -74,6 +74,19 @@ def reference_problem(phi=30.5):
     return model, plate, problem
 
 
+def block_on_support():
+    """A 0.2 m block (graph node 1) on a 2 × 1 m support (node 0)."""
+    from compas.geometry import Box
+
+    boxes = [
+        Box.from_corner_corner_height([-1, -0.5, -0.2], [1, 0.5, -0.2], 0.2),
+        Box.from_corner_corner_height([-0.1, -0.1, 0.0], [0.1, 0.1, 0.0], 0.2),
+    ]
+    model = BlockModel.from_boxes(boxes)
+    model.add_support(0)
+    return model
+
+
 # The plate moves in the arch's plane only (as in arch_static's limit analysis).
 PLATE_IN_PLANE = {"translation": ["free", "fixed", "free"], "rotation": ["fixed", "free", "fixed"]}
 
@@ -191,14 +204,7 @@ def test_bad_problems_are_refused_with_what_is_missing():
         cv.solve(problem, analysis="quasi", density=2000.0)
     with pytest.raises(ValueError, match="live"):
         cv.solve(problem, analysis="limit", density=2000.0)
-    from compas.geometry import Box
-
-    boxes = [
-        Box.from_corner_corner_height([-1, -0.5, -0.2], [1, 0.5, -0.2], 0.2),
-        Box.from_corner_corner_height([-0.1, -0.1, 0.0], [0.1, 0.1, 0.0], 0.2),
-    ]
-    single = BlockModel.from_boxes(boxes)
-    single.add_support(0)
+    single = block_on_support()
     lonely = Problem(single)
     lonely.set_contact_model("MohrCoulomb", phi=30.0)
     with pytest.raises(ValueError, match="loading device"):
@@ -260,14 +266,7 @@ def test_a_dynamic_run_slides_a_pushed_block_as_coulomb_says():
     """A 0.2 m block on a support (μ 0.2), pushed by an instantaneous 0.5 W from rest, undamped:
     it slides x = ½ (0.5 − μ) g t² (0.2 % measured: the shear springs' pre-slip and the
     weight's first bounce)."""
-    from compas.geometry import Box
-
-    boxes = [
-        Box.from_corner_corner_height([-1, -0.5, -0.2], [1, 0.5, -0.2], 0.2),
-        Box.from_corner_corner_height([-0.1, -0.1, 0.0], [0.1, 0.1, 0.0], 0.2),
-    ]
-    model = BlockModel.from_boxes(boxes)
-    model.add_support(0)
+    model = block_on_support()
     problem = Problem(model)
     problem.set_contact_model("MohrCoulomb", mu=0.2)
     push = problem.add_boundary_condition("Push")
@@ -284,14 +283,7 @@ def test_a_prescribed_translation_is_reached():
     """compas_dem's prescribed displacement of a block (2 mm along x), reached at a constant rate
     over ramp_time and then held: the block ends 2 mm along (measured −0.12 %, one step at the
     prescribed velocity; asserted 1 %), its other axes free (it stays on its support)."""
-    from compas.geometry import Box
-
-    boxes = [
-        Box.from_corner_corner_height([-1, -0.5, -0.2], [1, 0.5, -0.2], 0.2),
-        Box.from_corner_corner_height([-0.1, -0.1, 0.0], [0.1, 0.1, 0.0], 0.2),
-    ]
-    model = BlockModel.from_boxes(boxes)
-    model.add_support(0)
+    model = block_on_support()
     problem = Problem(model)
     problem.set_contact_model("MohrCoulomb", phi=30.0)
     move = problem.add_boundary_condition("Move")
