@@ -9,7 +9,8 @@
 //! settles with local damping; then the damping is switched off and gravity is turned by
 //! `--tilt-deg` about the wall's length, as a tilting table does, and the wall is followed for
 //! `--seconds`: it leans, its stones rock on their edges and corners, and beyond about the wall's
-//! slenderness angle it falls. Writes a ParaView series (`rubble_wall.pvd`) and prints the energy
+//! slenderness angle it falls. Writes a ParaView series (`rubble_wall_blocks.pvd`), a viewer
+//! (`rubble_wall.html`, open it in a browser) and prints the energy
 //! balance (input against kinetic + elastic + friction + damping) and the time per step.
 
 #[path = "common/args.rs"]
@@ -21,6 +22,7 @@ use std::time::Instant;
 
 use clap::Parser;
 use voussoir::build::{rubble_wall, RubbleWallSpec};
+use voussoir::io::viewer::Viewer;
 use voussoir::io::vtk::Series;
 use voussoir::prelude::*;
 
@@ -64,7 +66,11 @@ fn main() {
 
 fn run() -> Result<()> {
     let options = Options::parse();
-    args::prepare_output_dir(&options.out, &["rubble_wall"], &["rubble_wall.pvd".to_owned()])?;
+    args::prepare_output_dir(
+        &options.out,
+        &["rubble_wall"],
+        &["rubble_wall_blocks.pvd".to_owned(), "rubble_wall.html".to_owned()],
+    )?;
     let spec = RubbleWallSpec {
         stone_size: options.stone_size,
         ..RubbleWallSpec::default()
@@ -108,7 +114,9 @@ fn run() -> Result<()> {
     })?;
     let before = model.energies();
     let mut series = Series::new(&options.out, "rubble_wall");
+    let mut viewer = Viewer::new("rubble wall on a tilting table").with_time_from_first_frame();
     series.write_frame(&model)?;
+    viewer.record(&model)?;
     let (t0, frames) = (model.time(), 30);
     let mut next = 1;
     let moving = Instant::now();
@@ -117,10 +125,12 @@ fn run() -> Result<()> {
         model.step()?;
         if model.time() >= t0 + options.seconds * next as f64 / frames as f64 {
             series.write_frame(&model)?;
+            viewer.record(&model)?;
             next += 1;
         }
     }
     let moving_steps = model.step_count() - steps_before;
+    viewer.write(&options.out.join("rubble_wall.html"))?;
     let per_step = moving.elapsed().as_secs_f64() / moving_steps as f64;
     let e = model.energies();
     let input = e.input() - before.input();
@@ -144,8 +154,9 @@ fn run() -> Result<()> {
         100.0 * (accounted - input) / input.abs().max(f64::MIN_POSITIVE)
     );
     println!(
-        "ParaView series in {} ({:.1} s wall in all)",
-        options.out.join("rubble_wall.pvd").display(),
+        "viewer {} (open in a browser); ParaView series in {} ({:.1} s wall in all)",
+        options.out.join("rubble_wall.html").display(),
+        options.out.join("rubble_wall_blocks.pvd").display(),
         started.elapsed().as_secs_f64()
     );
     Ok(())

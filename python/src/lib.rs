@@ -16,6 +16,7 @@ mod model;
 mod motion;
 mod scenarios;
 mod series;
+mod viewer;
 
 use pyo3::prelude::*;
 
@@ -30,6 +31,7 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<blocks::PyBlock>()?;
     m.add_class::<model::PyModel>()?;
     m.add_class::<series::PySeries>()?;
+    m.add_class::<viewer::PyViewer>()?;
     m.add_class::<motion::PyTimeHistory>()?;
     m.add_function(wrap_pyfunction!(blocks::arch, m)?)?;
     m.add_function(wrap_pyfunction!(blocks::running_bond_wall, m)?)?;

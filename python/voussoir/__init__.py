@@ -2,7 +2,7 @@
 
 The Python face of the Rust library of the same name (PyO3): build models from blocks and
 generators, run them (the GIL released; Ctrl-C and a progress callback between steps), read the
-results as numpy arrays, write ParaView and CSV files, save and load scenes and checkpoints, and
+results as numpy arrays, write ParaView and CSV files and self-contained HTML viewers of a run (``Viewer``), save and load scenes and checkpoints, and
 run the reference arch's benchmarks (``voussoir.scenarios``), and find collapse loads by
 limit analysis (``voussoir.limit``).
 
@@ -17,6 +17,7 @@ from ._voussoir import (
     Model,
     ParaviewSeries,
     TimeHistory,
+    Viewer,
     VoussoirError,
     VoussoirIOError,
     __version__,
@@ -34,6 +35,7 @@ __all__ = [
     "Model",
     "ParaviewSeries",
     "TimeHistory",
+    "Viewer",
     "VoussoirError",
     "VoussoirIOError",
     "__version__",

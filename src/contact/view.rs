@@ -247,6 +247,20 @@ impl<'a, S> ContactView<'a, S> {
             cells: self.cells,
         })
     }
+    /// The centre of the sub-contacts' normal forces (m, world; each force where it acts within
+    /// its cell): where the resultant gives the contact's moment about any axis in the joint
+    /// plane. `None` for a contact that carries no compression.
+    pub fn application_point(&self) -> Option<Vector> {
+        let (mut total, mut moment) = (0.0, Vector::ZERO);
+        for s in self.subcontacts() {
+            let n = s.normal_force();
+            if n > 0.0 {
+                total += n;
+                moment += s.normal_force_point() * n;
+            }
+        }
+        (total > 0.0).then(|| moment / total)
+    }
     /// World positions of the sub-contacts, in order (m).
     pub fn points(&self) -> impl ExactSizeIterator<Item = Vector> + 'a {
         self.subcontacts().map(|s| s.point())

@@ -1,11 +1,12 @@
-//! Outputs users expect: ParaView series ([`vtk`]), CSV histories ([`csv`]) and scene files
-//! ([`scene`]). Checkpoints are methods of [`crate::Model`] (`save_checkpoint`,
+//! Outputs users expect: ParaView series ([`vtk`]), a self-contained HTML viewer of a run
+//! ([`viewer`]), CSV histories ([`csv`]) and scene files ([`scene`]). Checkpoints are methods of [`crate::Model`] (`save_checkpoint`,
 //! `load_checkpoint`).
 //!
 //! Needs the `io` feature (on by default), which turns on `serde`.
 
 pub mod csv;
 pub mod scene;
+pub mod viewer;
 pub mod vtk;
 
 use std::path::Path;

@@ -14,8 +14,10 @@
 //! (drop-height perturbations, default `-0.5,-0.25,0,0.25,0.5`), `--out DIR`, `--study`,
 //! `--compare-release`, `--paraview-setups NAME[,NAME]|all`, `--no-paraview`. Writes
 //! `summary.json`, one history CSV per setup (with the energy terms), `displacement_time.svg`,
-//! `max_disp_vs_experiment.svg`, the ParaView series of M60H20's central run (blocks every 10 ms,
-//! sub-contacts every 50 ms: about 15 MB; every setup's with `--paraview-setups all`), and
+//! `max_disp_vs_experiment.svg`, the viewer `M60H20.html` of M60H20's central run (open it in a
+//! browser: the blocks played over time, contacts and forces on demand) and its ParaView series
+//! (blocks every 10 ms, sub-contacts every 50 ms: about 15 MB; every setup's with
+//! `--paraview-setups all`), and
 //! `sensitivity.svg` with `--study`, under `out/arch_impact/`. The ranges of the
 //! numbers (`--help`; [`DAMPING_RANGE`], [`DURATION_RANGE`], ...) are checked when parsed, and a
 //! setup or an offset given twice is refused.

@@ -15,7 +15,8 @@
 //! mechanism in `summary.json` and the table, the second curve of `capacity_vs_friction.svg`).
 //!
 //! Writes `summary.json`, `force_displacement.csv`, `force_displacement.svg`,
-//! `capacity_vs_friction.svg` and a ParaView series of the baseline under `out/arch_static/`.
+//! `capacity_vs_friction.svg`, a viewer of the baseline (`baseline.html`) and its ParaView series
+//! under `out/arch_static/`.
 
 use std::ops::Bound::{Excluded, Included};
 

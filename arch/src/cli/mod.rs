@@ -27,6 +27,7 @@ use std::time::Instant;
 use clap::{Args, CommandFactory, FromArgMatches, Parser};
 use rayon::prelude::*;
 use serde::Serialize;
+use voussoir::io::viewer::Viewer;
 use voussoir::io::{vtk, write_json};
 use voussoir::Model;
 
@@ -215,10 +216,12 @@ impl Outputs {
     }
 
     /// [`Outputs::with_frames`] with the sub-contacts written on every `subcontacts_every`-th
-    /// frame only ([`vtk::Series::with_subcontacts_every`]).
+    /// frame only ([`vtk::Series::with_subcontacts_every`]). The same frames go into a viewer,
+    /// `<out>/<name>.html` ([`Viewer`]: open it in a browser), written also with
+    /// `--no-paraview`, and also when the run fails (with the frames up to the failure).
     ///
     /// # Errors
-    /// `run`'s.
+    /// `run`'s; [`voussoir::Error::Io`] if the viewer cannot be written.
     pub fn with_frames_and_subcontacts<T>(
         &self,
         name: Option<&str>,
@@ -226,18 +229,36 @@ impl Outputs {
         subcontacts_every: usize,
         run: impl FnOnce(Option<f64>, &mut (dyn FnMut(&Model) -> voussoir::Result<()> + Send)) -> voussoir::Result<T>,
     ) -> voussoir::Result<T> {
-        match name.filter(|_| self.paraview) {
-            Some(name) => {
-                // Times from the first frame: a drop's from its release, a push's from its
-                // start, as the histories and plots count them (not the model's, which include
-                // the settling).
-                let mut series = vtk::Series::new(self.dir.join("paraview"), name)
-                    .with_subcontacts_every(subcontacts_every)
-                    .with_time_from_first_frame();
-                run(Some(every), &mut |m| series.write_frame(m))
+        let Some(name) = name else {
+            return run(None, &mut |_| Ok(()));
+        };
+        // Times from the first frame: a drop's from its release, a push's from its start, as
+        // the histories and plots count them (not the model's, which include the settling).
+        let mut series = self.paraview.then(|| {
+            vtk::Series::new(self.dir.join("paraview"), name)
+                .with_subcontacts_every(subcontacts_every)
+                .with_time_from_first_frame()
+        });
+        let mut viewer = Viewer::new(name).with_time_from_first_frame();
+        let result = run(Some(every), &mut |m| {
+            if let Some(series) = &mut series {
+                series.write_frame(m)?;
             }
-            None => run(None, &mut |_| Ok(())),
-        }
+            viewer.record(m)
+        });
+        let written = if viewer.is_empty() {
+            Ok(())
+        } else {
+            viewer.write(&self.viewer_path(name))
+        };
+        let value = result?;
+        written?;
+        Ok(value)
+    }
+
+    /// Where the viewer of the series `name` goes.
+    pub fn viewer_path(&self, name: &str) -> PathBuf {
+        self.dir.join(format!("{name}.html"))
     }
 
     /// Writes `value` as pretty JSON to `file` in the output folder.

@@ -59,6 +59,11 @@ pub(crate) struct Inner {
 }
 
 impl Inner {
+    /// The monitors added with `add_monitor`, in order.
+    pub(crate) fn monitors(&self) -> &[(String, voussoir::monitor::Monitor)] {
+        &self.samples.monitors
+    }
+
     /// The block of index `block` (`VoussoirError` naming the argument `what` when out of range).
     fn id(&self, block: &Int, what: &str) -> PyResult<BlockId> {
         block.block(what, self.model.blocks().len())

@@ -214,21 +214,8 @@ impl PyModel {
             "application_point",
             array_n3(
                 py,
-                cs.iter().map(|c| {
-                    let (mut total, mut moment) = (0.0, voussoir::math::Vector::ZERO);
-                    for s in c.subcontacts() {
-                        let n = s.normal_force();
-                        if n > 0.0 {
-                            total += n;
-                            moment += s.normal_force_point() * n;
-                        }
-                    }
-                    if total > 0.0 {
-                        moment / total
-                    } else {
-                        voussoir::math::Vector::splat(f64::NAN)
-                    }
-                }),
+                cs.iter()
+                    .map(|c| c.application_point().unwrap_or(voussoir::math::Vector::splat(f64::NAN))),
             ),
         )?;
         let axes: Vec<_> = cs.iter().map(|c| c.axes()).collect();
