@@ -1,5 +1,6 @@
-//! SVG line plots (plotters, SVG backend only: no system font libraries): several series, axis
-//! labels with units, a legend and optional reference markers such as an experiment's value.
+//! Line plots as SVG and PNG (plotters; text set in the DejaVu Sans subset of `assets/`, so no
+//! system font libraries): several series, axis labels with units, a legend and optional
+//! reference markers such as an experiment's value.
 
 use std::path::Path;
 
@@ -105,6 +106,28 @@ const SIZE: (u32, u32) = (800, 560);
 /// Non-finite points and references are skipped.
 pub const COORDINATE_LIMIT: f64 = 1e300;
 
+/// DejaVu Sans, subset to Latin-1, Greek, punctuation, super- and subscripts, arrows and
+/// mathematical operators (`assets/LICENSE-DejaVu.txt`).
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans-subset.ttf");
+
+/// Gives plotters the font for "sans-serif" in every style (once): the PNG backend draws its
+/// glyphs, and both backends measure text with it (legend boxes, label areas).
+fn register_fonts() {
+    static DONE: std::sync::Once = std::sync::Once::new();
+    DONE.call_once(|| {
+        for style in [
+            FontStyle::Normal,
+            FontStyle::Bold,
+            FontStyle::Italic,
+            FontStyle::Oblique,
+        ] {
+            // The font is checked by the tests (`png_plots_have_text`); should it ever fail to
+            // load, text would be missing, which the tests see.
+            let _ = plotters::style::register_font("sans-serif", style, FONT);
+        }
+    });
+}
+
 fn clamp(v: f64) -> f64 {
     v.clamp(-COORDINATE_LIMIT, COORDINATE_LIMIT)
 }
@@ -148,6 +171,7 @@ impl LinePlot {
     pub fn to_svg_string(&self) -> Result<String> {
         let mut svg = String::new();
         {
+            register_fonts();
             let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
             self.draw(root).map_err(|e| Error::Io {
                 path: "(svg)".into(),
@@ -164,6 +188,43 @@ impl LinePlot {
     pub fn write_svg(&self, path: &Path) -> Result<()> {
         let svg = self.to_svg_string()?;
         voussoir::io::write_atomically(path, svg.as_bytes())
+    }
+
+    /// Renders the plot as a PNG image (800 × 560 pixels, RGB), as total over any input as
+    /// [`LinePlot::to_svg_string`].
+    ///
+    /// # Errors
+    /// [`Error::Io`] if plotters fails to draw or the image cannot be encoded.
+    pub fn to_png_bytes(&self) -> Result<Vec<u8>> {
+        let fail = |e: String| Error::Io {
+            path: "(png)".into(),
+            message: format!("plot {:?}: {e}", self.title),
+        };
+        let (w, h) = SIZE;
+        let mut pixels = vec![0u8; 3 * w as usize * h as usize];
+        {
+            register_fonts();
+            let root = BitMapBackend::with_buffer(&mut pixels, SIZE).into_drawing_area();
+            self.draw(root).map_err(fail)?;
+        }
+        let mut png = Vec::new();
+        let mut encoder = png::Encoder::new(&mut png, w, h);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder
+            .write_header()
+            .and_then(|mut writer| writer.write_image_data(&pixels))
+            .map_err(|e| fail(e.to_string()))?;
+        Ok(png)
+    }
+
+    /// Writes the plot to a PNG file (atomically), creating its folder.
+    ///
+    /// # Errors
+    /// [`Error::Io`] naming the file.
+    pub fn write_png(&self, path: &Path) -> Result<()> {
+        let png = self.to_png_bytes()?;
+        voussoir::io::write_atomically(path, &png)
     }
 
     /// The axis ranges: every finite curve point and reference, each coordinate clamped to
@@ -369,6 +430,47 @@ impl LinePlot {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A PNG plot is a picture of the plot: its size, a white background, the first curve's
+    /// colour, and text (the title's dark pixels), with labels beyond ASCII (φ, °, ², –).
+    #[test]
+    fn png_plots_have_text() {
+        let plot = LinePlot {
+            title: "capacity – φ 35°, kn 4 GPa/m²".into(),
+            x_label: "φ (°)".into(),
+            y_label: "P (kN)".into(),
+            curves: vec![curve(vec![(0.0, 0.0), (1.0, 1.0), (2.0, 0.5)])],
+            ..Default::default()
+        };
+        let bytes = plot.to_png_bytes().expect("renders");
+        let mut reader = png::Decoder::new(std::io::Cursor::new(bytes))
+            .read_info()
+            .expect("a PNG");
+        let mut pixels = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut pixels).expect("decodes");
+        assert_eq!((info.width, info.height), SIZE);
+        let rgb = |x: usize, y: usize| {
+            let i = 3 * (y * info.width as usize + x);
+            (pixels[i], pixels[i + 1], pixels[i + 2])
+        };
+        assert_eq!(rgb(2, 2), (255, 255, 255), "white background");
+        let dark = |y0: usize, y1: usize| {
+            (y0..y1)
+                .flat_map(|y| (0..info.width as usize).map(move |x| (x, y)))
+                .filter(|&(x, y)| {
+                    let (r, g, b) = rgb(x, y);
+                    u16::from(r) + u16::from(g) + u16::from(b) < 200
+                })
+                .count()
+        };
+        assert!(dark(0, 40) > 200, "the title is set: {} dark pixels", dark(0, 40));
+        let c = CURVE_COLORS[0];
+        let curve_pixels = (0..info.height as usize)
+            .flat_map(|y| (0..info.width as usize).map(move |x| (x, y)))
+            .filter(|&(x, y)| rgb(x, y) == (c.0, c.1, c.2))
+            .count();
+        assert!(curve_pixels > 300, "the curve is drawn: {curve_pixels} pixels");
+    }
 
     /// The impact benchmark's plot: three test markers rising to the upper right, model curves
     /// low. The legend must not go to the upper right, where it would hide the M60H30 marker.

@@ -13,12 +13,12 @@
 //! `--guide frame|seat`, `--base sloped|flat`, `--release above|full`, `--offsets MM[,MM]`
 //! (drop-height perturbations, default `-0.5,-0.25,0,0.25,0.5`), `--out DIR`, `--study`,
 //! `--compare-release`, `--paraview-setups NAME[,NAME]|all`, `--no-paraview`. Writes
-//! `summary.json`, one history CSV per setup (with the energy terms), `displacement_time.svg`,
-//! `max_disp_vs_experiment.svg`, the viewer `M60H20.html` of M60H20's central run (open it in a
+//! `summary.json`, one history CSV per setup (with the energy terms), `displacement_time.svg`
+//! and `max_disp_vs_experiment.svg` (and as PNG), the viewer `M60H20.html` of M60H20's central run (open it in a
 //! browser: the blocks played over time, contacts and forces on demand) and its ParaView series
 //! (blocks every 10 ms, sub-contacts every 50 ms: about 15 MB; every setup's with
 //! `--paraview-setups all`), and
-//! `sensitivity.svg` with `--study`, under `out/arch_impact/`. The ranges of the
+//! `sensitivity.svg` (and `.png`) with `--study`, under `out/arch_impact/`. The ranges of the
 //! numbers (`--help`; [`DAMPING_RANGE`], [`DURATION_RANGE`], ...) are checked when parsed, and a
 //! setup or an offset given twice is refused.
 
@@ -227,12 +227,14 @@ impl Run for ImpactOptions {
             "summary.json",
             "tables.md",
             "displacement_time.svg",
+            "displacement_time.png",
             "max_disp_vs_experiment.svg",
+            "max_disp_vs_experiment.png",
         ]
         .map(String::from)
         .into();
         if self.study {
-            files.push("sensitivity.svg".into());
+            files.extend(["sensitivity.svg".into(), "sensitivity.png".into()]);
         }
         // The unknown setups that `groups` refuses are refused by the parser first.
         if let Ok(groups) = groups(self) {
@@ -814,7 +816,7 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
         references: Vec::new(),
         legend: LegendPosition::Auto,
     };
-    out.svg("displacement_time.svg", &displacement_time)?;
+    out.plot("displacement_time", &displacement_time)?;
     let standing: Vec<&&Outcome> = main
         .iter()
         .filter(|x| x.central.case.setup.max_disp.is_some())
@@ -846,7 +848,7 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
         references: refs,
         legend: LegendPosition::Auto,
     };
-    out.svg("max_disp_vs_experiment.svg", &max_disp)?;
+    out.plot("max_disp_vs_experiment", &max_disp)?;
     if o.study {
         let mut curves = Vec::new();
         for s in ["M60H20", "M60H25", "M60H30"] {
@@ -877,7 +879,7 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
             references: Vec::new(),
             legend: LegendPosition::Auto,
         };
-        out.svg("sensitivity.svg", &sensitivity)?;
+        out.plot("sensitivity", &sensitivity)?;
     }
     Ok(())
 }

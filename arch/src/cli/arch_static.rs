@@ -15,7 +15,7 @@
 //! mechanism in `summary.json` and the table, the second curve of `capacity_vs_friction.svg`).
 //!
 //! Writes `summary.json`, `force_displacement.csv`, `force_displacement.svg`,
-//! `capacity_vs_friction.svg`, a viewer of the baseline (`baseline.html`) and its ParaView series
+//! `capacity_vs_friction.svg` (both also as PNG), a viewer of the baseline (`baseline.html`) and its ParaView series
 //! under `out/arch_static/`.
 
 use std::ops::Bound::{Excluded, Included};
@@ -119,7 +119,9 @@ and the paper's parameter studies, in parallel";
             "summary.json",
             "force_displacement.csv",
             "force_displacement.svg",
+            "force_displacement.png",
             "capacity_vs_friction.svg",
+            "capacity_vs_friction.png",
         ]
         .map(String::from)
         .into()
@@ -477,7 +479,7 @@ limit: rigid-block limit analysis of the settled arch, associative Coulomb joint
         }],
         ..Default::default()
     };
-    out.svg("force_displacement.svg", &force_displacement)?;
+    out.plot("force_displacement", &force_displacement)?;
     let mut sweep: Vec<(f64, f64, f64)> = results
         .iter()
         .filter(|r| r.case.label == "baseline" || r.case.label.starts_with("friction"))
@@ -505,7 +507,7 @@ limit: rigid-block limit analysis of the settled arch, associative Coulomb joint
         }],
         ..Default::default()
     };
-    out.svg("capacity_vs_friction.svg", &capacity)?;
+    out.plot("capacity_vs_friction", &capacity)?;
     // The convergence check, after every output is written.
     let unconverged: Vec<String> = runs
         .iter()

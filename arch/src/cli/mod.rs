@@ -277,12 +277,13 @@ impl Outputs {
         args::write_text(&self.dir.join(file), text)
     }
 
-    /// Writes `plot` as SVG to `file` in the output folder.
+    /// Writes `plot` as `<stem>.svg` and `<stem>.png` in the output folder.
     ///
     /// # Errors
     /// [`voussoir::Error::Io`] naming the file.
-    pub fn svg(&self, file: &str, plot: &LinePlot) -> voussoir::Result<()> {
-        plot.write_svg(&self.dir.join(file))
+    pub fn plot(&self, stem: &str, plot: &LinePlot) -> voussoir::Result<()> {
+        plot.write_svg(&self.dir.join(format!("{stem}.svg")))?;
+        plot.write_png(&self.dir.join(format!("{stem}.png")))
     }
 }
 
