@@ -23,7 +23,10 @@ fn floats(text: &serde_json::Value) -> Vec<f32> {
     let bytes = base64::engine::general_purpose::STANDARD
         .decode(text.as_str().expect("base64 text"))
         .expect("base64");
-    bytes.chunks(4).map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes"))).collect()
+    bytes
+        .chunks(4)
+        .map(|c| f32::from_le_bytes(c.try_into().expect("4 bytes")))
+        .collect()
 }
 
 /// A cube dropped 1 cm onto a slab, recorded every 200 steps.
@@ -80,9 +83,15 @@ fn the_page_carries_every_frame_pose_field_contact_and_curve() -> Result<()> {
     let shown = floats(&last["fields"]["displacement"]);
     let curves = d["curves"].as_array().expect("curves");
     let names: Vec<&str> = curves.iter().map(|c| c["name"].as_str().expect("name")).collect();
-    assert_eq!(names, ["largest displacement", "kinetic energy", "cube height", "a line"]);
+    assert_eq!(
+        names,
+        ["largest displacement", "kinetic energy", "cube height", "a line"]
+    );
     let height = curves[2]["y"][5].as_f64().expect("sampled");
-    assert!((f64::from(shown[1]) - height.abs()).abs() < 1e-6, "{shown:?} vs {height}");
+    assert!(
+        (f64::from(shown[1]) - height.abs()).abs() < 1e-6,
+        "{shown:?} vs {height}"
+    );
     assert_eq!(f64::from(shown[0]), 0.0, "the slab does not move");
     // The cube fell 1 cm and rests on the slab: the frames show it.
     assert!((height + 0.01).abs() < 5e-4, "cube height change {height}");
@@ -91,7 +100,10 @@ fn the_page_carries_every_frame_pose_field_contact_and_curve() -> Result<()> {
     assert_eq!(c["count"], 1);
     let force = floats(&c["force"]);
     let weight = common::STONE_DENSITY * common::CUBE_EDGE.powi(3) * 9.81;
-    assert!((f64::from(force[2]).abs() - weight).abs() < 0.02 * weight, "{force:?} vs {weight}");
+    assert!(
+        (f64::from(force[2]).abs() - weight).abs() < 0.02 * weight,
+        "{force:?} vs {weight}"
+    );
     let polygon = floats(&c["polygon"]);
     assert_eq!(polygon.len(), 12, "four corners");
     // A NaN in a curve is null (a gap), not invalid JSON.
@@ -135,7 +147,9 @@ fn a_large_model_can_be_recorded_without_contacts() -> Result<()> {
     let dir = std::env::temp_dir().join(format!("voussoir-viewer-{}", std::process::id()));
     let path = dir.join("sub").join("cube.html");
     viewer.write(&path)?;
-    assert!(std::fs::read_to_string(&path).expect("written").starts_with("<!DOCTYPE html>"));
+    assert!(std::fs::read_to_string(&path)
+        .expect("written")
+        .starts_with("<!DOCTYPE html>"));
     std::fs::remove_dir_all(&dir).expect("cleaned up");
     Ok(())
 }

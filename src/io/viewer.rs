@@ -182,7 +182,14 @@ impl Viewer {
     /// # Errors
     /// [`Error::InvalidName`] if a monitor or curve of this name exists already;
     /// [`Error::Unsupported`] if `x` and `y` differ in length.
-    pub fn add_curve(&mut self, name: &str, (x_label, y_label): (&str, &str), x: &[f64], y: &[f64], time_axis: bool) -> Result<()> {
+    pub fn add_curve(
+        &mut self,
+        name: &str,
+        (x_label, y_label): (&str, &str),
+        x: &[f64],
+        y: &[f64],
+        time_axis: bool,
+    ) -> Result<()> {
         self.check_new_name(name)?;
         if x.len() != y.len() {
             return Err(Error::Unsupported {
@@ -252,7 +259,11 @@ impl Viewer {
         }
         let n = blocks.len();
         let mut frame = Frame {
-            time: if self.from_first_frame { model.time() - self.origin } else { model.time() },
+            time: if self.from_first_frame {
+                model.time() - self.origin
+            } else {
+                model.time()
+            },
             step: model.step_count(),
             kinetic: Monitor::Energy(EnergyTerm::Kinetic).evaluate(model),
             pose: Vec::with_capacity(7 * n),
@@ -286,7 +297,8 @@ impl Viewer {
                 for p in &polygon {
                     c.polygon.extend(p.to_array().map(|v| v as f32));
                 }
-                c.polygon_offset.push(index(c.polygon.len() / 3, "contact polygon corners")?);
+                c.polygon_offset
+                    .push(index(c.polygon.len() / 3, "contact polygon corners")?);
             }
             frame.contacts = Some(c);
         }
@@ -389,7 +401,11 @@ impl Viewer {
                 c => title.push(c),
             }
         }
-        let page = TEMPLATE.replacen("<title>voussoir</title>", &format!("<title>{title} — voussoir</title>"), 1);
+        let page = TEMPLATE.replacen(
+            "<title>voussoir</title>",
+            &format!("<title>{title} — voussoir</title>"),
+            1,
+        );
         Ok(page.replacen(DATA_MARK, &json, 1))
     }
 
@@ -433,7 +449,11 @@ impl Shapes {
             }
             s.face_offset.push(index(s.loop_offset.len() - 1, "faces")?);
             let fixity = b.fixity();
-            let all = fixity.translation.iter().chain(&fixity.rotation).all(|d| d.prescribed().is_some());
+            let all = fixity
+                .translation
+                .iter()
+                .chain(&fixity.rotation)
+                .all(|d| d.prescribed().is_some());
             s.fixed.push(u8::from(all));
         }
         let g = model.parameters().gravity;
