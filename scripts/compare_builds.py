@@ -28,6 +28,13 @@ Scenes:
   take minutes).
 A scene a build does not have (``shaking_wall`` came after e9fb418) is reported as n/a.
 
+With ``--instructions`` it counts instead of timing: each build runs once per scene and size
+under ``valgrind --tool=callgrind`` on one thread, to the end of the warm-up and to the end of
+the timed steps, and the difference of the two instruction counts per timed step is printed
+with the ratio. The count is the same for the same binary and input whatever else the machine
+does (one thread: no work-stealing), so it resolves changes of a few per cent that the wall
+clock here does not; it does not see memory stalls, which the timed runs do.
+
 Each run's first step is timed on its own (``Model::step`` once, after the wall is built): the
 full detection of every contact, the issue's "first step".
 """
@@ -186,6 +193,26 @@ def measure(binary, scene, blocks, threads):
     return json.loads(out.strip().splitlines()[-1])
 
 
+def instructions(binary, scene, blocks, work):
+    """Instructions per timed step of `scene` (callgrind, one thread): the count to the end of
+    the timed steps minus the count to the end of the warm-up, per timed step."""
+    warmup, steps = SCENES[scene]
+    counts = []
+    for n in (0, steps):
+        out = os.path.join(work, f"callgrind.out.{os.getpid()}")
+        run(
+            ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", "--dump-instr=no",
+             binary, scene, str(blocks), str(warmup), str(n)],
+            capture_output=True,
+            env={**os.environ, "RAYON_NUM_THREADS": "1"},
+        )
+        with open(out, encoding="utf-8") as f:
+            total = sum(int(line.split()[1]) for line in f if line.startswith(("summary:", "totals:")))
+        os.remove(out)
+        counts.append(total)
+    return (counts[1] - counts[0]) / steps
+
+
 def summary(values, scale, fmt):
     med = statistics.median(values)
     return f"{fmt.format(med * scale)} ({fmt.format(min(values) * scale)}-{fmt.format(max(values) * scale)})"
@@ -204,6 +231,7 @@ def main():
     ap.add_argument("--rounds", type=int, default=5, help="runs of each build per scene and size")
     ap.add_argument("--threads", type=int, default=2, help="RAYON_NUM_THREADS of the runs")
     ap.add_argument("--json", help="also write the raw runs to this file")
+    ap.add_argument("--instructions", action="store_true", help="count instructions per step (callgrind) instead of timing")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")]
     scenes = a.scenes.split(",")
@@ -222,6 +250,21 @@ def main():
         "base": build(f"base-{base_commit}", base_tree, work, "target-base"),
         "new": build("working-tree", ROOT, work, "target-new"),
     }
+
+    if a.instructions:
+        print()
+        print(f"base {base_commit} against the working tree; instructions per step (callgrind, 1 thread)")
+        print()
+        print("| scene | blocks | base instructions/step | new instructions/step | ratio |")
+        print("|---|---|---|---|---|")
+        for scene in scenes:
+            for blocks in sizes:
+                if not all(shake for _, shake in binaries.values()) and scene != "rest":
+                    continue
+                base = instructions(binaries["base"][0], scene, blocks, work)
+                new = instructions(binaries["new"][0], scene, blocks, work)
+                print(f"| {scene} | {blocks} | {base / 1e6:.2f} M | {new / 1e6:.2f} M | {new / base:.4f} |", flush=True)
+        return
 
     raw = []
     rows = []
