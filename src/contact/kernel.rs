@@ -6,7 +6,9 @@ use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, 
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
 use super::spread::{cell_response, CellResponse};
-use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
+use super::{
+    CellSummary, ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord,
+};
 use crate::block::BlockState;
 use crate::law::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
 use crate::math::{Matrix, Pose, Real, Vector, Vector2};
@@ -165,8 +167,21 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
         (sums, dissipated, spread_energy) = match face_gap_coefficients {
-            Some(g) => update_elastic_first(subs, law, &regime, &kinematics, Some(g), exact, axes, dt),
-            None => update_elastic_first(subs, law, &regime, &kinematics, None, None, axes, dt),
+            Some(g) => {
+                let whole = WholeContact::of(g, &pair.cells);
+                update_elastic_first(subs, law, &regime, &kinematics, Some(g), exact, whole, axes, dt)
+            }
+            None => update_elastic_first(
+                subs,
+                law,
+                &regime,
+                &kinematics,
+                None,
+                None,
+                WholeContact::Mixed,
+                axes,
+                dt,
+            ),
         };
         done = subs.len();
     } else if !dashpots {
@@ -320,6 +335,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     kinematics: &Kinematics,
     face: Option<(Real, Real, Real)>,
     exact: Option<ExactCells>,
+    whole: WholeContact<'_>,
     axes: JointAxes,
     dt: Real,
 ) -> (ForceMoments, Real, Real) {
@@ -329,7 +345,71 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     let mut spread_energy = 0.0;
     // `Σ J_xx`, `Σ J_yy` of the all-closed cells in the elastic regime, for their spread energy.
     let mut closed_moments = Vector2::ZERO;
-    for sub in subs.iter_mut() {
+    // Two kinds of contact take a shorter way through their cells, doing the operations of the
+    // loop below for such cells, in its order (the same bits); at the first cell that does not
+    // fit, the loop below takes over from it.
+    // - All closed (a joint at rest): each virgin cell's force is the law's elastic step at its
+    //   anchor gap, with no test of the cell; the loop below then starts with the `Σ J` of the
+    //   cells before it.
+    // - All open (a head joint): each virgin cell that was open and unloaded, and that the law
+    //   keeps open, only takes its smallest gap.
+    let mut start = 0;
+    if let (Some(g), Some(e), WholeContact::Open) = (face, exact, whole) {
+        if e.virgin_without_tension {
+            for sub in subs.iter_mut() {
+                if sub.state != virgin
+                    || sub.status != JointStatus::Open
+                    || sub.force.normal != 0.0
+                    || sub.force.shear != Vector2::ZERO
+                {
+                    break;
+                }
+                let anchor_gap = face_gap(g, sub.plane.x, sub.plane.y);
+                let half = sub.half();
+                let spread = e.slope.x.abs() * half.x + e.slope.y.abs() * half.y;
+                let gap = anchor_gap - spread;
+                // Open over the whole cell: its law gap is its smallest, its force nothing.
+                if !(anchor_gap >= spread && gap > 0.0) || !law.stays_open(sub.area, gap, &sub.state) {
+                    break;
+                }
+                sub.gap = gap;
+                start += 1;
+            }
+        }
+    }
+    if let (Some(g), Some(e), WholeContact::Closed(cells)) = (face, exact, whole) {
+        if e.virgin_without_tension {
+            for sub in subs.iter_mut() {
+                if sub.state != virgin {
+                    break;
+                }
+                let (x, y) = (sub.plane.x, sub.plane.y);
+                let [_, du_1, du_2] = increment(kinematics, x, y);
+                let gap = face_gap(g, x, y);
+                let du_s = Vector2::new(du_1, du_2);
+                let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) else {
+                    break;
+                };
+                if status == JointStatus::Sliding {
+                    dissipated += slide_dissipation(regime, sub, &force, du_s);
+                    sub.slip += du_s.length();
+                }
+                sub.force = force;
+                sub.gap = gap;
+                sub.status = status;
+                sums.add_joint(&force, sub.plane);
+                start += 1;
+            }
+            closed_moments = if start == subs.len() {
+                cells.closed_moments
+            } else {
+                subs[..start]
+                    .iter()
+                    .fold(Vector2::ZERO, |m, sub| m + cell_moments(sub.area, sub.half()))
+            };
+        }
+    }
+    for sub in subs[start..].iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
         let is_virgin = sub.state == virgin;
@@ -361,16 +441,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
         if is_virgin {
             if let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) {
                 if status == JointStatus::Sliding {
-                    // As `update_with_law` books a slide: the shear spring's work less the
-                    // change of its energy.
-                    let before = sub.force.shear;
-                    let work = -0.5 * (before + force.shear).dot(du_s);
-                    let ks_area = regime.shear_stiffness * sub.area;
-                    dissipated += if ks_area > 0.0 {
-                        work - 0.5 * (force.shear.length_squared() - before.length_squared()) / ks_area
-                    } else {
-                        work
-                    };
+                    dissipated += slide_dissipation(regime, sub, &force, du_s);
                     sub.slip += du_s.length();
                 }
                 sub.force = force;
@@ -381,7 +452,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                         // `N c = −k_n J s` and `½ k_n J s²`, `J = A h²/3`: summed over the
                         // contact's all-closed cells as `Σ J` (the slope is the contact's).
                         sums.add_joint(&force, sub.plane);
-                        closed_moments += sub.area * THIRD * (half * half);
+                        closed_moments += cell_moments(sub.area, half);
                     }
                     Cell::Response(c) => exact.add(&mut sums, &mut spread_energy, sub, &c),
                 }
@@ -412,8 +483,64 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     (sums, dissipated, spread_energy)
 }
 
+/// The energy a slide of `sub` to `force` dissipates, as `update_with_law` books a slide: the
+/// shear spring's work over the increment `du_s` less the change of its energy.
+#[inline(always)]
+fn slide_dissipation<S>(
+    regime: &ElasticRegime,
+    sub: &SubContact<S>,
+    force: &crate::law::JointForce,
+    du_s: Vector2,
+) -> Real {
+    let before = sub.force.shear;
+    let work = -0.5 * (before + force.shear).dot(du_s);
+    let ks_area = regime.shear_stiffness * sub.area;
+    if ks_area > 0.0 {
+        work - 0.5 * (force.shear.length_squared() - before.length_squared()) / ks_area
+    } else {
+        work
+    }
+}
+
 /// One third.
 const THIRD: Real = 1.0 / 3.0;
+
+/// A cell's `J = A h²/3` per axis (its second moments about its centre), as the step sums them
+/// for its all-closed cells.
+#[inline(always)]
+pub(crate) fn cell_moments(area: Real, half: Vector2) -> Vector2 {
+    area * THIRD * (half * half)
+}
+
+/// A face-face contact's cells as a whole, from the gap `face_gap(g, x, y)` over the box they
+/// cover (its extremes are at the box's corners).
+#[derive(Clone, Copy)]
+enum WholeContact<'a> {
+    /// Negative over the whole box, by a margin far above the round-off of the cells' own
+    /// test, so that each cell would also find itself all closed: the cells need no test.
+    Closed(&'a CellSummary),
+    /// Positive over the whole box: every cell is open (each still checks, with its own test).
+    Open,
+    /// Either sign.
+    Mixed,
+}
+
+impl<'a> WholeContact<'a> {
+    #[inline(always)]
+    fn of(g: (Real, Real, Real), cells: &'a CellSummary) -> Self {
+        let slope = Vector2::new(-g.1, -g.2);
+        let (lo, hi) = (slope * cells.lo, slope * cells.hi);
+        let largest = g.0 + lo.x.max(hi.x) + lo.y.max(hi.y);
+        let scale = g.0.abs() + (slope.abs() * cells.lo.abs().max(cells.hi.abs())).element_sum();
+        if largest < -1e-9 * scale {
+            Self::Closed(cells)
+        } else if g.0 + lo.x.min(hi.x) + lo.y.min(hi.y) > 0.0 {
+            Self::Open
+        } else {
+            Self::Mixed
+        }
+    }
+}
 
 /// A cell as the elastic-regime loop sees it: all closed (the gap at the anchor and the half
 /// sizes: its force and moments are linear in them), or its [`CellResponse`].
@@ -599,6 +726,56 @@ pub(super) fn plane_turn(from: Vector, to: Vector) -> Option<Vector> {
 mod tests {
     use super::*;
     use crate::math::Rotation;
+
+    /// The whole-contact test agrees with the cells' own tests: a box of cells wholly under
+    /// the plane is `Closed` only when every cell's test finds it all closed, wholly above is
+    /// `Open`, and a box the line `g = 0` crosses, or touches within round-off, is `Mixed`.
+    #[test]
+    fn whole_contact_classes_agree_with_each_cells_test() {
+        use crate::contact::CellSummary;
+        // Cells of 0.05 × 0.02 m (half sizes 0.025, 0.01) covering [-0.2, 0.2] × [-0.05, 0.05].
+        let cells: Vec<(Vector2, Vector2)> = (0..8)
+            .flat_map(|i| (0..5).map(move |j| (i, j)))
+            .map(|(i, j)| {
+                let centre = Vector2::new(-0.175 + 0.05 * i as Real, -0.04 + 0.02 * j as Real);
+                (centre, Vector2::new(0.025, 0.01))
+            })
+            .collect();
+        let summary = CellSummary {
+            lo: Vector2::new(-0.2, -0.05),
+            hi: Vector2::new(0.2, 0.05),
+            closed_moments: Vector2::ZERO,
+        };
+        let cell_closed = |g: (Real, Real, Real), (c, h): (Vector2, Vector2)| {
+            let anchor_gap = face_gap(g, c.x, c.y);
+            let spread = g.1.abs() * h.x + g.2.abs() * h.y;
+            anchor_gap < 0.0 && anchor_gap <= -spread
+        };
+        let cell_open = |g: (Real, Real, Real), (c, h): (Vector2, Vector2)| {
+            face_gap(g, c.x, c.y) >= g.1.abs() * h.x + g.2.abs() * h.y
+        };
+        // Tilted planes at several depths: from wholly closed through crossing to wholly open.
+        for &(gx, gy) in &[(1e-3_f64, -4e-4_f64), (-2e-3, 0.0), (0.0, 5e-3)] {
+            let reach = gx.abs() * 0.2 + gy.abs() * 0.05;
+            for k in -40..=40 {
+                let g0 = reach * k as Real / 20.0;
+                let g = (g0, gx, gy);
+                match WholeContact::of(g, &summary) {
+                    WholeContact::Closed(_) => assert!(cells.iter().all(|&c| cell_closed(g, c)), "{g:?}"),
+                    WholeContact::Open => assert!(cells.iter().all(|&c| cell_open(g, c)), "{g:?}"),
+                    WholeContact::Mixed => assert!(
+                        !cells.iter().all(|&c| cell_closed(g, c)) || g0 + reach > -1e-9 * (g0.abs() + reach),
+                        "{g:?}: all closed by a margin, yet mixed"
+                    ),
+                }
+            }
+            // Touching zero at a corner: not taken for closed.
+            assert!(matches!(
+                WholeContact::of((-reach, gx, gy), &summary),
+                WholeContact::Mixed
+            ));
+        }
+    }
 
     #[test]
     fn plane_turn_keeps_in_plane_vectors_in_plane_with_their_length() {

@@ -85,6 +85,41 @@ pub(crate) struct ContactPair {
     /// `F_n²/(2 k_n A)` (J, `contact/spread.rs`): kept by the step with `springs`,
     /// checkpointed.
     pub(crate) spread_energy: Real,
+    /// What the step needs of the cells as a whole (see [`CellSummary`]): derived from the
+    /// sub-contacts whenever they are set (detection, checkpoint load), not stored.
+    pub(crate) cells: CellSummary,
+}
+
+/// A face-face contact's cells as a whole: the box on the anchor plane that they cover, and
+/// `Σ A h²/3` per axis (`J = A h²/3`, a rectangle's second moment about its centre) summed in
+/// sub-contact order. When the gap is negative over the whole box, every cell is all closed,
+/// and the step need not test them one by one (`kernel.rs`).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct CellSummary {
+    /// Lower corner of the box (plane coordinates, m).
+    pub(crate) lo: Vector2,
+    /// Upper corner (m).
+    pub(crate) hi: Vector2,
+    /// `Σ A h_x²/3`, `Σ A h_y²/3` (m⁴).
+    pub(crate) closed_moments: Vector2,
+}
+
+impl CellSummary {
+    /// The summary of the cells of `own`, a contact's sub-contacts.
+    pub(crate) fn of<S>(own: &[SubContact<S>]) -> Self {
+        let mut s = Self {
+            lo: Vector2::splat(Real::INFINITY),
+            hi: Vector2::splat(Real::NEG_INFINITY),
+            closed_moments: Vector2::ZERO,
+        };
+        for sub in own {
+            let half = sub.half();
+            s.lo = s.lo.min(sub.plane - half);
+            s.hi = s.hi.max(sub.plane + half);
+            s.closed_moments += kernel::cell_moments(sub.area, half);
+        }
+        s
+    }
 }
 
 /// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
@@ -228,6 +263,7 @@ impl ContactPair {
         law: &L,
         poses: Option<(&Pose, &Pose)>,
     ) {
+        self.cells = CellSummary::of(own);
         if let (ContactKind::FaceFace { .. }, Some(poses)) = (self.kind, poses) {
             kernel::seed_law_gaps(self, own, law, poses);
         }

@@ -80,6 +80,7 @@ fn into_storage<S>(
                 per_y: e.springs[2],
             },
             spread_energy: e.spread_energy,
+            cells: Default::default(),
         });
         references.push(ContactReference {
             ref_a: e.reference_centroids.0,
@@ -379,6 +380,7 @@ where
         for (k, p) in model.state.pairs.iter_mut().enumerate() {
             let (a, b) = (&model.state.blocks[p.a as usize], &model.state.blocks[p.b as usize]);
             p.cache_local_faces(Block::shape(a), Block::shape(b));
+            p.cells = crate::contact::CellSummary::of(&model.state.subs[p.range()]);
             // Dashpot forces still held must be seen (and their work booked) by the next step.
             p.dashpots |= model.state.sub_records[p.range()]
                 .iter()

@@ -49,6 +49,7 @@ pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
         normal_force: 0.0,
         springs: ForceMoments::default(),
         spread_energy: 0.0,
+        cells: Default::default(),
     };
     let reference = ContactReference {
         ref_a: Vector::ZERO,
@@ -308,6 +309,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             normal_force: 0.0,
             springs: ForceMoments::default(),
             spread_energy: 0.0,
+            cells: Default::default(),
         };
         pair.cache_local_faces(bi.shape(), bj.shape());
         pair.refresh_springs(subs, joint_law, large.then_some((&bi.state.pose, &bj.state.pose)));
