@@ -369,7 +369,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                 let spread = e.slope.x.abs() * half.x + e.slope.y.abs() * half.y;
                 let gap = anchor_gap - spread;
                 // Open over the whole cell: its law gap is its smallest, its force nothing.
-                if !(anchor_gap >= spread && gap > 0.0) || !law.stays_open(sub.area, gap, &sub.state) {
+                if !(anchor_gap >= spread && gap > 0.0 && law.stays_open(sub.area, gap, &sub.state)) {
                     break;
                 }
                 sub.gap = gap;
