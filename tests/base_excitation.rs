@@ -3,7 +3,7 @@
 //! acceleration stays below `g tan φ`, and slides once it exceeds it, by the relative slip of
 //! Newmark's rigid–plastic block (1965).
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

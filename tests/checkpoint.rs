@@ -1,7 +1,7 @@
 //! Checkpoint and restart: a restarted run continues bit-identically; corrupt or truncated
 //! checkpoints give errors, never panics.
 
-mod common;
+use crate::common;
 
 use voussoir::build::{running_bond_wall, WallSpec};
 use voussoir::monitor::Recorder;

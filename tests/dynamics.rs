@@ -9,7 +9,7 @@
 //!
 //! Every reference value is computed here from its formula; nothing is copied from a run.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

@@ -1,7 +1,7 @@
 //! Whole-engine checks through the public API: the energy balance of damped collapses and of an
 //! undamped elastic system, and bit-identical determinism across runs and thread counts.
 
-mod common;
+use crate::common;
 
 use voussoir::build::{running_bond_wall, WallSpec};
 use voussoir::prelude::*;

@@ -22,7 +22,7 @@
 //! `energy_balance_holds_at_every_step_with_a_resolving_step` checks separately with a
 //! smaller step.
 
-mod common;
+use crate::common;
 
 use common::z_range;
 use voussoir::build::{running_bond_wall, WallSpec};

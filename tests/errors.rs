@@ -2,7 +2,7 @@
 //! variant comes back (never a panic), its fields name what is wrong, where, and the bad value,
 //! and so does its message.
 
-mod common;
+use crate::common;
 
 use voussoir::block::Dof;
 use voussoir::geometry::{ContactParameters, SubcontactDensity};

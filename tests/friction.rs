@@ -13,7 +13,7 @@
 //!   exercises inclined contact planes, rotated principal frames and re-detection along a
 //!   slanted face.
 
-mod common;
+use crate::common;
 
 use voussoir::prelude::*;
 

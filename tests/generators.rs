@@ -2,7 +2,7 @@
 //! settling run the unbalanced-force ratio is small and no block has moved by more than a small
 //! fraction of its size (elastic settlement on the joint springs only).
 
-mod common;
+use crate::common;
 
 use voussoir::build::{
     barrel_vault, dome, multi_leaf_wall, rubble_wall, BarrelVaultSpec, DomeSpec, MultiLeafSpec, RubbleWallSpec,

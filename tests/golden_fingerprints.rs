@@ -18,7 +18,7 @@
 //! test does not run elsewhere.
 #![cfg(target_arch = "x86_64")]
 
-mod common;
+use crate::common;
 
 use common::{cube, fingerprint, fixed_slab};
 use voussoir::prelude::*;

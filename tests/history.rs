@@ -7,7 +7,7 @@
 //! sub-contacts' shear forces, the joint would drop the load and the block would slip by
 //! `P/(ks·A)` each time until the springs reloaded.
 
-mod common;
+use crate::common;
 
 use voussoir::prelude::*;
 

@@ -3,7 +3,7 @@
 //! through another; limit analysis lets only the part of a tilted face that touches carry
 //! force; a checkpoint's slack of a tested pair is checked against its shapes.
 
-mod common;
+use crate::common;
 
 use voussoir::prelude::*;
 

@@ -1,7 +1,7 @@
 //! Issue 33, files: what a save leaves on disk when two threads save to one path, when the name
 //! is long or a symbolic link, and that a model with a base motion that saves also loads.
 
-mod common;
+use crate::common;
 
 use std::path::PathBuf;
 

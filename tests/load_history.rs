@@ -1,7 +1,7 @@
 //! Time-varying loads (`loading::LoadHistory`, `Model::set_load_history`) against closed forms,
 //! the energy books, checkpoints and scenes.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

@@ -1,7 +1,7 @@
 //! Two kinds of law in one model through `AnyLaw`: each part of the scene moves, bit for bit, as
 //! it does in a model of its own law alone.
 
-mod common;
+use crate::common;
 
 use voussoir::integrate::TimeStep;
 use voussoir::law::AnyLaw;

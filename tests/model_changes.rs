@@ -1,7 +1,7 @@
 //! Changing a model mid-run (laws, parameters, fixity) re-evaluates what depends on it
 //! (regressions from a review: these changes used to be ignored silently).
 
-mod common;
+use crate::common;
 
 use voussoir::prelude::*;
 

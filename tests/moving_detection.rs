@@ -2,7 +2,7 @@
 //! its two blocks move together, whatever distance they travel, and is tested afresh once they
 //! move relative to each other.
 
-mod common;
+use crate::common;
 
 use voussoir::prelude::*;
 

@@ -1,7 +1,7 @@
 //! The capacity driver (`loading::PushOver`) against a closed form: a block pushed sideways by
 //! a frictionless pusher slides when the push reaches the base joint's friction, `tan φ · W`.
 
-mod common;
+use crate::common;
 
 use std::ops::ControlFlow;
 

@@ -2,7 +2,7 @@
 //! depend on the loading speed or the threshold, where a plate driven at a constant speed
 //! measures inertia.
 
-mod common;
+use crate::common;
 
 use std::ops::ControlFlow;
 

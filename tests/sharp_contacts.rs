@@ -12,7 +12,7 @@
 //! error at the kinks of the springs, `docs/theory.md` §5.4, is a fraction of that with the
 //! impact-resolving step), 1 % for the balance with friction.
 
-mod common;
+use crate::common;
 
 use common::z_range;
 use voussoir::prelude::*;

@@ -13,7 +13,7 @@
 //! Closed forms are written out from the geometry and the loads; nothing is read back from a
 //! previous run.
 
-mod common;
+use crate::common;
 
 use voussoir::law::JointStatus;
 use voussoir::prelude::*;

@@ -4,7 +4,7 @@
 //! with Chromium installed): pixels, the page's own checks of frame count and time range, no
 //! console errors.
 
-mod common;
+use crate::common;
 
 use base64::Engine as _;
 use voussoir::io::viewer::Viewer;

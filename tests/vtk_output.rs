@@ -6,7 +6,7 @@
 //! checks cell counts, cell types, the total volume of the polyhedra, the total area of the
 //! face polygons the series writes and the sub-contact areas.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::process::Command;

@@ -10,11 +10,18 @@
 //! |---|---|
 //! | [`scenarios`] | the runs as functions of their parameters, shared by the command line and the tests |
 //! | [`cli`] | one command line for the static and impact runs (`cargo run --release --example arch_static` / `arch_impact`) |
-//! | [`plot`] | SVG line plots |
+//! | [`plot`] | line plots, SVG and PNG |
 //! | [`progress`] | progress bars |
+//!
+//! `cli`, `plot` and `progress` need the default feature `cli` (clap, indicatif, plotters);
+//! without it (`default-features = false`, as the Python package has it) the crate is its
+//! scenarios alone.
 #![warn(missing_docs)]
 
+#[cfg(feature = "cli")]
 pub mod cli;
+#[cfg(feature = "cli")]
 pub mod plot;
+#[cfg(feature = "cli")]
 pub mod progress;
 pub mod scenarios;

@@ -1,4 +1,5 @@
-//! Fixtures shared by the integration tests: each test file that uses them says `mod common;`.
+//! Fixtures shared by the integration tests (one crate, `tests/integration.rs`): a test file
+//! that uses them says `use crate::common;`.
 //!
 //! Only what several files build the same way lives here: the fixed 2 m slab that most single-
 //! block tests stand on, the 0.2 m stone cube, a model with one joint law for material 0, and
