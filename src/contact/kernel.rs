@@ -345,38 +345,12 @@ fn update_elastic_first<L: ConstitutiveLaw>(
     let mut spread_energy = 0.0;
     // `Σ J_xx`, `Σ J_yy` of the all-closed cells in the elastic regime, for their spread energy.
     let mut closed_moments = Vector2::ZERO;
-    // Two kinds of contact take a shorter way through their cells, doing the operations of the
-    // loop below for such cells, in its order (the same bits); at the first cell that does not
-    // fit, the loop below takes over from it.
-    // - All closed (a joint at rest): each virgin cell's force is the law's elastic step at its
-    //   anchor gap, with no test of the cell; the loop below then starts with the `Σ J` of the
-    //   cells before it.
-    // - All open (a head joint): each virgin cell that was open and unloaded, and that the law
-    //   keeps open, only takes its smallest gap.
+    // A contact whose cells are all closed (a joint at rest) takes a shorter way through them,
+    // doing the operations of the loop below for such cells, in its order (the same bits): each
+    // virgin cell's force is the law's elastic step at its anchor gap, with no test of the
+    // cell. At the first cell that does not fit (a failed state, a law leaving its regime) the
+    // loop below takes over from it, with the `Σ J` of the cells before it.
     let mut start = 0;
-    if let (Some(g), Some(e), WholeContact::Open) = (face, exact, whole) {
-        if e.virgin_without_tension {
-            for sub in subs.iter_mut() {
-                if sub.state != virgin
-                    || sub.status != JointStatus::Open
-                    || sub.force.normal != 0.0
-                    || sub.force.shear != Vector2::ZERO
-                {
-                    break;
-                }
-                let anchor_gap = face_gap(g, sub.plane.x, sub.plane.y);
-                let half = sub.half();
-                let spread = e.slope.x.abs() * half.x + e.slope.y.abs() * half.y;
-                let gap = anchor_gap - spread;
-                // Open over the whole cell: its law gap is its smallest, its force nothing.
-                if !(anchor_gap >= spread && gap > 0.0 && law.stays_open(sub.area, gap, &sub.state)) {
-                    break;
-                }
-                sub.gap = gap;
-                start += 1;
-            }
-        }
-    }
     if let (Some(g), Some(e), WholeContact::Closed(cells)) = (face, exact, whole) {
         if e.virgin_without_tension {
             for sub in subs.iter_mut() {
@@ -409,8 +383,30 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             };
         }
     }
+    // An open, unloaded virgin cell that the law keeps open only takes its smallest gap (as
+    // below: the elastic step gives nothing for a positive gap, and `stays_separated` holds).
+    let open_cells = match (face, exact) {
+        (Some(g), Some(e)) if e.virgin_without_tension => Some((g, e.slope.abs())),
+        _ => None,
+    };
     for sub in subs[start..].iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
+        if let Some((g, slope)) = open_cells {
+            if sub.status == JointStatus::Open
+                && sub.force.normal == 0.0
+                && sub.force.shear == Vector2::ZERO
+                && sub.state == virgin
+            {
+                let anchor_gap = face_gap(g, x, y);
+                let half = sub.half();
+                let spread = slope.x * half.x + slope.y * half.y;
+                let gap = anchor_gap - spread;
+                if anchor_gap >= spread && gap > 0.0 && law.stays_open(sub.area, gap, &sub.state) {
+                    sub.gap = gap;
+                    continue;
+                }
+            }
+        }
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
         let is_virgin = sub.state == virgin;
         let cell = match (face, exact) {
@@ -513,15 +509,13 @@ pub(crate) fn cell_moments(area: Real, half: Vector2) -> Vector2 {
 }
 
 /// A face-face contact's cells as a whole, from the gap `face_gap(g, x, y)` over the box they
-/// cover (its extremes are at the box's corners).
+/// cover (its largest value is at a corner of the box).
 #[derive(Clone, Copy)]
 enum WholeContact<'a> {
     /// Negative over the whole box, by a margin far above the round-off of the cells' own
     /// test, so that each cell would also find itself all closed: the cells need no test.
     Closed(&'a CellSummary),
-    /// Positive over the whole box: every cell is open (each still checks, with its own test).
-    Open,
-    /// Either sign.
+    /// Not known to be closed everywhere: each cell tests itself.
     Mixed,
 }
 
@@ -534,8 +528,6 @@ impl<'a> WholeContact<'a> {
         let scale = g.0.abs() + (slope.abs() * cells.lo.abs().max(cells.hi.abs())).element_sum();
         if largest < -1e-9 * scale {
             Self::Closed(cells)
-        } else if g.0 + lo.x.min(hi.x) + lo.y.min(hi.y) > 0.0 {
-            Self::Open
         } else {
             Self::Mixed
         }
@@ -727,9 +719,9 @@ mod tests {
     use super::*;
     use crate::math::Rotation;
 
-    /// The whole-contact test agrees with the cells' own tests: a box of cells wholly under
-    /// the plane is `Closed` only when every cell's test finds it all closed, wholly above is
-    /// `Open`, and a box the line `g = 0` crosses, or touches within round-off, is `Mixed`.
+    /// The whole-contact test agrees with the cells' own tests: a box of cells is `Closed` only
+    /// when every cell's test finds it all closed, and is `Closed` whenever they all are by more
+    /// than the margin; a box the line `g = 0` crosses, or touches within round-off, is `Mixed`.
     #[test]
     fn whole_contact_classes_agree_with_each_cells_test() {
         use crate::contact::CellSummary;
@@ -751,9 +743,6 @@ mod tests {
             let spread = g.1.abs() * h.x + g.2.abs() * h.y;
             anchor_gap < 0.0 && anchor_gap <= -spread
         };
-        let cell_open = |g: (Real, Real, Real), (c, h): (Vector2, Vector2)| {
-            face_gap(g, c.x, c.y) >= g.1.abs() * h.x + g.2.abs() * h.y
-        };
         // Tilted planes at several depths: from wholly closed through crossing to wholly open.
         for &(gx, gy) in &[(1e-3_f64, -4e-4_f64), (-2e-3, 0.0), (0.0, 5e-3)] {
             let reach = gx.abs() * 0.2 + gy.abs() * 0.05;
@@ -762,7 +751,6 @@ mod tests {
                 let g = (g0, gx, gy);
                 match WholeContact::of(g, &summary) {
                     WholeContact::Closed(_) => assert!(cells.iter().all(|&c| cell_closed(g, c)), "{g:?}"),
-                    WholeContact::Open => assert!(cells.iter().all(|&c| cell_open(g, c)), "{g:?}"),
                     WholeContact::Mixed => assert!(
                         !cells.iter().all(|&c| cell_closed(g, c)) || g0 + reach > -1e-9 * (g0.abs() + reach),
                         "{g:?}: all closed by a margin, yet mixed"
@@ -774,6 +762,71 @@ mod tests {
                 WholeContact::of((-reach, gx, gy), &summary),
                 WholeContact::Mixed
             ));
+        }
+    }
+
+    /// The all-closed way through a joint gives the same bits as the cell-by-cell loop: for a
+    /// dry joint whose cells stick and slide, and for a cohesive one whose failed cells and
+    /// slides (outside the elastic regime's cover) send the rest of the joint back to that loop.
+    #[test]
+    fn the_all_closed_way_gives_the_bits_of_the_cell_by_cell_loop() {
+        use crate::contact::CellSummary;
+        use crate::law::{CoulombSlip, CoulombState, JointForce};
+        let kinematics = Kinematics {
+            at_origin: Vector::new(-2e-7, 3e-6, -1e-6),
+            per_x: Vector::new(1e-6, -4e-6, 2e-6),
+            per_y: Vector::new(-3e-6, 1e-6, 5e-6),
+        };
+        let g = (-4e-5, 1e-4, -2e-4);
+        let axes = JointAxes::from_normal(Vector::Z);
+        let cells = |failed: &[usize]| -> Vec<SubContact<CoulombState>> {
+            (0..12)
+                .map(|k| SubContact {
+                    plane: Vector2::new(-0.075 + 0.05 * (k % 4) as Real, -0.05 + 0.05 * (k / 4) as Real),
+                    area: 0.05 * 0.05,
+                    gap: -4e-5,
+                    // Some cells near their strength, so that a few slide.
+                    force: JointForce {
+                        normal: 100.0,
+                        shear: Vector2::new(40.0 + 5.0 * k as Real, -8.0),
+                    },
+                    slip: 0.0,
+                    half: [0.025, 0.025],
+                    status: JointStatus::Elastic,
+                    state: CoulombState {
+                        failed: failed.contains(&k),
+                    },
+                })
+                .collect()
+        };
+        let dry = CoulombSlip::dry(1e9, 4e8, 30.0).expect("law");
+        let cohesive = CoulombSlip::new(1e9, 4e8, 35.0, 30.0, 2e4, 0.0).expect("law");
+        for (law, failed) in [(dry, vec![]), (cohesive, vec![]), (cohesive, vec![5, 9])] {
+            let regime = law.elastic_regime().expect("a regime");
+            let exact = ExactCells::of(&law, Some(g));
+            let mut fast = cells(&failed);
+            let summary = CellSummary::of(&fast);
+            let whole = WholeContact::of(g, &summary);
+            assert!(
+                matches!(whole, WholeContact::Closed(_)),
+                "the joint is closed everywhere"
+            );
+            let mut slow = fast.clone();
+            let a = update_elastic_first(&mut fast, &law, &regime, &kinematics, Some(g), exact, whole, axes, 1e-4);
+            let b = update_elastic_first(
+                &mut slow,
+                &law,
+                &regime,
+                &kinematics,
+                Some(g),
+                exact,
+                WholeContact::Mixed,
+                axes,
+                1e-4,
+            );
+            assert_eq!(fast, slow, "{law:?}, failed {failed:?}");
+            assert_eq!((a.0, a.1.to_bits(), a.2.to_bits()), (b.0, b.1.to_bits(), b.2.to_bits()));
+            assert!(fast.iter().any(|s| s.status == JointStatus::Sliding) || law.cohesion() > 0.0);
         }
     }
 
