@@ -157,3 +157,23 @@ def test_chromium_screenshot_shows_the_blocks(tmp_path):
     assert bright.sum() > 50, bright.sum()
     # The pillar fell between the two frames: the pictures differ.
     assert np.mean(np.any(np.abs(shots["0"] - shots["last"]) > 0.1, axis=-1)) > 0.005
+
+
+@needs_chromium
+@pytest.mark.parametrize("case", ["no blocks", "one block, no contacts recorded"])
+def test_chromium_opens_edge_cases_without_errors(tmp_path, case):
+    m = vs.Model()
+    v = vs.Viewer(case, contacts=case == "no blocks")
+    if case != "no blocks":
+        m.add_cuboid("block", (0, 0, 0), (1, 1, 1), 2000.0)
+    v.record(m)
+    v.record(m)
+    path = v.write(tmp_path / "edge.html")
+    out, err = chromium(path.as_uri() + "#joints=1&forces=1&frame=last", "--dump-dom", f"--user-data-dir={tmp_path / 'profile'}")
+    found = re.search(r'<pre id="voussoir-checks" hidden="">(.*?)</pre>', out, re.S)
+    assert found, out[-2000:]
+    checks = json.loads(html.unescape(found.group(1)))
+    assert checks["errors"] == [] and console_messages(err) == []
+    assert checks["frames"] == 2 and checks["blocks"] == len(m)
+    # A box seen from above and aside shows three faces; nothing is drawn without blocks.
+    assert checks["faces_drawn"] == (0 if case == "no blocks" else 3)
