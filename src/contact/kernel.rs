@@ -364,13 +364,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
                 let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) else {
                     break;
                 };
-                if status == JointStatus::Sliding {
-                    dissipated += slide_dissipation(regime, sub, &force, du_s);
-                    sub.slip += du_s.length();
-                }
-                sub.force = force;
-                sub.gap = gap;
-                sub.status = status;
+                take_elastic_step(regime, sub, (force, status), gap, du_s, &mut dissipated);
                 sums.add_joint(&force, sub.plane);
                 start += 1;
             }
@@ -436,13 +430,7 @@ fn update_elastic_first<L: ConstitutiveLaw>(
         let du_s = Vector2::new(du_1, du_2);
         if is_virgin {
             if let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) {
-                if status == JointStatus::Sliding {
-                    dissipated += slide_dissipation(regime, sub, &force, du_s);
-                    sub.slip += du_s.length();
-                }
-                sub.force = force;
-                sub.gap = gap;
-                sub.status = status;
+                take_elastic_step(regime, sub, (force, status), gap, du_s, &mut dissipated);
                 match cell {
                     Cell::Closed(_, half) => {
                         // `N c = −k_n J s` and `½ k_n J s²`, `J = A h²/3`: summed over the
@@ -477,6 +465,26 @@ fn update_elastic_first<L: ConstitutiveLaw>(
             * (closed_moments.x * e.slope.x * e.slope.x + closed_moments.y * e.slope.y * e.slope.y);
     }
     (sums, dissipated, spread_energy)
+}
+
+/// Stores the elastic regime's step (`force`, `status`) at the law gap `gap` in `sub`, with its
+/// slip while sliding, and adds the energy a slide dissipated to `dissipated`.
+#[inline(always)]
+fn take_elastic_step<S>(
+    regime: &ElasticRegime,
+    sub: &mut SubContact<S>,
+    (force, status): (crate::law::JointForce, JointStatus),
+    gap: Real,
+    du_s: Vector2,
+    dissipated: &mut Real,
+) {
+    if status == JointStatus::Sliding {
+        *dissipated += slide_dissipation(regime, sub, &force, du_s);
+        sub.slip += du_s.length();
+    }
+    sub.force = force;
+    sub.gap = gap;
+    sub.status = status;
 }
 
 /// The energy a slide of `sub` to `force` dissipates, as `update_with_law` books a slide: the
