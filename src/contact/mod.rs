@@ -1,6 +1,7 @@
 //! Contacts between block pairs: the [`Contact`] trait, typed ids, sub-contact state and the
 //! per-sub-contact kinematics kernel.
 
+mod elastic;
 mod kernel;
 mod lanes;
 mod law_update;
@@ -116,7 +117,7 @@ impl CellSummary {
             let half = sub.half();
             s.lo = s.lo.min(sub.plane - half);
             s.hi = s.hi.max(sub.plane + half);
-            s.closed_moments += kernel::cell_moments(sub.area, half);
+            s.closed_moments += elastic::cell_moments(sub.area, half);
         }
         s
     }
