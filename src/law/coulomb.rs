@@ -171,9 +171,10 @@ impl ConstitutiveLaw for CoulombSlip {
         } else {
             (self.tensile_strength, self.cohesion, self.tan_friction)
         };
-        // Open: beyond the tensile strength of a bonded joint; any tension for a dry one (`-0·A`);
-        // no compression for a failed one.
-        let open = if state.failed {
+        // Open: beyond the tensile strength of a bonded joint; no compression for a joint without
+        // tensile strength (a dry one, or a failed one), touching included: at zero gap it
+        // carries no force, and no shear strength without cohesion.
+        let open = if tensile == 0.0 {
             f.normal <= 0.0
         } else {
             f.normal < -tensile * a
@@ -201,17 +202,13 @@ impl ConstitutiveLaw for CoulombSlip {
         JointStatus::Elastic
     }
 
-    /// The open test of [`CoulombSlip::update`], evaluated the same way: true for a failed
-    /// joint without compression, and for an intact one beyond its tensile strength only when
-    /// that strength is zero (else opening is a failure, a change of state).
+    /// The open test of [`CoulombSlip::update`], evaluated the same way: true for a joint
+    /// without tensile strength (failed, or intact with none) and without compression; false
+    /// for an intact joint with tensile strength (opening it is a failure, a change of state).
     #[inline]
     fn stays_open(&self, area: Real, normal_displacement: Real, state: &CoulombState) -> bool {
         let normal = -self.normal_stiffness * normal_displacement * area;
-        if state.failed {
-            normal <= 0.0
-        } else {
-            self.tensile_strength == 0.0 && normal < -self.tensile_strength * area
-        }
+        (state.failed || self.tensile_strength == 0.0) && normal <= 0.0
     }
 
     /// Intact joint in compression below its strength: `c` and `tan φ` (peak values); sliding
@@ -377,6 +374,40 @@ mod tests {
         assert!(stood > 100 && declined > 100, "{stood} {declined}");
     }
 
+    /// A dry joint that just touches (zero gap, either sign of zero) carries nothing and is
+    /// open, whatever shear it carried and however it moves along the joint: no compression,
+    /// no strength. A bonded one holds there (zero normal force is within its tensile
+    /// strength) and keeps its cohesive shear strength.
+    #[test]
+    fn a_dry_joint_touching_at_zero_gap_is_open_and_carries_nothing() {
+        for gap in [0.0, -0.0] {
+            for du in [0.0, 2e-6] {
+                let mut f = JointForce {
+                    normal: 50.0,
+                    shear: Vector2::new(20.0, -5.0),
+                };
+                let mut state = CoulombState::default();
+                let status = laws()[0].update(&step(gap, Vector2::new(du, 0.0)), &mut f, &mut state);
+                assert_eq!(
+                    (status, f.normal, f.shear),
+                    (JointStatus::Open, 0.0, Vector2::ZERO),
+                    "{gap} {du}"
+                );
+                assert!(!state.failed);
+                assert!(laws()[0].stays_open(0.01, gap, &state));
+            }
+        }
+        let bonded = laws()[2];
+        let mut f = JointForce::default();
+        let status = bonded.update(
+            &step(0.0, Vector2::new(1e-9, 0.0)),
+            &mut f,
+            &mut CoulombState::default(),
+        );
+        assert_eq!(status, JointStatus::Elastic);
+        assert!(f.shear.x < 0.0);
+    }
+
     /// `stays_open` promises for separated dry and failed joints, not for intact bonded ones
     /// (opening them is a failure). (That `update` keeps the promise: the conformance check.)
     #[test]
@@ -392,8 +423,9 @@ mod tests {
                 }
             }
         }
-        // Dry joints: every positive gap, intact or failed, and zero gap once failed.
-        assert_eq!(promised[0], 5 + 7);
+        // Dry joints: every gap that is not negative (zero included: touching, no force),
+        // intact or failed.
+        assert_eq!(promised[0], 7 + 7);
         // The bonded joint only once failed.
         assert_eq!(promised[2], 7);
         assert!(!laws()[2].stays_open(1.0, 1.0, &CoulombState { failed: false }));
