@@ -67,9 +67,16 @@ fn newmark_slip(a: impl Fn(f64) -> f64, mu: f64, times: &[f64]) -> Vec<f64> {
 /// 17 N to 441 N against a weight of 188 N), and the friction limit with it; Newmark's block
 /// presses on its base with its weight.
 fn dem_slip(amplitude: f64, times: &[f64]) -> Vec<f64> {
+    dem_slip_shifted(amplitude, times, 0.0)
+}
+
+/// [`dem_slip`] with the cube placed `shift` (m) along x.
+fn dem_slip_shifted(amplitude: f64, times: &[f64], shift: f64) -> Vec<f64> {
     let mut model = common::model(CoulombSlip::dry(1e10, 4e9, PHI_DEG).expect("law"));
     let base = model.add_block(common::fixed_slab("shaking table")).expect("slab");
-    let cube = model.add_block(common::cube("block", Vector::ZERO)).expect("cube");
+    let cube = model
+        .add_block(common::cube("block", Vector::new(shift, 0.0, 0.0)))
+        .expect("cube");
     model.run_until_time(0.1).expect("settle");
     let speed = model.block(cube).expect("block").state().velocity.length();
     assert!(speed < 1e-6, "the cube settled: {speed} m/s");
@@ -99,6 +106,22 @@ fn sample_times() -> Vec<f64> {
         .collect()
 }
 
+/// The DEM block against Newmark's over three cycles, for twelve placements of the cube on its
+/// slab (along x, by up to 1 mm: the same problem).
+///
+/// The DEM block is not rigid–plastic: its joint has elastic springs (kn 1e10, ks 4e9 Pa/m),
+/// which at μ m g ≈ 91 N over 0.04 m² store about 0.6 µm of elastic shear (and the block rocks
+/// by about as much), and it stands on 0.4 µm of elastic settlement; each transition between
+/// sticking and sliding is shifted by the time these take. Up to the end of the first cycle
+/// every placement gives the same answer, 0.056 mm (0.3 %) from Newmark's. Undamped, the onset
+/// of sliding then sets the block rocking on its joint (a period of about 1.4 ms) for good, the
+/// friction limit swinging with the normal force, and from the second cycle on the slip
+/// depends on the rocking's phase at each onset: chaotically, on the placement and on
+/// round-off alike (placements a nanometre apart, or the contact's force sums taken in another
+/// order, give a largest difference anywhere from 0.08 to 0.36 mm, 0.4–2 % of the slip). It is
+/// a random walk about Newmark's answer: the final differences, −0.26 to +0.16 mm, have a mean
+/// of −0.03 mm (0.2 %; its standard error over twelve placements is about 0.04 mm). So: the first cycle within 0.5 %, every placement within 2.5 %
+/// everywhere, and the placements' mean final slip within 0.5 % of Newmark's.
 #[test]
 fn a_block_on_a_shaking_base_slides_by_newmarks_slip() {
     let mu = PHI_DEG.to_radians().tan();
@@ -106,33 +129,50 @@ fn a_block_on_a_shaking_base_slides_by_newmarks_slip() {
     let w = 2.0 * PI * FREQUENCY;
     let times = sample_times();
     let expected = newmark_slip(|t| amplitude * (w * t).sin(), mu, &times);
-    let measured = dem_slip(amplitude, &times);
     let scale = expected.iter().fold(0.0f64, |m, u| m.max(u.abs()));
-    let worst = measured
-        .iter()
-        .zip(&expected)
-        .map(|(m, e)| (m - e).abs())
-        .fold(0.0f64, f64::max);
-    for k in (0..times.len()).step_by(10) {
-        println!(
-            "t {:.2} s: DEM {:+.6} m, Newmark {:+.6} m",
-            times[k], measured[k], expected[k]
-        );
-    }
-    println!("largest relative slip {scale:.5} m; largest difference {worst:.3e} m");
-    // The DEM block is not rigid–plastic: its joint has elastic springs (kn 1e10, ks 4e9 Pa/m),
-    // which at μ m g ≈ 91 N over 0.04 m² store about 0.6 µm of elastic shear (and the block
-    // rocks by about as much), and it stands on 0.4 µm of elastic settlement; each transition
-    // between sticking and sliding is shifted by the time these take. Undamped, the onset of
-    // sliding also sets the block rocking on its joint (a period of about 1.4 ms) for good,
-    // and the friction limit swings with the normal force. Measured: 0.11 mm (0.6 %) here, and
-    // 0.16 mm when every contact of a moved block is clipped afresh at every re-detection, as
-    // before contacts kept their geometry while their blocks moved together. Against a slip of
-    // centimetres both are well under 1 %.
     assert!(scale > 0.01, "the case slides: {scale}");
+    let first_cycle = times.iter().take_while(|&&t| t <= 1.0 / FREQUENCY + 1e-9).count();
+    let shifts = [0.0, 1e-9, 2e-9, 3e-9, 1e-6, 2e-6, 1e-4, 2e-4, 3e-4, 1e-3, -3e-4, -1e-3];
+    let mut final_errors = Vec::new();
+    for shift in shifts {
+        let measured = dem_slip_shifted(amplitude, &times, shift);
+        let worst_in = |n: usize| {
+            measured
+                .iter()
+                .zip(&expected)
+                .take(n)
+                .map(|(m, e)| (m - e).abs())
+                .fold(0.0f64, f64::max)
+        };
+        let (first, worst) = (worst_in(first_cycle), worst_in(times.len()));
+        if shift == 0.0 {
+            for k in (0..times.len()).step_by(10) {
+                println!(
+                    "t {:.2} s: DEM {:+.6} m, Newmark {:+.6} m",
+                    times[k], measured[k], expected[k]
+                );
+            }
+        }
+        let last = measured[times.len() - 1] - expected[times.len() - 1];
+        println!(
+            "shift {shift:.0e} m: largest difference {worst:.3e} m ({:.2} % of {scale:.5} m), first cycle {first:.3e} m, at the end {last:+.3e} m",
+            100.0 * worst / scale
+        );
+        assert!(
+            first < 0.005 * scale,
+            "shift {shift}: first cycle {first} m against {scale} m"
+        );
+        assert!(
+            worst < 0.025 * scale,
+            "shift {shift}: largest difference {worst} m against {scale} m"
+        );
+        final_errors.push(last);
+    }
+    let mean = final_errors.iter().sum::<f64>() / final_errors.len() as f64;
+    println!("mean final difference {mean:+.3e} m");
     assert!(
-        worst < 0.01 * scale,
-        "largest difference {worst} m against a slip of {scale} m"
+        mean.abs() < 0.005 * scale,
+        "mean final difference {mean} m against {scale} m"
     );
 }
 

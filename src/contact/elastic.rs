@@ -3,8 +3,9 @@
 //! joint whose cells are all closed (a joint at rest), four cells at a time. The equations are in
 //! `docs/theory.md` ("Sub-contact kinematics", "Exact integration over the cells").
 
+use super::closed_lanes::{closed_groups, ClosedJoint, LaneBuild};
 use super::kernel::{tension_free, CellRule, ExactCells};
-use super::lanes::{face_gap, increment, Kinematics};
+use super::lanes::{face_gap, increment, Kinematics, LaneSums, LANES};
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::ForceMoments;
 use super::spread::{cell_response, CellResponse};
@@ -32,6 +33,7 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
     whole: WholeContact<'_>,
     axes: JointAxes,
     dt: Real,
+    lanes: LaneBuild,
 ) -> (ForceMoments, Real, Real) {
     let virgin = L::State::default();
     let mut sums = ForceMoments::default();
@@ -40,14 +42,26 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
     // `Σ J_xx`, `Σ J_yy` of the all-closed cells in the elastic regime, for their spread energy.
     let mut closed_moments = Vector2::ZERO;
     // A contact whose cells are all closed (a joint at rest) takes a shorter way through them,
-    // doing the operations of the loop below for such cells, in its order (the same bits): each
-    // virgin cell's force is the law's elastic step at its anchor gap, with no test of the
-    // cell. At the first cell that does not fit (a failed state, a law leaving its regime) the
-    // loop below takes over from it, with the `Σ J` of the cells before it.
+    // doing the operations of the loop below for such cells (each cell gets the same bits):
+    // each virgin cell's force is the law's elastic step at its anchor gap, with no test of the
+    // cell, four cells at a time and then one at a time (the forces summed per lane, then in
+    // cell order). At the first cell that does not fit (a failed state, a law leaving its
+    // regime) the loop below takes over from it, with the `Σ J` of the cells before it.
     let mut start = 0;
     if let (Some(g), Some(e), WholeContact::Closed(cells)) = (face, exact, whole) {
         if e.virgin_without_tension {
-            for sub in subs.iter_mut() {
+            // Four cells at a time while they fit (`closed_lanes.rs`), then one at a time.
+            let mut lane_sums = LaneSums::default();
+            let (groups, _) = subs.as_chunks_mut::<LANES>();
+            let joint = ClosedJoint {
+                regime,
+                kinematics,
+                gap: g,
+                virgin: &virgin,
+            };
+            start = LANES * closed_groups(lanes, groups, &joint, &mut lane_sums, &mut dissipated);
+            sums = lane_sums.total().0;
+            for sub in subs[start..].iter_mut() {
                 if sub.state != virgin {
                     break;
                 }
@@ -295,13 +309,17 @@ mod tests {
         }
     }
 
-    /// The all-closed way through a joint gives the same bits as the cell-by-cell loop: for a
-    /// dry joint whose cells stick and slide, and for a cohesive one whose failed cells and
-    /// slides (outside the elastic regime's cover) send the rest of the joint back to that loop.
+    /// The all-closed way through a joint gives each cell the bits of the cell-by-cell loop, and
+    /// sums that agree with its sums to round-off (they are taken per lane); its two builds
+    /// (arrays, AVX) give the same bits, sums included. For a dry joint whose cells stick and
+    /// slide, a linear elastic one, and a cohesive one whose failed cells and slides (outside the
+    /// elastic regime's cover) send the rest of the joint back to that loop, at several cell
+    /// counts (groups of four and a remainder).
     #[test]
-    fn the_all_closed_way_gives_the_bits_of_the_cell_by_cell_loop() {
+    fn the_all_closed_way_gives_each_cell_the_bits_of_the_cell_by_cell_loop() {
         use crate::contact::CellSummary;
-        use crate::law::{CoulombSlip, CoulombState, JointForce};
+        use crate::law::AnyState;
+        use crate::law::{AnyLaw, CoulombSlip, CoulombState, JointForce, LinearElastic};
         let kinematics = Kinematics {
             at_origin: Vector::new(-2e-7, 3e-6, -1e-6),
             per_x: Vector::new(1e-6, -4e-6, 2e-6),
@@ -309,54 +327,94 @@ mod tests {
         };
         let g = (-4e-5, 1e-4, -2e-4);
         let axes = JointAxes::from_normal(Vector::Z);
-        let cells = |failed: &[usize]| -> Vec<SubContact<CoulombState>> {
-            (0..12)
+        let cells = |count: usize, failed: &[usize]| -> Vec<SubContact<AnyState>> {
+            (0..count)
                 .map(|k| SubContact {
-                    plane: Vector2::new(-0.075 + 0.05 * (k % 4) as Real, -0.05 + 0.05 * (k / 4) as Real),
-                    area: 0.05 * 0.05,
+                    plane: Vector2::new(-0.075 + 0.05 * (k % 4) as Real, -0.05 + 0.025 * (k / 4) as Real),
+                    area: 0.05 * 0.025,
                     gap: -4e-5,
                     // Some cells near their strength, so that a few slide.
                     force: JointForce {
                         normal: 100.0,
-                        shear: Vector2::new(40.0 + 5.0 * k as Real, -8.0),
+                        shear: Vector2::new(40.0 + 5.0 * k as Real, -8.0 + (k % 3) as Real),
                     },
                     slip: 0.0,
-                    half: [0.025, 0.025],
+                    half: [0.025, 0.0125],
                     status: JointStatus::Elastic,
-                    state: CoulombState {
-                        failed: failed.contains(&k),
+                    state: AnyState {
+                        coulomb: CoulombState {
+                            failed: failed.contains(&k),
+                        },
                     },
                 })
                 .collect()
         };
-        let dry = CoulombSlip::dry(1e9, 4e8, 30.0).expect("law");
-        let cohesive = CoulombSlip::new(1e9, 4e8, 35.0, 30.0, 2e4, 0.0).expect("law");
-        for (law, failed) in [(dry, vec![]), (cohesive, vec![]), (cohesive, vec![5, 9])] {
-            let regime = law.elastic_regime().expect("a regime");
-            let exact = ExactCells::of(&law, Some(g));
-            let mut fast = cells(&failed);
-            let summary = CellSummary::of(&fast);
-            let whole = WholeContact::of(g, &summary);
-            assert!(
-                matches!(whole, WholeContact::Closed(_)),
-                "the joint is closed everywhere"
-            );
-            let mut slow = fast.clone();
-            let a = update_elastic_first(&mut fast, &law, &regime, &kinematics, Some(g), exact, whole, axes, 1e-4);
-            let b = update_elastic_first(
-                &mut slow,
-                &law,
-                &regime,
-                &kinematics,
-                Some(g),
-                exact,
-                WholeContact::Mixed,
-                axes,
-                1e-4,
-            );
-            assert_eq!(fast, slow, "{law:?}, failed {failed:?}");
-            assert_eq!((a.0, a.1.to_bits(), a.2.to_bits()), (b.0, b.1.to_bits(), b.2.to_bits()));
-            assert!(fast.iter().any(|s| s.status == JointStatus::Sliding) || law.cohesion() > 0.0);
+        let dry = AnyLaw::Coulomb(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
+        let cohesive = AnyLaw::Coulomb(CoulombSlip::new(1e9, 4e8, 35.0, 30.0, 2e4, 0.0).expect("law"));
+        let elastic = AnyLaw::Elastic(LinearElastic {
+            normal_stiffness: 1e9,
+            shear_stiffness: 4e8,
+        });
+        let mut slid = 0;
+        for count in [4, 14, 16] {
+            for (law, failed) in [
+                (dry, vec![]),
+                (elastic, vec![]),
+                (cohesive, vec![]),
+                (cohesive, vec![5, 9]),
+            ] {
+                let regime = law.elastic_regime().expect("a regime");
+                let exact = ExactCells::of(&law, Some(g));
+                let start = cells(count, &failed);
+                let summary = CellSummary::of(&start);
+                let whole = WholeContact::of(g, &summary);
+                assert!(
+                    matches!(whole, WholeContact::Closed(_)),
+                    "the joint is closed everywhere"
+                );
+                let mut builds = vec![LaneBuild::Portable];
+                #[cfg(target_arch = "x86_64")]
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    builds.push(LaneBuild::Avx2);
+                }
+                let mut slow = start.clone();
+                let b = update_elastic_first(
+                    &mut slow,
+                    &law,
+                    &regime,
+                    &kinematics,
+                    Some(g),
+                    exact,
+                    WholeContact::Mixed,
+                    axes,
+                    1e-4,
+                    LaneBuild::Portable,
+                );
+                slid += slow.iter().filter(|s| s.status == JointStatus::Sliding).count();
+                let mut first = None;
+                for build in builds {
+                    let mut fast = start.clone();
+                    let a = update_elastic_first(
+                        &mut fast,
+                        &law,
+                        &regime,
+                        &kinematics,
+                        Some(g),
+                        exact,
+                        whole,
+                        axes,
+                        1e-4,
+                        build,
+                    );
+                    assert_eq!(fast, slow, "{law:?}, {count} cells, failed {failed:?}, {build:?}");
+                    assert!(a.0.matches(&b.0), "{:?} vs {:?}", a.0, b.0);
+                    assert_eq!(a.1.to_bits(), b.1.to_bits(), "dissipated in cell order");
+                    assert!((a.2 - b.2).abs() <= 1e-12 * b.2.abs(), "spread energy");
+                    let bits = (a.0, a.1.to_bits(), a.2.to_bits());
+                    assert_eq!(*first.get_or_insert(bits), bits, "the builds agree bit for bit");
+                }
+            }
         }
+        assert!(slid > 10, "{slid} cells slid");
     }
 }

@@ -45,6 +45,8 @@ pub(crate) struct KernelContext {
     /// Rayleigh stiffness-proportional coefficient `b` (s).
     pub stiffness_damping: Real,
     pub mode: DisplacementMode,
+    /// How the all-closed joints' cells are computed (the same bits either way).
+    pub lanes: super::LaneBuild,
 }
 
 impl KernelContext {
@@ -168,7 +170,18 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         (sums, dissipated, spread_energy) = match face_gap_coefficients {
             Some(g) => {
                 let whole = WholeContact::of(g, &pair.cells);
-                update_elastic_first(subs, law, &regime, &kinematics, Some(g), exact, whole, axes, dt)
+                update_elastic_first(
+                    subs,
+                    law,
+                    &regime,
+                    &kinematics,
+                    Some(g),
+                    exact,
+                    whole,
+                    axes,
+                    dt,
+                    ctx.lanes,
+                )
             }
             None => update_elastic_first(
                 subs,
@@ -180,6 +193,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 WholeContact::Mixed,
                 axes,
                 dt,
+                ctx.lanes,
             ),
         };
         done = subs.len();

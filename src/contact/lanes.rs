@@ -21,15 +21,15 @@ pub(crate) const LANES: usize = 4;
 
 /// Four values, one per lane.
 #[derive(Debug, Clone, Copy, Default)]
-struct F4([Real; LANES]);
+pub(crate) struct F4(pub(crate) [Real; LANES]);
 
 impl F4 {
     #[inline(always)]
-    fn splat(x: Real) -> Self {
+    pub(crate) fn splat(x: Real) -> Self {
         Self([x; LANES])
     }
     #[inline(always)]
-    fn from_fn(f: impl FnMut(usize) -> Real) -> Self {
+    pub(crate) fn from_fn(f: impl FnMut(usize) -> Real) -> Self {
         Self(std::array::from_fn(f))
     }
     /// Lanes added in order: `((l₀ + l₁) + l₂) + l₃`.
@@ -128,14 +128,24 @@ pub(crate) struct ContactFrame {
 /// lane.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct LaneSums {
-    force: [F4; 3],
-    per_x: [F4; 3],
-    per_y: [F4; 3],
+    pub(crate) force: [F4; 3],
+    pub(crate) per_x: [F4; 3],
+    pub(crate) per_y: [F4; 3],
     /// Energy dissipated by the law, in sub-contact order.
     dissipated: Real,
 }
 
 impl LaneSums {
+    /// Adds four forces `f = (F_n, F_t₁, F_t₂)` at plane coordinates `(x, y)`, lane-wise.
+    #[inline(always)]
+    pub(crate) fn add(&mut self, f: [F4; 3], x: F4, y: F4) {
+        for (k, f) in f.into_iter().enumerate() {
+            self.force[k] = self.force[k] + f;
+            self.per_x[k] = self.per_x[k] + f * x;
+            self.per_y[k] = self.per_y[k] + f * y;
+        }
+    }
+
     /// The lane sums added in lane order, and the dissipated energy.
     pub fn total(self) -> (ForceMoments, Real) {
         let v = |s: [F4; 3]| Vector::new(s[0].sum(), s[1].sum(), s[2].sum());
@@ -182,9 +192,5 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
         F4::from_fn(|l| group[l].force.shear.x),
         F4::from_fn(|l| group[l].force.shear.y),
     ];
-    for (k, f) in f.into_iter().enumerate() {
-        sums.force[k] = sums.force[k] + f;
-        sums.per_x[k] = sums.per_x[k] + f * x;
-        sums.per_y[k] = sums.per_y[k] + f * y;
-    }
+    sums.add(f, x, y);
 }

@@ -1,6 +1,7 @@
 //! Contacts between block pairs: the [`Contact`] trait, typed ids, sub-contact state and the
 //! per-sub-contact kinematics kernel.
 
+mod closed_lanes;
 mod elastic;
 mod kernel;
 mod lanes;
@@ -13,6 +14,7 @@ mod view;
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
+pub(crate) use closed_lanes::LaneBuild;
 pub(crate) use kernel::{face_gap_coefficients, tension_free, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
 pub(crate) use nodes::{node_frame, stored_node_frame, update_nodes};

@@ -11,7 +11,7 @@
 
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    update_contact, update_nodes, ContactPair, ContactReference, ContactWrench, KernelContext, SubContact,
+    update_contact, update_nodes, ContactPair, ContactReference, ContactWrench, KernelContext, LaneBuild, SubContact,
     SubContactRecord,
 };
 use crate::geometry::ContactKind;
@@ -139,13 +139,14 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             return;
         }
         let _ = avx2;
-        self.run(chunk);
+        self.run(chunk, LaneBuild::Portable);
     }
 
     /// Updates one chunk of contacts and their sub-contacts, writes their wrenches and adds
     /// their totals to the chunk's sums.
     #[inline(always)]
-    fn run(&self, chunk: ContactSlices<'_, L::State>) {
+    fn run(&self, chunk: ContactSlices<'_, L::State>, lanes: LaneBuild) {
+        let ctx = KernelContext { lanes, ..self.ctx };
         let ContactSlices {
             first,
             pairs,
@@ -170,7 +171,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                     (&a.state, ra, a.shape()),
                     (&b.state, rb, b.shape()),
                     &self.laws[p.law as usize],
-                    self.ctx,
+                    ctx,
                     watch,
                 )
             } else {
@@ -182,7 +183,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                     (&a.state, ra),
                     (&b.state, rb),
                     &self.laws[p.law as usize],
-                    self.ctx,
+                    ctx,
                     if p.host_is_a { a.radius } else { b.radius },
                     watch,
                 )
@@ -217,6 +218,6 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     unsafe fn run_avx2(&self, chunk: ContactSlices<'_, L::State>) {
-        self.run(chunk);
+        self.run(chunk, LaneBuild::Avx2);
     }
 }

@@ -174,6 +174,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             impact_horizon: 2.0 * self.dt,
             stiffness_damping: self.integrator.damping().stiffness_coefficient(),
             mode: self.params.mode,
+            lanes: crate::contact::LaneBuild::Portable,
         };
         // The records run index for index with the sub-contacts (kept so by detection and
         // checkpoint load).

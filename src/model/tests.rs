@@ -79,6 +79,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
         impact_horizon: 0.0,
         stiffness_damping: 0.0,
         mode: model.state.params.mode,
+        lanes: crate::contact::LaneBuild::Portable,
     };
     let (mut grouped_subs, mut single_subs) = (model.state.subs.clone(), model.state.subs.clone());
     let (mut grouped_records, mut single_records) = (model.state.sub_records.clone(), model.state.sub_records.clone());
