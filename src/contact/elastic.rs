@@ -85,28 +85,27 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
             };
         }
     }
-    // An open, unloaded virgin cell that the law keeps open only takes its smallest gap (as
-    // below: the elastic step gives nothing for a positive gap, and `stays_separated` holds).
+    // An open, unloaded virgin cell that the law keeps open only takes its smallest gap
+    // ([`stays_open_cell`]).
     let open_cells = match (face, exact) {
         (Some(g), Some(e)) if e.virgin_without_tension => Some((g, e.slope.abs())),
         _ => None,
     };
+    // A joint that opens from its first cell on (a joint standing open: a quarter of a settled
+    // wall's cells) takes those cells in a loop of its own, doing the loop below's skip.
+    if let (Some((g, slope)), WholeContact::Mixed) = (open_cells, whole) {
+        for sub in subs.iter_mut() {
+            if !stays_open_cell(law, sub, &virgin, g, slope) {
+                break;
+            }
+            start += 1;
+        }
+    }
     for sub in subs[start..].iter_mut() {
         let (x, y) = (sub.plane.x, sub.plane.y);
         if let Some((g, slope)) = open_cells {
-            if sub.status == JointStatus::Open
-                && sub.force.normal == 0.0
-                && sub.force.shear == Vector2::ZERO
-                && sub.state == virgin
-            {
-                let anchor_gap = face_gap(g, x, y);
-                let half = sub.half();
-                let spread = slope.x * half.x + slope.y * half.y;
-                let gap = anchor_gap - spread;
-                if anchor_gap >= spread && gap > 0.0 && law.stays_open(sub.area, gap, &sub.state) {
-                    sub.gap = gap;
-                    continue;
-                }
+            if stays_open_cell(law, sub, &virgin, g, slope) {
+                continue;
             }
         }
         let [du_n, du_1, du_2] = increment(kinematics, x, y);
@@ -173,6 +172,37 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
             * (closed_moments.x * e.slope.x * e.slope.x + closed_moments.y * e.slope.y * e.slope.y);
     }
     (sums, dissipated, spread_energy)
+}
+
+/// Whether `sub` is an open, unloaded `virgin` cell that the law keeps open all over (the
+/// gap over its rectangle, `face_gap(g, x, y) ∓ (|s_x| h_x + |s_y| h_y)` for the slope's
+/// magnitudes `slope`, positive): if so it takes its smallest gap and needs nothing else (the
+/// elastic step gives nothing for a positive gap, and `stays_separated` holds).
+#[inline(always)]
+fn stays_open_cell<L: ConstitutiveLaw>(
+    law: &L,
+    sub: &mut SubContact<L::State>,
+    virgin: &L::State,
+    g: (Real, Real, Real),
+    slope: Vector2,
+) -> bool {
+    if !(sub.status == JointStatus::Open
+        && sub.force.normal == 0.0
+        && sub.force.shear == Vector2::ZERO
+        && sub.state == *virgin)
+    {
+        return false;
+    }
+    let anchor_gap = face_gap(g, sub.plane.x, sub.plane.y);
+    let half = sub.half();
+    let spread = slope.x * half.x + slope.y * half.y;
+    let gap = anchor_gap - spread;
+    if anchor_gap >= spread && gap > 0.0 && law.stays_open(sub.area, gap, &sub.state) {
+        sub.gap = gap;
+        true
+    } else {
+        false
+    }
 }
 
 /// Stores the elastic regime's step (`force`, `status`) at the law gap `gap` in `sub`, with its
