@@ -789,3 +789,54 @@ fn inconsistent_histories_are_refused() -> Result<()> {
     assert!(err.to_string().contains("10 times for 9 steps"), "{err}");
     Ok(())
 }
+
+/// A running-bond wall's bricks are copies of two bricks (whole and half) sharing their shapes,
+/// placed where the spec puts them (corners to round-off), and they share them again once read
+/// back from a checkpoint: a wall's memory per block does not grow on restart.
+#[test]
+fn a_walls_bricks_share_their_shapes_also_after_a_checkpoint() -> Result<()> {
+    let spec = WallSpec {
+        bricks_per_course: 4,
+        courses: 5,
+        ..WallSpec::default()
+    };
+    let bricks = running_bond_wall(&spec)?;
+    let distinct = |blocks: &[RigidBlock]| {
+        let mut shapes: Vec<*const voussoir::geometry::Polyhedron> = Vec::new();
+        for b in blocks {
+            let p = std::ptr::from_ref(b.shape());
+            if !shapes.contains(&p) {
+                shapes.push(p);
+            }
+        }
+        shapes.len()
+    };
+    // The base, a whole brick, a half brick.
+    assert_eq!(distinct(&bricks), 3);
+    // Course 1 starts with a half brick: x from 0 to l/2.
+    let (l, w, h) = (spec.brick.x, spec.brick.y, spec.brick.z);
+    let half = &bricks[1 + spec.bricks_per_course];
+    let pose = half.state().pose;
+    let corners: Vec<Vector> = half
+        .shape()
+        .vertices()
+        .iter()
+        .map(|v| pose.transform_point(*v))
+        .collect();
+    let lo = corners.iter().fold(Vector::splat(Real::INFINITY), |m, c| m.min(*c));
+    let hi = corners.iter().fold(Vector::splat(Real::NEG_INFINITY), |m, c| m.max(*c));
+    assert!((lo - Vector::new(0.0, 0.0, h)).length() < 1e-12, "{lo}");
+    assert!((hi - Vector::new(0.5 * l, w, 2.0 * h)).length() < 1e-12, "{hi}");
+
+    let mut model = moving_wall()?;
+    model.run_steps(5)?;
+    assert_eq!(distinct(model.blocks()), 3);
+    let dir = std::env::temp_dir().join(format!("voussoir-shared-shapes-{}", std::process::id()));
+    let path = dir.join("wall.json");
+    model.save_checkpoint(&path)?;
+    let restored: Model = Model::load_checkpoint(&path)?;
+    assert_eq!(distinct(restored.blocks()), 3);
+    assert_eq!(fingerprint(&restored), fingerprint(&model));
+    std::fs::remove_dir_all(&dir).ok();
+    Ok(())
+}

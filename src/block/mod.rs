@@ -8,6 +8,7 @@ use crate::geometry::{MassProperties, Polyhedron};
 pub use crate::ids::BlockId;
 use crate::ids::MaterialId;
 use crate::math::{is_finite_vector, Pose, Real, Vector};
+use std::sync::Arc;
 
 /// What a single degree of freedom does.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -193,7 +194,9 @@ pub struct RigidBlock {
     free: bool,
     fixity: Fixity,
     material: MaterialId,
-    shape: Box<Polyhedron>,
+    /// Shared between blocks of the same shape (the builders' bricks): a shape is immutable
+    /// once built.
+    shape: Arc<Polyhedron>,
     name: String,
     density: Real,
     pub(crate) initial_pose: Pose,
@@ -234,7 +237,7 @@ impl RigidBlock {
         Self {
             name: name.to_owned(),
             radius: shape.radius(),
-            shape: Box::new(shape),
+            shape: Arc::new(shape),
             density,
             mass,
             material: MaterialId::default(),
@@ -294,6 +297,21 @@ impl RigidBlock {
         self.state.pose = pose * self.state.pose;
         self.initial_pose = self.state.pose;
         self.state.angular_momentum = self.world_inertia_times(self.state.angular_velocity);
+        self
+    }
+
+    /// Makes this block share `other`'s shape when the two are the same bit for bit.
+    pub(crate) fn share_shape_of(&mut self, other: &RigidBlock) -> bool {
+        let same = Arc::ptr_eq(&self.shape, &other.shape) || self.shape.same_as(&other.shape);
+        if same {
+            self.shape = Arc::clone(&other.shape);
+        }
+        same
+    }
+
+    /// This block under another name (the builders' copies of one brick).
+    pub(crate) fn renamed(mut self, name: &str) -> Self {
+        name.clone_into(&mut self.name);
         self
     }
 
@@ -384,7 +402,7 @@ impl RigidBlock {
     }
 
     pub(crate) fn restore(&mut self) -> Result<()> {
-        self.shape.restore()?;
+        Arc::make_mut(&mut self.shape).restore()?;
         self.radius = self.shape.radius();
         self.free = self.fixity.is_free();
         self.validate()
@@ -442,6 +460,20 @@ impl Block for RigidBlock {
     }
     fn material(&self) -> MaterialId {
         self.material
+    }
+}
+
+/// Makes blocks whose shapes are the same bit for bit share one (a checkpoint's bricks, each
+/// read on its own): memory, not physics.
+pub(crate) fn share_shapes(blocks: &mut [RigidBlock]) {
+    let mut first: std::collections::HashMap<u64, Vec<usize>> = std::collections::HashMap::new();
+    for i in 0..blocks.len() {
+        let (earlier, rest) = blocks.split_at_mut(i);
+        let block = &mut rest[0];
+        let candidates = first.entry(block.shape.vertex_hash()).or_default();
+        if !candidates.iter().any(|&j| block.share_shape_of(&earlier[j])) {
+            candidates.push(i);
+        }
     }
 }
 

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::block::{Fixity, RigidBlock};
 use crate::error::{positive, Result};
 use crate::law::MaterialId;
-use crate::math::{Real, Vector};
+use crate::math::{Pose, Real, Vector};
 
 /// A running-bond wall: courses of bricks along x, stacked in z, one brick thick in y, on a fixed
 /// base slab. Odd courses are shifted by half a brick and closed with half bricks at both ends.
@@ -89,6 +89,11 @@ pub fn running_bond_wall(spec: &WallSpec) -> Result<Vec<RigidBlock>> {
         .with_fixity(Fixity::FIXED)
         .with_material(spec.base_material),
     );
+    let centred = |length: Real| {
+        let half = 0.5 * Vector::new(length, w, h);
+        RigidBlock::cuboid("brick", -half, half, spec.density).map(|b| b.with_material(spec.material))
+    };
+    let (brick, half_brick) = (centred(l)?, centred(0.5 * l)?);
     for c in 0..spec.courses {
         let z0 = c as Real * h;
         let mut edges: Vec<Real> = Vec::with_capacity(spec.bricks_per_course + 2);
@@ -99,15 +104,21 @@ pub fn running_bond_wall(spec: &WallSpec) -> Result<Vec<RigidBlock>> {
             edges.extend((0..spec.bricks_per_course).map(|k| (k as Real + 0.5) * l));
             edges.push(length);
         }
+        let last = edges.len() - 2;
         for (k, x) in edges.windows(2).enumerate() {
+            // The half bricks that end the odd courses, else whole ones: copies of one brick
+            // each, placed at their centres, so that they share one shape.
+            let prototype = if c % 2 == 1 && (k == 0 || k == last) {
+                &half_brick
+            } else {
+                &brick
+            };
+            let centre = Vector::new(0.5 * (x[0] + x[1]), 0.5 * w, z0 + 0.5 * h);
             blocks.push(
-                RigidBlock::cuboid(
-                    &format!("brick c{c} k{k}"),
-                    Vector::new(x[0], 0.0, z0),
-                    Vector::new(x[1], w, z0 + h),
-                    spec.density,
-                )?
-                .with_material(spec.material),
+                prototype
+                    .clone()
+                    .transformed(Pose::from_translation(centre))
+                    .renamed(&format!("brick c{c} k{k}")),
             );
         }
     }

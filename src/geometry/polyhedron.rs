@@ -460,6 +460,32 @@ impl Polyhedron {
         Ok(())
     }
 
+    /// Whether `other` is this shape bit for bit: the same vertices (as bits: `-0.0` is not
+    /// `0.0`), faces and edges. Derived data follow from these.
+    pub(crate) fn same_as(&self, other: &Self) -> bool {
+        let bits = |v: &Vector| v.to_array().map(Real::to_bits);
+        self.vertices.len() == other.vertices.len()
+            && self
+                .vertices
+                .iter()
+                .zip(&other.vertices)
+                .all(|(a, b)| bits(a) == bits(b))
+            && self.faces == other.faces
+            && self.face_vertices == other.face_vertices
+            && self.edges == other.edges
+    }
+
+    /// A hash of the vertices' bits (for [`Polyhedron::same_as`] lookups).
+    pub(crate) fn vertex_hash(&self) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for v in &self.vertices {
+            for x in v.to_array() {
+                h = (h ^ x.to_bits()).wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+        h
+    }
+
     /// Vertices in the body frame (m).
     pub fn vertices(&self) -> &[Vector] {
         &self.vertices

@@ -370,6 +370,8 @@ where
             }
             model.add_block(b)?;
         }
+        // Blocks that were built from one shape share it again (a wall's bricks).
+        crate::block::share_shapes(&mut model.state.blocks);
         model.state.laws = snap.joints;
         model.state.integrator = Box::new(CentralDifference::new(snap.damping));
         model.state.pairs = pairs;
