@@ -60,7 +60,7 @@ pub(crate) fn closed_groups<S: PartialEq>(
 
 /// [`closed_groups`] on arrays of four.
 #[inline(always)]
-pub(crate) fn closed_groups_portable<S: PartialEq>(
+fn closed_groups_portable<S: PartialEq>(
     groups: &mut [[SubContact<S>; LANES]],
     joint: &ClosedJoint<'_, S>,
     sums: &mut LaneSums,
