@@ -165,11 +165,11 @@ pub enum Error {
         /// The law type it is being loaded as.
         loading: String,
     },
-    /// A checkpointed contact whose law index is not the one the law table gives its blocks'
-    /// pair of materials.
+    /// A checkpointed contact whose law index is not the one the law table gives its pair of
+    /// blocks (their interface's own law, else their materials').
     #[error(
-        "checkpoint contact {contact} between blocks {a} and {b} uses law {law}, but their materials \
-         ({material_a}, {material_b}) map to {expected}"
+        "checkpoint contact {contact} between blocks {a} and {b} uses law {law}, but their interface \
+         and materials ({material_a}, {material_b}) map to {expected}"
     )]
     CheckpointContactLaw {
         /// Index of the contact in the file (`contacts[contact]`).
@@ -184,7 +184,7 @@ pub enum Error {
         material_b: MaterialId,
         /// The law index stored in the file.
         law: u32,
-        /// The law index the law table gives (`"no law"` when it has none for the pair).
+        /// The law index the law table gives the pair (`"no law"` when it has none).
         expected: String,
     },
     /// A checkpointed block whose stored derived data (mass properties, face planes, angular

@@ -840,3 +840,79 @@ fn a_walls_bricks_share_their_shapes_also_after_a_checkpoint() -> Result<()> {
     std::fs::remove_dir_all(&dir).ok();
     Ok(())
 }
+
+/// Every way a law reaches a contact survives a checkpoint and the run goes on bit for bit: a
+/// pair of materials, an interface's own law set before the first step, one set while the
+/// contact exists, an interface law replaced, and a law set after the last step (the contact
+/// still holds its old law until the next step's detection, which the checkpoint owes).
+#[test]
+fn every_way_a_law_reaches_a_contact_reloads_bit_identically() -> Result<()> {
+    let build = || -> Result<Model> {
+        let mut model: Model = Model::new(ModelParameters::default())?;
+        model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+        model.set_joint_law(MaterialId(0), MaterialId(1), CoulombSlip::dry(2e9, 8e8, 35.0)?)?;
+        model.add_block(common::fixed_slab("base").with_material(MaterialId(1)))?;
+        model.add_block(common::cube("low", Vector::ZERO))?;
+        model.add_block(common::cube("high", Vector::new(0.0, 0.0, common::CUBE_EDGE)))?;
+        Ok(model)
+    };
+    let weak = || CoulombSlip::dry(5e8, 2e8, 20.0);
+    type Setup = fn(&mut Model, &dyn Fn() -> Result<CoulombSlip>) -> Result<()>;
+    let cases: [(&str, Setup); 5] = [
+        ("materials only", |m, _| m.run_steps(60)),
+        ("interface before the first step", |m, weak| {
+            m.set_interface_law(BlockId(1), BlockId(2), weak()?)?;
+            m.run_steps(60)
+        }),
+        ("interface set while in contact", |m, weak| {
+            m.run_steps(30)?;
+            m.set_interface_law(BlockId(0), BlockId(1), weak()?)?;
+            m.run_steps(30)
+        }),
+        ("interface replaced", |m, weak| {
+            m.set_interface_law(BlockId(2), BlockId(1), weak()?)?;
+            m.run_steps(30)?;
+            m.set_interface_law(BlockId(1), BlockId(2), CoulombSlip::dry(7e8, 3e8, 25.0)?)?;
+            m.run_steps(30)
+        }),
+        ("laws set after the last step", |m, weak| {
+            m.run_steps(60)?;
+            m.set_interface_law(BlockId(1), BlockId(2), weak()?)?;
+            m.set_joint_law(MaterialId(0), MaterialId(1), CoulombSlip::dry(3e9, 1.2e9, 40.0)?)
+        }),
+    ];
+    for (name, setup) in cases {
+        let mut model = build()?;
+        setup(&mut model, &weak)?;
+        assert_eq!(model.contacts().len(), 2, "{name}");
+        let text = model.to_checkpoint_string()?;
+        let mut restarted = Model::<CoulombSlip>::from_checkpoint_str(&text)
+            .unwrap_or_else(|e| panic!("{name}: the checkpoint does not load: {e}"));
+        assert_eq!(fingerprint(&model), fingerprint(&restarted), "{name}: as loaded");
+        // Saved again, the same document; but for the stability bounds of a checkpoint that owes a
+        // detection, which the next step re-evaluates and the loader does not restore.
+        let document = |text: &str| {
+            let mut json: serde_json::Value = serde_json::from_str(text).expect("json");
+            if json["pending_detection"] == serde_json::json!(true) {
+                json["bounds"] = serde_json::Value::Null;
+                json["checksum"] = serde_json::Value::Null;
+            }
+            json
+        };
+        assert!(
+            document(&restarted.to_checkpoint_string()?) == document(&text),
+            "{name}: saved again, another document"
+        );
+        model.run_steps(200)?;
+        restarted.run_steps(200)?;
+        assert_eq!(fingerprint(&model), fingerprint(&restarted), "{name}: 200 steps on");
+        // The contacts hold the laws detection gives them.
+        for c in model.contacts() {
+            let (a, b) = c.blocks();
+            let (ma, mb) = (model.block(a)?.material(), model.block(b)?.material());
+            let expected = model.law_table().index_for((a, ma), (b, mb));
+            assert_eq!(Some(c.law_index() as u32), expected, "{name}: contact {a}–{b}");
+        }
+    }
+    Ok(())
+}

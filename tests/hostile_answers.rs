@@ -292,7 +292,9 @@ fn limit_analysis_messages_and_extreme_live_loads() {
             &LimitOptions::default(),
         )
         .expect("solved");
-    assert_eq!(r.multiplier, 0.0);
+    // Zero to the solver's round-off on either side; below zero it is reported as 0, never
+    // negative (it was −1.14e-24 before the clamp, and is 9.3e-28 with today's geometry).
+    assert!(r.multiplier >= 0.0 && r.multiplier < 1e-12 * weight, "{}", r.multiplier);
 }
 
 /// A checkpoint whose tested pair's slack was raised and resealed is refused: the slack is

@@ -22,6 +22,7 @@ mod history;
 mod hostile_answers;
 mod hostile_files;
 mod hostile_input;
+mod inertia;
 mod limit_analysis;
 mod load_history;
 mod mixed_laws;

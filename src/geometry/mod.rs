@@ -3,6 +3,7 @@
 
 mod broad_phase;
 pub mod clip;
+mod inertia;
 mod narrow_phase;
 mod polyhedron;
 

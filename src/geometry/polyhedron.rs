@@ -1,13 +1,14 @@
 //! Convex polyhedra in their principal frame, with exact mass properties.
 
+use super::inertia::{symmetric_eigen, volume_moments};
 use super::narrow_phase::nodes::FaceGrid;
-use parry3d_f64::shape::{ConvexPolyhedron, Shape};
+use parry3d_f64::shape::ConvexPolyhedron;
 use parry3d_f64::transformation::try_convex_hull;
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector};
+use crate::math::{is_finite_vector, Pose, Real, Vector};
 
 /// One planar face of a [`Polyhedron`], in the body frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -231,23 +232,17 @@ impl Polyhedron {
                 reason: "the vertices are flat (no extent in some direction)".into(),
             });
         }
-        let world =
-            ConvexPolyhedron::from_convex_mesh(verts.clone(), tris).ok_or_else(|| Error::DegenerateGeometry {
-                block: name.to_owned(),
-                reason: "the faces do not form a closed convex manifold".into(),
-            })?;
-        // Subtract a reference point first so that mass properties keep their digits far from the origin.
-        let reference = verts.iter().copied().sum::<Vector>() / verts.len() as Real;
-        let shifted: Vec<Vector> = world.points().iter().map(|p| *p - reference).collect();
-        let shifted_poly =
-            ConvexPolyhedron::from_convex_mesh(shifted, tris).ok_or_else(|| Error::DegenerateGeometry {
-                block: name.to_owned(),
-                reason: "the faces do not form a closed convex manifold".into(),
-            })?;
-        let mp = shifted_poly.mass_properties(1.0);
-        let volume = mp.mass();
+        let world = ConvexPolyhedron::from_convex_mesh(verts, tris).ok_or_else(|| Error::DegenerateGeometry {
+            block: name.to_owned(),
+            reason: "the faces do not form a closed convex manifold".into(),
+        })?;
+        // Our own moments and eigen solver, not parry's (`inertia.rs` says why); the moments are
+        // taken about the vertices' mean and then the centroid, so that they keep their digits
+        // far from the origin.
+        let moments = volume_moments(world.points(), tris);
+        let volume = moments.volume;
         // Each term of the divergence sum is a triple product of one x, one y and one z
-        // coordinate relative to `reference`, so its round-off is of the order of
+        // coordinate relative to the reference point, so its round-off is of the order of
         // ε·(extent.x·extent.y·extent.z) whatever the orientation: compare the volume with the
         // bounding box's, not with the cube of the diagonal, which refused long slender blocks
         // (a 600 km × 1 m × 0.23 m slab of 137,870 m³).
@@ -259,12 +254,12 @@ impl Polyhedron {
                 bounding_box,
             });
         }
-        let frame: Rotation = mp.principal_inertia_local_frame.normalize();
-        let com = mp.local_com;
+        let (unit_inertia, frame) = symmetric_eigen(moments.inertia);
+        let com = moments.centroid;
         let inv = frame.inverse();
-        let body: Vec<Vector> = shifted_poly.points().iter().map(|p| inv * (*p - com)).collect();
-        let pose = Pose::from_parts(reference + com, frame);
-        let shape = Self::from_body_mesh(name, body, tris, volume, mp.principal_inertia())?;
+        let body: Vec<Vector> = world.points().iter().map(|p| inv * (*p - com)).collect();
+        let pose = Pose::from_parts(com, frame);
+        let shape = Self::from_body_mesh(name, body, tris, volume, unit_inertia)?;
         Ok(PlacedPolyhedron { shape, pose })
     }
 
@@ -425,21 +420,26 @@ impl Polyhedron {
                 ));
             }
         }
-        let mp = self.parry().mass_properties(1.0);
-        let volume = mp.mass();
+        let mut tris: Vec<[u32; 3]> = Vec::new();
+        for i in 0..self.faces.len() {
+            let ids = self.face_loop(i);
+            tris.extend((1..ids.len() - 1).map(|k| [ids[0], ids[k], ids[k + 1]]));
+        }
+        let moments = volume_moments(&self.vertices, &tris);
+        let volume = moments.volume;
         if !(volume > 0.0 && (volume - self.volume).abs() <= 1e-9 * volume) {
             return differs("shape.volume".into(), &self.volume, &volume);
         }
-        if mp.local_com.length() > 1e-9 * radius {
+        if moments.centroid.length() > 1e-9 * radius {
             return Err((
                 "shape.vertices".into(),
                 format!(
                     "have their centroid at {:?}, not at the origin of the body frame",
-                    mp.local_com
+                    moments.centroid
                 ),
             ));
         }
-        let inertia = mp.reconstruct_inertia_matrix();
+        let inertia = moments.inertia;
         let scale = self.unit_inertia.abs().max_element();
         for i in 0..3 {
             for j in 0..3 {

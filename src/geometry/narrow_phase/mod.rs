@@ -379,7 +379,19 @@ pub fn detect(
             }
             ContactKind::Nodes => node_contact(a, b, n, params, seeds),
         };
-        if kept.is_some() {
+        // A kept face-face joint must still be the contact: its faces the most aligned and no
+        // part of either block outside them in the other (a stone toppling onto its next face).
+        let blind = match p.kind {
+            ContactKind::FaceFace { face_a, face_b } if kept.is_some() => {
+                let (fa, fb) = (face_a as usize, face_b as usize);
+                next_face_takes_over(a, fa, b, fb, tolerance)
+                    || !sees_the_overlap(&seeds[start..], axis.separation, a.shape.radius() + b.shape.radius())
+                    || vertex_outside_joint_inside(a, fa, &scratch.world_a, b)
+                    || vertex_outside_joint_inside(b, fb, &scratch.world_b, a)
+            }
+            _ => false,
+        };
+        if kept.is_some() && !blind {
             return kept;
         }
         seeds.truncate(start);
@@ -410,6 +422,67 @@ pub fn detect(
         seeds.truncate(start);
     }
     node_contact(a, b, n, params, seeds)
+}
+
+/// Whether a kept joint's sub-contacts see the blocks' overlap: the overlap along the separating
+/// axis (`-separation`, the least penetration, a lower bound on how deep any point of one block
+/// is in the other) may exceed the deepest sub-contact's only by the distance from a cell's
+/// anchor to its corner (the polygon's deepest corner lies in some cell). More means a part of
+/// a block outside the joint's faces has gone into the other: an irregular stone toppling on a
+/// slab (kept up to `COVERED_FACE_ANGLE`) whose next face, at a shallow angle to the first,
+/// comes down; its corner went 4.6 cm into the slab while the joint on the first face carried
+/// its weight with 0.05 mm overlaps (a sharp-block drop). Node contacts see every vertex and
+/// edge and are not asked.
+fn sees_the_overlap(seeds: &[SubcontactSeed], separation: Real, size: Real) -> bool {
+    if separation >= 0.0 {
+        return true;
+    }
+    let deepest = seeds.iter().map(|s| s.gap).fold(Real::INFINITY, Real::min);
+    let corner = seeds.iter().map(|s| s.half.length()).fold(0.0, Real::max);
+    // Round-off of the two depths, each a difference of coordinates of the blocks' size.
+    let round_off = 1e-12 * size;
+    -separation <= (-deepest).max(0.0) + corner + round_off
+}
+
+/// Whether another face of either block has turned nearer the joint's opposite face than the
+/// joint's own, and to within the face angle tolerance of it (`tolerance`: its cosine). A block
+/// rocking or toppling about an edge of its joint face turns its next face towards the other
+/// block; for an irregular stone whose next face meets the joint face at a shallow angle, that
+/// face lies nearly flat on the other block after a few degrees, overlapping it over its whole
+/// width while the joint measures gaps over the first face only. The contact is then found
+/// afresh. A cuboid's next face is 90° away: still beyond the tolerance when it becomes the more
+/// aligned (at 45°), so a rocking cuboid keeps its joint as before.
+fn next_face_takes_over(a: BlockGeometry<'_>, fa: usize, b: BlockGeometry<'_>, fb: usize, tolerance: Real) -> bool {
+    let na = a.pose.rotation * a.shape.faces()[fa].normal;
+    let nb = b.pose.rotation * b.shape.faces()[fb].normal;
+    let turned = |x: BlockGeometry<'_>, fx: usize, other: Vector| {
+        let g = x.shape.most_aligned_face(x.pose.rotation.inverse() * -other);
+        g != fx && -(x.pose.rotation * x.shape.faces()[g].normal).dot(other) >= tolerance
+    };
+    turned(b, fb, na) || turned(a, fa, nb)
+}
+
+/// Whether a vertex of `a` that is not on the joint's face `fa` lies inside `b` (`world_a`: the
+/// vertices of `a` in the world, as the separating-axis test left them): a kept face-face joint
+/// measures gaps over its two faces only, so such a vertex goes into `b` without a force. An
+/// irregular stone toppling on a slab about an edge of its joint face brings its next face down
+/// at a shallow angle; the joint must turn into nodes when that face's far corner touches, not
+/// once it is deep (`sees_the_overlap` catches that only a cell's size deep, and the node
+/// contact then found it 7 mm in and threw the stone up with 15 `m g h`).
+/// A vertex exactly on a face of `b` (within round-off of the blocks' size) is not inside.
+fn vertex_outside_joint_inside(a: BlockGeometry<'_>, fa: usize, world_a: &[Vector], b: BlockGeometry<'_>) -> bool {
+    let joint = a.shape.face_loop(fa);
+    let round_off = 1e-12 * (a.shape.radius() + b.shape.radius());
+    world_a.iter().enumerate().any(|(i, p)| {
+        if joint.contains(&(i as u32)) {
+            return false;
+        }
+        let local = b.pose.inverse_transform_point(*p);
+        b.shape
+            .faces()
+            .iter()
+            .all(|f| f.normal.dot(local) - f.offset < -round_off)
+    })
 }
 
 /// Faces of one block whose outward normals lie within this angle (rad, 10°) of each other are

@@ -303,13 +303,18 @@ where
                     "inconsistent block, law or sub-contact indices",
                 ));
             }
-            // The law is the one the blocks' materials map to (a contact is never given another).
+            // The law is the one detection gives the pair: the interface's own, else the one
+            // its materials map to. A law set since the last detection takes effect at the next
+            // step's full detection (`pending_detection`), so the contact may still hold the
+            // law it was detected with (any law of the table).
             let (material_a, material_b) = (
                 snap.blocks[p.a as usize].material(),
                 snap.blocks[p.b as usize].material(),
             );
-            let expected = snap.joints.index_of(material_a, material_b);
-            if expected != Some(p.law) {
+            let expected = snap
+                .joints
+                .index_for((BlockId(p.a), material_a), (BlockId(p.b), material_b));
+            if expected != Some(p.law) && !snap.pending_detection {
                 return Err(Error::CheckpointContactLaw {
                     contact: k,
                     a: BlockId(p.a),
