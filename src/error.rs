@@ -222,6 +222,22 @@ pub enum Error {
         /// The contact tolerance (m).
         tolerance: Real,
     },
+    /// A block added to a model that has already stepped overlaps one of its blocks by more than
+    /// the contact tolerance (the same layout before the first step is [`Error::InitialOverlap`]).
+    #[error(
+        "block {block:?} added after the first step overlaps block {other} by {depth:.3e} m, more than the \
+         contact tolerance {tolerance} m: move it clear"
+    )]
+    AddedBlockOverlap {
+        /// The name of the block being added (it has no id: it was not added).
+        block: String,
+        /// The block it overlaps.
+        other: BlockId,
+        /// Depth of the overlap (m).
+        depth: Real,
+        /// The contact tolerance (m).
+        tolerance: Real,
+    },
     /// A block's translation driven by a base motion was to be set free: the motion would put
     /// it back at the next step, and a model saved in between would not load.
     #[error(

@@ -560,16 +560,23 @@ fn edited_time_step_and_counters_are_refused() -> Result<()> {
     Ok(())
 }
 
-/// Two materials with two laws: a contact whose law index is the other pair's law is refused,
-/// naming the contact and its blocks.
-#[test]
-fn contact_law_index_must_be_its_materials_law() -> Result<()> {
+/// A slab of material 1 under two stacked cubes of material 0, with a law for each pair of
+/// materials (laws 0 and 1).
+fn two_cubes_on_a_slab_of_another_material() -> Result<Model> {
     let mut model: Model = Model::new(ModelParameters::default())?;
     model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
     model.set_joint_law(MaterialId(0), MaterialId(1), CoulombSlip::dry(2e9, 8e8, 35.0)?)?;
     model.add_block(common::fixed_slab("base").with_material(MaterialId(1)))?;
     model.add_block(common::cube("low", Vector::ZERO))?;
     model.add_block(common::cube("high", Vector::new(0.0, 0.0, common::CUBE_EDGE)))?;
+    Ok(model)
+}
+
+/// Two materials with two laws: a contact whose law index is the other pair's law is refused,
+/// naming the contact and its blocks.
+#[test]
+fn contact_law_index_must_be_its_materials_law() -> Result<()> {
+    let mut model = two_cubes_on_a_slab_of_another_material()?;
     model.run_steps(50)?;
     let text = model.to_checkpoint_string()?;
     let json: serde_json::Value = serde_json::from_str(&text).expect("json");
@@ -847,15 +854,7 @@ fn a_walls_bricks_share_their_shapes_also_after_a_checkpoint() -> Result<()> {
 /// still holds its old law until the next step's detection, which the checkpoint owes).
 #[test]
 fn every_way_a_law_reaches_a_contact_reloads_bit_identically() -> Result<()> {
-    let build = || -> Result<Model> {
-        let mut model: Model = Model::new(ModelParameters::default())?;
-        model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
-        model.set_joint_law(MaterialId(0), MaterialId(1), CoulombSlip::dry(2e9, 8e8, 35.0)?)?;
-        model.add_block(common::fixed_slab("base").with_material(MaterialId(1)))?;
-        model.add_block(common::cube("low", Vector::ZERO))?;
-        model.add_block(common::cube("high", Vector::new(0.0, 0.0, common::CUBE_EDGE)))?;
-        Ok(model)
-    };
+    let build = two_cubes_on_a_slab_of_another_material;
     let weak = || CoulombSlip::dry(5e8, 2e8, 20.0);
     type Setup = fn(&mut Model, &dyn Fn() -> Result<CoulombSlip>) -> Result<()>;
     let cases: [(&str, Setup); 5] = [

@@ -5,35 +5,11 @@
 //! at `I⁻¹·M·t`. parry3d-f64 0.31.1's eigen solver got these wrong by up to 69 % of the largest
 //! moment (`docs/parry-issue-inertia.md`).
 
+use crate::common::Lcg;
 use voussoir::build::arch::{Arch, ArchSpec};
 use voussoir::build::{multi_leaf_wall, rubble_wall, running_bond_wall, MultiLeafSpec, RubbleWallSpec, WallSpec};
 use voussoir::math::Matrix;
 use voussoir::prelude::*;
-
-/// A deterministic generator (the test needs no reproducible-seed machinery).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> Real {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (self.0 >> 11) as Real / (1u64 << 53) as Real
-    }
-    fn unit(&mut self) -> Vector {
-        loop {
-            let v = Vector::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5);
-            if v.length() > 0.05 && v.length() < 0.5 {
-                return v.normalize();
-            }
-        }
-    }
-    fn rotation(&mut self) -> Rotation {
-        let axis = self.unit();
-        Rotation::from_axis_angle(axis, std::f64::consts::TAU * self.next())
-    }
-}
 
 fn outer(u: Vector) -> Matrix {
     Matrix::from_cols(u * u.x, u * u.y, u * u.z)

@@ -231,3 +231,52 @@ fn interrupted_step_leaves_the_model_as_it_was() -> Result<()> {
     assert!(model.detection_count() > detections);
     Ok(())
 }
+
+/// A block added to a running model 5 mm into another is refused, as the same layout is at the
+/// start (it was launched: both blocks thrown up); one added clear of the others is taken.
+#[test]
+fn a_block_added_into_another_after_the_first_step_is_refused() -> Result<()> {
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0)?);
+    model.add_block(common::fixed_slab("base"))?;
+    model.add_block(common::cube("cube", Vector::ZERO))?;
+    model.run_steps(20)?;
+    let blocks = model.blocks().len();
+    let into = common::cube("into the base", Vector::new(0.5, 0.0, -0.005));
+    let err = model.add_block(into.clone()).expect_err("overlapping by 5 mm");
+    let Error::AddedBlockOverlap { other, depth, .. } = &err else {
+        panic!("expected AddedBlockOverlap, got {err:?}")
+    };
+    assert_eq!(*other, BlockId(0), "{err}");
+    assert!((depth - 0.005).abs() < 1e-9, "{err}");
+    assert!(err.to_string().contains("into the base"), "{err}");
+    assert_eq!(model.blocks().len(), blocks, "nothing added");
+    model.run_steps(5)?;
+    // Within the tolerance (1 mm), and clear: taken.
+    model.add_block(common::cube("touching", Vector::new(0.5, 0.0, -0.0005)))?;
+    model.add_block(common::cube("clear", Vector::new(-0.5, 0.0, 0.001)))?;
+    model.run_steps(5)?;
+    // Before the first step the same layout is refused by the first step.
+    let mut fresh = common::model(CoulombSlip::dry(1e9, 4e8, 30.0)?);
+    fresh.add_block(common::fixed_slab("base"))?;
+    fresh.add_block(into)?;
+    assert!(matches!(fresh.step(), Err(Error::InitialOverlap { .. })));
+    Ok(())
+}
+
+/// Probe 3, F11: `run_to_equilibrium` on a model with nothing free says so at once (it ran all
+/// its steps, then reported "last value inf").
+#[test]
+fn equilibrium_of_a_model_with_nothing_free_is_refused_at_once() -> Result<()> {
+    let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0)?);
+    model.add_block(common::fixed_slab("base"))?;
+    model.add_block(common::cube("held", Vector::ZERO).with_fixity(Fixity::FIXED))?;
+    let err = model.run_to_equilibrium(1e-4, 1_000_000).expect_err("nothing free");
+    assert!(
+        matches!(err, Error::Unsupported { .. }) && err.to_string().contains("no block has a free"),
+        "{err}"
+    );
+    assert_eq!(model.step_count(), 0);
+    model.set_fixity(BlockId(1), Fixity::FREE)?;
+    model.run_to_equilibrium(1e-3, 100_000)?;
+    Ok(())
+}

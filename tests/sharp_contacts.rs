@@ -14,28 +14,10 @@
 
 use crate::common;
 
-use common::z_range;
+use common::{z_range, Lcg};
 use voussoir::prelude::*;
 
 const RHO: Real = 2500.0;
-
-/// A deterministic pseudo-random stream in [0, 1) (64-bit LCG), for reproducible drops.
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> Real {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as Real) / ((1u64 << 53) as Real)
-    }
-
-    fn rotation(&mut self) -> Rotation {
-        let axis = Vector::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5);
-        Rotation::from_scaled_axis(axis * 6.0)
-    }
-}
 
 /// A regular tetrahedron (0), a triangular wedge (1) or a random convex stone (2) of half-size
 /// `s`: the stone is the hull of 14 points at 0.6–1 `s` from its centre in random directions.

@@ -128,6 +128,20 @@ fn a_viewer_refuses_what_it_cannot_show() -> Result<()> {
     model.add_block(common::cube("another", Vector::new(0.5, 0.5, 0.0)))?;
     let err = viewer.record(&model).expect_err("other blocks");
     assert!(err.to_string().contains("3 blocks after frames of 2"), "{err}");
+    // Another model of as many blocks but other shapes (probe 3, F8: it was taken).
+    let mut other = common::model(CoulombSlip::dry(1e9, 4e8, 30.0)?);
+    other.add_block(common::fixed_slab("slab"))?;
+    other.add_block(RigidBlock::cuboid(
+        "brick",
+        Vector::new(0.0, 0.0, 0.0),
+        Vector::new(0.2, 0.1, 0.05),
+        2000.0,
+    )?)?;
+    let err = viewer.record(&other).expect_err("another model");
+    assert!(
+        err.to_string().contains("block 1 (\"brick\") has another shape"),
+        "{err}"
+    );
     // Nothing to show before a frame; nothing written then.
     let empty = Viewer::new("empty");
     assert!(empty.is_empty());
@@ -151,5 +165,27 @@ fn a_large_model_can_be_recorded_without_contacts() -> Result<()> {
         .expect("written")
         .starts_with("<!DOCTYPE html>"));
     std::fs::remove_dir_all(&dir).expect("cleaned up");
+    Ok(())
+}
+
+/// Names that HTML would read as markup inside the data element (probe 3, F8): `<!--<script>`
+/// opened an escaped section that swallowed the renderer. Every `<` in the data is written as
+/// `\u003c`, and the names read back unchanged.
+#[test]
+fn markup_in_names_cannot_break_the_page() -> Result<()> {
+    let (_, mut viewer) = dropped_cube()?;
+    let name = "<!--<script> </script><b>";
+    viewer.add_curve(name, ("x <i>", "y"), &[0.0, 1.0], &[1.0, 2.0], false)?;
+    let page = viewer.to_html()?;
+    let open = "<script type=\"application/json\" id=\"voussoir-data\">";
+    let start = page.find(open).expect("data element") + open.len();
+    let end = start + page[start..].find("</script>").expect("end of the data element");
+    assert!(!page[start..end].contains('<'), "markup in the data element");
+    let json = data(&page);
+    let curves = json["curves"].as_array().expect("curves");
+    assert!(
+        curves.iter().any(|c| c["name"] == name && c["x_label"] == "x <i>"),
+        "{curves:?}"
+    );
     Ok(())
 }

@@ -209,6 +209,15 @@ def test_bad_problems_are_refused_with_what_is_missing():
     lonely.set_contact_model("MohrCoulomb", phi=30.0)
     with pytest.raises(ValueError, match="loading device"):
         cv.solve(lonely, analysis="capacity", capacity={"block": 1, "direction": (1, 0, 0)}, density=2000.0)
+    # Probe 3, F13: run arguments named (duration=-1 and NaN were accepted), an unknown block
+    # named (it was a bare KeyError: 99).
+    for bad in (-1.0, math.nan, 0.0):
+        with pytest.raises(ValueError, match="duration"):
+            cv.solve(problem, analysis="dynamic", duration=bad, density=2000.0)
+    with pytest.raises(ValueError, match="max_steps"):
+        cv.solve(problem, max_steps=0, density=2000.0)
+    with pytest.raises(ValueError, match="block 99 is not a node"):
+        cv.solve(lonely, analysis="capacity", capacity={"block": 99, "direction": (1, 0, 0)}, density=2000.0)
 
 
 def test_self_weight_reactions_against_compas_cra():

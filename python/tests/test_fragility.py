@@ -26,6 +26,22 @@ def test_the_fit_recovers_a_known_lognormal_within_its_sampling_error():
         fragility.fit_lognormal([0.1, 0.2], [True, True])
 
 
+def test_fits_that_do_not_exist_are_refused():
+    """Probe 3, F7: perfectly separated outcomes (β → 0; the search stopped at 0.025), no
+    trend (β → ∞; it returned 1.6e9) and NaN intensities (NaN) each raise a ValueError that
+    says why; an overlapping, increasing set still fits."""
+    with pytest.raises(ValueError, match="separated.*between 0.3 and 0.4"):
+        fragility.fit_lognormal([0.1, 0.2, 0.3, 0.4, 0.5], [False, False, False, True, True])
+    with pytest.raises(ValueError, match="no increasing trend"):
+        fragility.fit_lognormal([0.1, 0.2, 0.3, 0.4, 0.5, 0.6], [True, False, True, False, True, False])
+    with pytest.raises(ValueError, match="intensity 2 is nan"):
+        fragility.fit_lognormal([0.1, 0.2, math.nan, 0.4], [False, True, False, True])
+    with pytest.raises(ValueError, match="booleans"):
+        fragility.fit_lognormal([0.1, 0.2, 0.3], [0, 2, 1])
+    fit = fragility.fit_lognormal([0.1, 0.2, 0.3, 0.4, 0.5, 0.6], [False, False, True, False, True, True])
+    assert 0.2 < fit["median"] < 0.5 and 0.05 < fit["beta"] < 2.0, fit
+
+
 def test_synthetic_records_are_reproducible_and_shaped():
     t, a = fragility.kanai_tajimi(7)
     t2, a2 = fragility.kanai_tajimi(7)

@@ -148,3 +148,18 @@ time.sleep(30)
     # The other process was killed holding its lock: the lock is stale and taken over.
     mine.write_frame(m)
     assert len(mine) == 1
+
+
+def test_a_block_added_into_another_after_the_first_step_is_refused():
+    """Probe 3, F5: a cube added 5 mm into the slab after the first step was launched; it is
+    refused as the same layout is at the start, and the model is left as it was."""
+    m = vs.Model()
+    m.set_joint_law(0, 0, vs.CoulombSlip.dry(1e9, 4e8, 30.0))
+    m.add_cuboid("slab", (-1, -1, -0.2), (1, 1, 0), 2500.0, fixed=True)
+    m.add_cuboid("cube", (-0.1, -0.1, 0), (0.1, 0.1, 0.2), 2500.0)
+    m.run_steps(20)
+    with pytest.raises(vs.VoussoirError, match="overlaps block #0 by 5.000e-3 m"):
+        m.add_cuboid("late", (0.3, -0.1, -0.005), (0.5, 0.1, 0.195), 2500.0)
+    assert m.block_count == 2
+    m.run_steps(5)
+    assert m.velocities()[1, 2] > -1e-2

@@ -91,6 +91,14 @@ def test_an_interface_law_overrides_the_materials_law():
     assert moved[weak] > 5e-3 and abs(moved[held]) < 1e-4
     back = vs.Model.from_scene_json(m.to_scene_json())
     assert back.interface_law(weak, slab).friction_deg == 20.0
+    # A checkpoint with the interface law in use loads and goes on bit for bit (it was refused:
+    # "uses law 1, but their materials map to law 0").
+    resumed = vs.Model.from_checkpoint_string(m.to_checkpoint_string())
+    assert resumed.interface_law(weak, slab).friction_deg == 20.0
+    for model in (m, resumed):
+        model.run_steps(100)
+    assert resumed.to_checkpoint_string() == m.to_checkpoint_string()
+    assert np.array_equal(resumed.positions(), m.positions())
 
 
 def test_contact_polygons_are_the_touching_faces():

@@ -160,12 +160,16 @@ def test_chromium_screenshot_shows_the_blocks(tmp_path):
 
 
 @needs_chromium
-@pytest.mark.parametrize("case", ["no blocks", "one block, no contacts recorded"])
+@pytest.mark.parametrize("case", ["no blocks", "one block, no contacts recorded", "<!--<script> in the names"])
 def test_chromium_opens_edge_cases_without_errors(tmp_path, case):
     m = vs.Model()
     v = vs.Viewer(case, contacts=case == "no blocks")
     if case != "no blocks":
         m.add_cuboid("block", (0, 0, 0), (1, 1, 1), 2000.0)
+    if "script" in case:
+        # Probe 3, F8: markup in a title or curve name broke the page (the data swallowed the
+        # renderer); every "<" in the data is written as an escape.
+        v.add_curve("<!--<script>", [0.0, 1.0], [1.0, 2.0], time_axis=False)
     v.record(m)
     v.record(m)
     path = v.write(tmp_path / "edge.html")
@@ -177,3 +181,17 @@ def test_chromium_opens_edge_cases_without_errors(tmp_path, case):
     assert checks["frames"] == 2 and checks["blocks"] == len(m)
     # A box seen from above and aside shows three faces; nothing is drawn without blocks.
     assert checks["faces_drawn"] == (0 if case == "no blocks" else 3)
+
+
+def test_a_viewer_refuses_another_models_frames():
+    """One viewer shows one model (its docstring): a model of as many blocks but other shapes
+    is refused (probe 3, F8: it was taken)."""
+    v = vs.Viewer("one model")
+    a = vs.Model()
+    a.add_cuboid("cube", (0, 0, 0), (1, 1, 1), 2000.0)
+    v.record(a)
+    b = vs.Model()
+    b.add_cuboid("brick", (0, 0, 0), (0.2, 0.1, 0.05), 2000.0)
+    with pytest.raises(vs.VoussoirError, match="another shape"):
+        v.record(b)
+    v.record(a)

@@ -167,13 +167,37 @@ def fit_lognormal(intensity: Sequence[float], collapsed: Sequence[bool]) -> Dict
     """The lognormal fragility ``P(collapse | IM) = Φ(ln(IM/θ)/β)`` that maximises the
     likelihood of the observed outcomes (Baker 2015, eq. 11): ``median`` θ, ``beta`` β and
     ``log_likelihood``. Nelder–Mead on ``(ln θ, ln β)`` from the data's own moments, to a
-    relative tolerance of 1e-10."""
+    relative tolerance of 1e-10.
+
+    Raises ``ValueError`` where no such fit exists: intensities not positive and finite (NaN
+    included), outcomes all the same, outcomes **separated** (every collapse at an intensity at
+    or above every survival: the likelihood grows without bound as β → 0, so any β the search
+    stopped at would be an artefact; the message gives the interval that holds the median), or
+    **no increasing trend** (collapses no more likely at higher intensities: the likelihood is
+    largest as β → ∞)."""
     x = np.asarray(intensity, dtype=float)
     y = np.asarray(collapsed, dtype=float)
-    if x.shape != y.shape or x.size < 2 or (x <= 0).any():
-        raise ValueError("fit_lognormal: positive intensities and outcomes of the same length")
+    if x.shape != y.shape or x.ndim != 1 or x.size < 2:
+        raise ValueError("fit_lognormal: intensities and outcomes of the same length, at least two")
+    if not np.isfinite(x).all() or (x <= 0).any():
+        bad = int(np.flatnonzero(~(np.isfinite(x) & (x > 0)))[0])
+        raise ValueError(f"fit_lognormal: intensity {bad} is {float(x[bad])}; intensities must be positive and finite")
+    if not np.isin(y, (0.0, 1.0)).all():
+        raise ValueError("fit_lognormal: outcomes must be booleans (collapsed or not)")
     if y.min() == y.max():
         raise ValueError("fit_lognormal: all outcomes are the same; no fragility can be fitted")
+    survived_max, collapsed_min = x[y == 0].max(), x[y == 1].min()
+    if survived_max <= collapsed_min:
+        raise ValueError(
+            "fit_lognormal: the outcomes are separated (every collapse at an intensity at or above every "
+            f"survival): the median lies between {survived_max:g} and {collapsed_min:g}, and β has no "
+            "maximum-likelihood value (it tends to 0); add runs between them"
+        )
+    if np.corrcoef(np.log(x), y)[0, 1] <= 0:
+        raise ValueError(
+            "fit_lognormal: collapses are no more frequent at higher intensities (no increasing trend): "
+            "the likelihood is largest as β → ∞, so no fragility curve fits these outcomes"
+        )
     start = np.array([np.log(x).mean(), math.log(max(np.log(x).std(), 0.1))])
     f = lambda p: _neg_log_likelihood(p, x, y)  # noqa: E731
     simplex = [start, start + [0.2, 0.0], start + [0.0, 0.2]]
@@ -202,6 +226,13 @@ def fit_lognormal(intensity: Sequence[float], collapsed: Sequence[bool]) -> Dict
                 simplex = [simplex[0] + 0.5 * (p - simplex[0]) for p in simplex]
                 values = [f(p) for p in simplex]
     best = simplex[int(np.argmin(values))]
+    spread = float(np.log(x).max() - np.log(x).min())
+    if math.exp(best[1]) > 1e3 * spread:
+        # The search ran off towards β → ∞: the trend, if any, is too weak to fit.
+        raise ValueError(
+            f"fit_lognormal: β ran to {math.exp(best[1]):.3g}, beyond 1000 times the spread of ln IM "
+            f"({spread:.3g}): no increasing trend to fit"
+        )
     return {"median": math.exp(best[0]), "beta": math.exp(best[1]), "log_likelihood": -min(values)}
 
 

@@ -255,7 +255,17 @@ impl Viewer {
                     ),
                 })
             }
-            Some(_) => {}
+            Some(shapes) => {
+                if let Some(i) = shapes.first_other_shape(blocks) {
+                    return Err(Error::Unsupported {
+                        what: format!(
+                            "a viewer frame whose block {i} ({:?}) has another shape than in the first frames \
+                             (one viewer shows one model)",
+                            blocks[i].name()
+                        ),
+                    });
+                }
+            }
         }
         let n = blocks.len();
         let mut frame = Frame {
@@ -390,8 +400,10 @@ impl Viewer {
             "frames": frames,
             "curves": curves,
         });
-        // Inside <script>, "</" would end the element: JSON's "\/" is the same character.
-        let json = data.to_string().replace("</", "<\\/");
+        // Inside <script>, "</" would end the element and "<!--" start an escaped section that
+        // swallows the rest of the page: every "<" (only ever inside a JSON string) is written
+        // as the escape "\u003c", the same character to the parser.
+        let json = data.to_string().replace('<', "\\u003c");
         let mut title = String::new();
         for c in self.title.chars() {
             match c {
@@ -426,6 +438,24 @@ impl Viewer {
 }
 
 impl Shapes {
+    /// The first of `blocks` (as many as recorded) whose body-frame vertices are not those
+    /// recorded: a frame of another model.
+    fn first_other_shape(&self, blocks: &[crate::block::RigidBlock]) -> Option<usize> {
+        blocks.iter().enumerate().position(|(i, b)| {
+            let (start, end) = (
+                3 * self.vertex_offset[i] as usize,
+                3 * self.vertex_offset[i + 1] as usize,
+            );
+            let stored = &self.vertices[start..end];
+            let vertices = b.shape().vertices();
+            vertices.len() * 3 != stored.len()
+                || vertices
+                    .iter()
+                    .zip(stored.chunks_exact(3))
+                    .any(|(v, s)| v.to_array().map(|x| (x as f32).to_bits()) != [s[0], s[1], s[2]].map(f32::to_bits))
+        })
+    }
+
     fn of<L: ConstitutiveLaw>(model: &Model<L>) -> Result<Self> {
         let blocks = model.blocks();
         let mut s = Self {

@@ -65,9 +65,26 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// Runs until the unbalanced-force ratio falls below `target`; returns the steps taken.
     ///
     /// # Errors
-    /// [`Error::NotConverged`] after `max_steps`; otherwise as [`Model::step`].
+    /// [`Error::NotConverged`] after `max_steps`; [`Error::Unsupported`] at once for a model in
+    /// which no block has a free degree of freedom (all fixed or driven: nothing to bring to
+    /// equilibrium, and the run took all its steps to say "last value inf");
+    /// otherwise as [`Model::step`].
     pub fn run_to_equilibrium(&mut self, target: Real, max_steps: u64) -> Result<u64> {
         positive("equilibrium target ratio", target)?;
+        let held = |b: &crate::block::RigidBlock| {
+            let f = crate::block::Block::fixity(b);
+            f.translation
+                .iter()
+                .chain(&f.rotation)
+                .all(|d| *d != crate::block::Dof::Free)
+        };
+        if !self.state.blocks.is_empty() && self.state.blocks.iter().all(held) {
+            return Err(Error::Unsupported {
+                what: "run_to_equilibrium on a model in which no block has a free degree of freedom: nothing is free, so there \
+                       is no unbalanced force to bring down (free a block, or step with run_steps)"
+                    .into(),
+            });
+        }
         for k in 1..=max_steps {
             self.step()?;
             if self.state.unbalanced_ratio < target {

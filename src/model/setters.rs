@@ -60,7 +60,10 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// [`Error::NonFinite`] for a NaN or infinite velocity, position, rotation, load or
     /// prescribed velocity; [`Error::InvalidParameter`] for a rotation that is not a unit
     /// quaternion, or a block too large for the sub-contact spacing
-    /// ([`crate::geometry::MAX_SUBCONTACTS_PER_EDGE`] along a face edge).
+    /// ([`crate::geometry::MAX_SUBCONTACTS_PER_EDGE`] along a face edge);
+    /// [`Error::AddedBlockOverlap`] for a block added after the first step that overlaps a block
+    /// of the model by more than the contact tolerance (before the first step, the first step
+    /// refuses such a layout with [`Error::InitialOverlap`]).
     pub fn add_block(&mut self, mut block: RigidBlock) -> Result<BlockId> {
         block.validate()?;
         self.state
@@ -68,6 +71,9 @@ impl<L: ConstitutiveLaw> Model<L> {
             .contact
             .check_block(block.shape().radius(), block.name())?;
         block.radius = block.shape().radius();
+        if self.state.started {
+            self.check_added_overlap(&block)?;
+        }
         let id = BlockId(self.state.blocks.len() as u32);
         self.state.ref_poses.push(block.state.pose);
         self.state.blocks.push(block);
@@ -77,6 +83,44 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.state.changes.insert(Changes::BLOCKS);
         self.pipeline.max_speed = None;
         Ok(id)
+    }
+
+    /// A block added to a running model may not overlap another by more than the contact
+    /// tolerance, as none may at the start: the joint springs would throw both apart with the
+    /// energy of the whole overlap (a block added 5 mm into another launched both). Pairs of
+    /// fixed blocks get no contact and are not checked, as at the start.
+    fn check_added_overlap(&self, block: &RigidBlock) -> Result<()> {
+        use crate::geometry::{detect, BlockGeometry, NarrowPhaseScratch};
+        let tolerance = self.state.params.contact.tolerance;
+        let (mut scratch, mut seeds) = (NarrowPhaseScratch::default(), Vec::new());
+        let new = BlockGeometry {
+            shape: block.shape(),
+            pose: &block.state.pose,
+        };
+        for (i, other) in self.state.blocks.iter().enumerate() {
+            let reach = block.radius + other.radius + tolerance;
+            if (block.fixity().is_fixed() && other.fixity().is_fixed())
+                || (other.state.pose.translation - block.state.pose.translation).length() > reach
+            {
+                continue;
+            }
+            let old = BlockGeometry {
+                shape: other.shape(),
+                pose: &other.state.pose,
+            };
+            seeds.clear();
+            detect(old, new, None, &self.state.params.contact, &mut scratch, &mut seeds);
+            let depth = -scratch.separation();
+            if depth > tolerance {
+                return Err(Error::AddedBlockOverlap {
+                    block: block.name().to_owned(),
+                    other: BlockId(i as u32),
+                    depth,
+                    tolerance,
+                });
+            }
+        }
+        Ok(())
     }
 
     /// Sets the joint law between two materials (either order).

@@ -155,3 +155,34 @@ pub fn z_range(block: &RigidBlock) -> (Real, Real) {
             (lo.min(z), hi.max(z))
         })
 }
+
+/// A deterministic pseudo-random stream in [0, 1) (64-bit LCG), for reproducible random
+/// shapes, placements and orientations.
+pub struct Lcg(pub u64);
+
+impl Lcg {
+    /// The next number in [0, 1).
+    pub fn next(&mut self) -> Real {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as Real) / ((1u64 << 53) as Real)
+    }
+
+    /// A rotation by the rotation vector of components uniform in [-3, 3) rad.
+    pub fn rotation(&mut self) -> Rotation {
+        let axis = Vector::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5);
+        Rotation::from_scaled_axis(axis * 6.0)
+    }
+
+    /// A unit vector in a direction uniform over the sphere (by rejection in a shell).
+    pub fn unit(&mut self) -> Vector {
+        loop {
+            let v = Vector::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5);
+            if v.length() > 0.05 && v.length() < 0.5 {
+                return v.normalize();
+            }
+        }
+    }
+}

@@ -1,5 +1,6 @@
 """The analyses: a ``compas_dem`` problem solved by voussoir, ``compas_dem`` ``Results`` back."""
 
+import math
 from typing import Dict, Optional, Sequence
 
 import numpy as np
@@ -140,6 +141,7 @@ def run(
     analysis = analysis or "static"
     if analysis not in ANALYSES:
         raise ValueError(f"analysis {analysis!r}: expected one of {ANALYSES}")
+    _check_run_arguments(duration=duration, ramp_time=ramp_time, ratio=ratio, max_steps=max_steps)
     conv = to_voussoir(
         problem,
         model,
@@ -241,7 +243,13 @@ def run(
         if not capacity or "block" not in capacity:
             raise ValueError('analysis="capacity" needs capacity={"block": graph node, "direction": (x, y, z)}')
         c = dict(capacity)
-        i = conv.index[c.pop("block")]
+        node = c.pop("block")
+        if node not in conv.index:
+            raise ValueError(
+                f"capacity: block {node!r} is not a node of the model's graph (its nodes: {sorted(conv.index)[:20]}"
+                f"{' ...' if len(conv.index) > 20 else ''})"
+            )
+        i = conv.index[node]
         others = [j for j in range(len(m)) if j != i and not m.block(j).is_fixed]
         if not others:
             raise ValueError(
@@ -276,3 +284,19 @@ def run(
 
     meta.update({"time": m.time, "steps": m.step_count, "energies": dict(m.energies())})
     return from_model(problem, model, conv, meta)
+
+
+def _check_run_arguments(**values):
+    """The run's numeric arguments, each named in the error: ``duration`` and ``ratio``
+    positive and finite, ``ramp_time`` finite and not negative, ``max_steps`` a positive
+    integer (probe 3, F13: ``duration=-1`` or NaN was accepted)."""
+    for name in ("duration", "ratio"):
+        v = values[name]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+            raise ValueError(f"{name} = {v!r}: a positive, finite number expected")
+    v = values["ramp_time"]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
+        raise ValueError(f"ramp_time = {v!r}: a finite number not below 0 expected")
+    v = values["max_steps"]
+    if isinstance(v, bool) or not isinstance(v, int) or v <= 0:
+        raise ValueError(f"max_steps = {v!r}: a positive integer expected")
