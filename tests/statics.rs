@@ -466,3 +466,51 @@ fn column_of_three_blocks_joints_carry_the_weight_above() {
     // No other contacts than the three joints (blocks two apart are 0.15 m or more apart).
     assert_eq!(m.contacts().len(), heights.len());
 }
+
+/// **A hinge is a Winkler joint** (`docs/theory.md` §4.1): a 0.2 × 0.2 × 0.6 m pier on a fixed
+/// base under gravity tilted to 0.97 of its rigid overturning tilt (b/h), stiff joints (kn
+/// 4e11 Pa/m, φ 35°), settled: the joint is closed over a strip of width `c` at the toe, its
+/// resultant sits `c/3` inside the toe and the pier has turned by `φ = 2N/(kn c² d)`, the
+/// closed form of linear no-tension springs, to 1 % (measured: 1.8039e-4 rad both, c 8.8 mm).
+/// With springs at points on the edge (43203ac, before the exact cell integration) the
+/// resultant sat on the edge, a rigid pivot (6.7e-6 rad at the rigid tilt itself): issue 43's
+/// "hinges lost capacity" is this closed form, converging as kn^(-1/3).
+#[test]
+fn a_hinge_turns_as_a_no_tension_winkler_joint() -> Result<()> {
+    let (b, d, h, kn): (Real, Real, Real, Real) = (0.2, 0.2, 0.6, 4e11);
+    let mut params = ModelParameters::default();
+    params.contact.density = SubcontactDensity::PerEdge(5);
+    let tilt = (0.97 * b / h).atan();
+    params.gravity = 9.81 * Vector::new(tilt.sin(), 0.0, -tilt.cos());
+    let mut model: Model = Model::new(params)?;
+    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(kn, 0.4 * kn, 35.0)?)?;
+    let base = model.add_block(common::fixed_slab("base"))?;
+    let pier = model.add_block(RigidBlock::cuboid(
+        "pier",
+        Vector::new(-b / 2.0, -d / 2.0, 0.0),
+        Vector::new(b / 2.0, d / 2.0, h),
+        2500.0,
+    )?)?;
+    model.run_to_equilibrium(1e-6, 400_000)?;
+    let block = model.block(pier)?;
+    let turn = (block.state().pose.rotation * block.initial_pose().rotation.inverse())
+        .to_scaled_axis()
+        .y;
+    let toe = Vector::new(b / 2.0, 0.0, 0.0);
+    let toe = toe + block.displacement_of(toe);
+    let contact = model.contact_between(base, pier).expect("a contact");
+    let (mut n, mut moment) = (0.0, 0.0);
+    for s in contact.subcontacts() {
+        n += s.normal_force();
+        moment += s.normal_force() * s.normal_force_point().x;
+    }
+    let inside = toe.x - moment / n;
+    let c = 3.0 * inside;
+    let winkler = 2.0 * n / (kn * c * c * d);
+    assert!(c > 0.0 && c < 0.1 * b, "compressed strip {c} m");
+    assert!(
+        (turn / winkler - 1.0).abs() < 0.01,
+        "turned {turn} rad, Winkler {winkler} rad (c = {c} m)"
+    );
+    Ok(())
+}
