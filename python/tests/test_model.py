@@ -352,12 +352,20 @@ def test_another_thread_reads_the_model_while_it_runs():
                 errors.append(repr(e))
             time.sleep(0.002)
 
+    # A run long enough for several chunks (a chunk is at most 0.1 s of steps) on any machine:
+    # 2000 steps took 0.2 s on a fast one, too few chunks to see the run advance.
+    probe = vs.scenes.benchmark_wall(300)
+    start = time.perf_counter()
+    probe.run_steps(200)
+    per_step = (time.perf_counter() - start) / 200
+    steps = max(2000, int(0.8 / per_step))
+
     m = vs.scenes.benchmark_wall(300)
     done, reads, errors = threading.Event(), [], []
     t = threading.Thread(target=reader, args=(m, done, reads, errors))
     t.start()
     try:
-        assert m.run_steps(2000)
+        assert m.run_steps(steps)
     finally:
         done.set()
         t.join()
@@ -371,7 +379,7 @@ def test_another_thread_reads_the_model_while_it_runs():
 
     def runner():
         try:
-            result.append(m.run_steps(2000))
+            result.append(m.run_steps(steps))
         except Exception as e:  # noqa: BLE001
             failures.append(repr(e))
 
@@ -389,7 +397,7 @@ def test_another_thread_reads_the_model_while_it_runs():
     assert result == [True] and not failures, failures
     assert not errors, errors[:3]
     assert len(seen) >= 3, sorted(seen)
-    assert m.step_count == 2000
+    assert m.step_count == steps
 
 
 def test_ctrl_c_stops_a_run_cleanly():
