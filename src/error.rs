@@ -315,10 +315,10 @@ pub enum Error {
         /// Half the smaller block's radius (m).
         limit: Real,
     },
-    /// The interrupt check ([`crate::Model::set_interrupt_check`]) asked a step to stop. The
-    /// step did not happen: the model is as before it, and its next step detects every contact
-    /// afresh.
-    #[error("step {step} interrupted during contact detection; the model is as before the step")]
+    /// The interrupt check ([`crate::Model::set_interrupt_check`]) asked a step to stop (before
+    /// the step began, or during its contact detection). The step did not happen: the model is
+    /// as before it (after an interrupted detection, its next step detects every contact afresh).
+    #[error("step {step} interrupted; the model is as before the step")]
     Interrupted {
         /// The step that was interrupted (the model's step count).
         step: u64,

@@ -112,19 +112,20 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 pub const MAX_TEXT_BYTES: u64 = 4 << 30;
 
 /// Reads a UTF-8 text file of at most [`MAX_TEXT_BYTES`], refusing at the first NUL byte (no
-/// text format voussoir reads holds one: `/dev/zero` or a UTF-16 file is refused at once
-/// instead of being read without end).
+/// text format voussoir reads holds one: a UTF-16 file is refused at once). Only regular files
+/// are read: a folder, a device such as `/dev/zero`, a named pipe or a socket is refused before
+/// any read (a pipe would block for ever, a device read without end).
 ///
 /// # Errors
-/// [`crate::Error::Io`] naming the file: unreadable, larger than the limit, holding a NUL byte
-/// (saying where), or not UTF-8.
+/// [`crate::Error::Io`] naming the file: unreadable, not a regular file (saying what it is),
+/// larger than the limit, holding a NUL byte (saying where), or not UTF-8.
 pub fn read_text(path: &Path) -> Result<String> {
     use std::io::Read;
     let fail = |message: String| crate::Error::Io {
         path: path.display().to_string(),
         message,
     };
-    let mut file = std::fs::File::open(path).map_err(|e| io_error(path, &e))?;
+    let mut file = open_regular(path)?;
     let mut bytes = Vec::new();
     let mut chunk = vec![0u8; 1 << 16];
     loop {
@@ -158,6 +159,70 @@ pub fn read_text(path: &Path) -> Result<String> {
             e.utf8_error().valid_up_to()
         ))
     })
+}
+
+/// Opens `path` for reading if it is a regular file (after following links); a folder, a device
+/// (`/dev/zero`, `/dev/stdin`), a named pipe or a socket is refused at once. On Unix the file is
+/// opened without blocking (`O_NONBLOCK`: opening a named pipe waits for a writer otherwise, for
+/// ever and deaf to Ctrl-C) and its type read from the open file, so that nothing can swap it
+/// between the look and the read; reads of a regular file never block, the flag changes nothing
+/// for them.
+fn open_regular(path: &Path) -> Result<std::fs::File> {
+    #[cfg(unix)]
+    let file = {
+        use std::os::unix::fs::OpenOptionsExt;
+        std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_NONBLOCK)
+            .open(path)
+            .map_err(|e| refused_or(path, &e))?
+    };
+    #[cfg(not(unix))]
+    let file = std::fs::File::open(path).map_err(|e| refused_or(path, &e))?;
+    let kind = file.metadata().map_err(|e| io_error(path, &e))?.file_type();
+    if kind.is_file() {
+        return Ok(file);
+    }
+    Err(refused(path, kind))
+}
+
+/// The error for a file that is not a regular one.
+fn refused(path: &Path, kind: std::fs::FileType) -> crate::Error {
+    crate::Error::Io {
+        path: path.display().to_string(),
+        message: format!("{}: only a regular file is read", not_regular(kind)),
+    }
+}
+
+/// The error for a file that did not open: [`refused`] if it exists and is not a regular file
+/// (a socket does not open at all), the system's error otherwise.
+fn refused_or(path: &Path, e: &std::io::Error) -> crate::Error {
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() => refused(path, m.file_type()),
+        _ => io_error(path, e),
+    }
+}
+
+/// What a file that is not a regular one is, for messages.
+fn not_regular(kind: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return "a named pipe";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return "a device";
+        }
+    }
+    if kind.is_dir() {
+        "a folder"
+    } else {
+        "not a regular file"
+    }
 }
 
 /// Creates a new temporary file beside `path` (never opening one that exists).

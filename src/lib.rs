@@ -87,6 +87,8 @@ pub mod integrate;
 #[cfg(feature = "io")]
 #[cfg_attr(docsrs, doc(cfg(feature = "io")))]
 pub mod io;
+#[cfg(feature = "serde")]
+mod json_keys;
 pub mod law;
 pub mod loading;
 pub mod math;

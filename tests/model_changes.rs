@@ -232,6 +232,73 @@ fn interrupted_step_leaves_the_model_as_it_was() -> Result<()> {
     Ok(())
 }
 
+/// A push-over whose servo waits for a balance it never reaches (threshold 1e-300) stops within
+/// a few steps of the interrupt check firing, with the model as before the step it was about to
+/// take: the check is asked before every step (every 20 ms at most), not only in detections,
+/// which a resting model does not run. It ran to `max_steps` (minutes) before.
+#[test]
+fn a_push_over_waiting_for_its_servo_stops_when_interrupted() -> Result<()> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    use std::time::{Duration, Instant};
+    use voussoir::loading::{PushOver, Servo};
+    use voussoir::model::InterruptCheck;
+
+    // `PushOver`'s example: a cube on a base, pushed by a block whose x translation is
+    // prescribed.
+    let mut model: Model = Model::new(ModelParameters::default())?;
+    model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+    model.set_joint_law(MaterialId(0), MaterialId(1), CoulombSlip::dry(1e9, 4e8, 0.0)?)?;
+    model.add_block(
+        RigidBlock::cuboid(
+            "base",
+            Vector::new(-1.0, -1.0, -0.2),
+            Vector::new(1.0, 1.0, 0.0),
+            2500.0,
+        )?
+        .with_fixity(Fixity::FIXED),
+    )?;
+    model.add_block(RigidBlock::cuboid("cube", Vector::ZERO, Vector::splat(0.2), 2500.0)?)?;
+    let pusher = model.add_block(
+        RigidBlock::cuboid(
+            "pusher",
+            Vector::new(-0.1, 0.05, 0.05),
+            Vector::new(0.0, 0.15, 0.15),
+            2500.0,
+        )?
+        .with_material(MaterialId(1))
+        .with_fixity(Fixity::velocity(Vector::ZERO)),
+    )?;
+    model.run_steps(200)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    model.set_interrupt_check(Some(InterruptCheck::new(move || flag.load(Ordering::Relaxed))));
+    let setter = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(300));
+        stop.store(true, Ordering::Relaxed);
+        Instant::now()
+    });
+    let push = PushOver::new(Servo::new(pusher, Vector::X, 1e-6, 1e-300)?);
+    let outcome = push.run(&mut model, 50_000_000, |_, _| std::ops::ControlFlow::Continue(()));
+    let stopped = Instant::now();
+    let sent = setter.join().unwrap();
+    let step = model.step_count();
+    assert!(
+        matches!(outcome, Err(Error::Interrupted { step: s }) if s == step),
+        "{outcome:?} at step {step}"
+    );
+    let late = stopped.duration_since(sent);
+    assert!(
+        late < Duration::from_millis(500),
+        "stopped {late:?} after the check fired"
+    );
+    // Without the check firing, it goes on.
+    model.set_interrupt_check(None);
+    model.run_steps(3)?;
+    assert_eq!(model.step_count(), step + 3);
+    Ok(())
+}
+
 /// A block added to a running model 5 mm into another is refused, as the same layout is at the
 /// start (it was launched: both blocks thrown up); one added clear of the others is taken.
 #[test]

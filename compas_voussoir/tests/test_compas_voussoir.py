@@ -100,9 +100,9 @@ def test_limit_load_of_the_reference_arch():
     load = r.metadata["multiplier"] + weight
     assert load == pytest.approx(2755.0, rel=0.005), load
     assert r.metadata["carries_dead_load"] is True
-    # The same through the problem's own solver settings: the one line that changes from
-    # problem.solve().
+    # The same through compas_dem's own API: the solver set on the problem, problem.solve().
     problem.set_solver(cv.Voussoir(analysis="limit", live="Live", density=DENSITY, densities={plate: STEEL}, fixity={plate: PLATE_IN_PLANE}))
+    assert problem.solve().metadata["multiplier"] == r.metadata["multiplier"]
     assert cv.solve(problem).metadata["multiplier"] == r.metadata["multiplier"]
     # Every contact at collapse: a polygon whose corner forces add up to the resultant.
     for edge in r.edges():
@@ -218,6 +218,45 @@ def test_bad_problems_are_refused_with_what_is_missing():
         cv.solve(problem, max_steps=0, density=2000.0)
     with pytest.raises(ValueError, match="block 99 is not a node"):
         cv.solve(lonely, analysis="capacity", capacity={"block": 99, "direction": (1, 0, 0)}, density=2000.0)
+    # Every argument checked before the run, named in the error.
+    problem.add_boundary_condition("Live")
+    model.add_supports([0, 4])
+    bad_values = {
+        "ramp_time": 0.0,  # (a zero ramp was a time history error: "time of sample 1 = 0")
+        "ratio": math.nan,
+        "max_steps": 1.5,
+        "history_every": 0,
+        "subcontacts_per_edge": 0,
+        "contact_tolerance": -1.0,
+        "densities": {7: 2000.0},
+        "kn": "4e9",
+        "ks": 0.0,
+        "progress": "yes",
+        "interfaces": {(0, 1): {"mu": 0.3}},
+    }
+    for name, value in bad_values.items():
+        with pytest.raises(ValueError, match=name):
+            cv.solve(problem, density=2000.0, **{name: value})
+    with pytest.raises(ValueError, match="density"):
+        cv.solve(problem, density=-5.0)
+    limit_values = {"facets": 2, "check_dead_load": "no", "fixity": {9: "fixed"}, "centre": (0, 0), "max_iterations": 0, "mechanism_scale": 0.0}
+    for name, value in limit_values.items():
+        with pytest.raises(ValueError, match=name):
+            cv.solve(problem, analysis="limit", live="Live", density=2000.0, **{name: value})
+    with pytest.raises(ValueError, match="live: no boundary condition named"):
+        cv.solve(problem, analysis="limit", live="Nope", density=2000.0)
+    with pytest.raises(ValueError, match=r"capacity: direction"):
+        cv.solve(problem, analysis="capacity", capacity={"block": 2, "direction": (0, 0, 0)}, density=2000.0)
+    with pytest.raises(ValueError, match=r"capacity: unknown keys \['incremnt'\]"):
+        cv.solve(problem, analysis="capacity", capacity={"block": 2, "incremnt": 1e-5}, density=2000.0)
+    with pytest.raises(ValueError, match="ground_motion"):
+        cv.solve(problem, analysis="shaking", ground_motion={"x": (1, 2)}, density=2000.0)
+    with pytest.raises(ValueError, match="damping"):
+        cv.solve(problem, analysis="dynamic", damping={"ratio": 0.05}, density=2000.0)
+    # An unknown keyword is named (check_dead_load was "Model.__new__() got an unexpected
+    # keyword argument" before it was plumbed to voussoir.limit).
+    with pytest.raises(TypeError, match="'duration_s'"):
+        cv.solve(problem, duration_s=1.0, density=2000.0)
 
 
 def test_self_weight_reactions_against_compas_cra():
@@ -301,3 +340,292 @@ def test_a_prescribed_translation_is_reached():
     dx, dy, dz = r.displacement(1)
     assert dx == pytest.approx(0.002, rel=0.01)
     assert abs(dy) < 1e-9 and abs(dz) < 1e-5
+
+
+def semicircular_arch(thickness=0.2, n=16, mu=1.0, load_on=None, load=1.0):
+    """compas_dem's ArchTemplate as a semicircle (intrados radius 1 m about the origin, span 2 m,
+    0.2 m deep) of ``n`` voussoirs, the end ones supports; μ 1 (hinges, not sliding); a
+    downward live load of ``load`` N at voussoir ``load_on``'s centroid."""
+    model = BlockModel.from_template(ArchTemplate(rise=1.0, span=2.0, thickness=thickness, depth=0.2, n=n))
+    model.add_supports([0, n - 1])
+    problem = Problem(model)
+    problem.set_contact_model("MohrCoulomb", mu=mu)
+    live = problem.add_boundary_condition("Live")
+    if load_on is not None:
+        problem.add_point_load_at_centroid(load_on, [0.0, 0.0, -load], boundary_condition=live)
+    return model, problem
+
+
+def sliding_block_problem(mu=0.2, push=0.5, loading_type="ramp"):
+    """block_on_support (ρ 2000 kg/m³, μ ``mu``) pushed sideways by ``push`` times its weight."""
+    model = block_on_support()
+    problem = Problem(model)
+    problem.set_contact_model("MohrCoulomb", mu=mu)
+    bc = problem.add_boundary_condition("Push")
+    weight = 2000.0 * 0.008 * 9.81
+    problem.add_point_load_at_centroid(1, [push * weight, 0, 0], loading_type=loading_type, boundary_condition=bc)
+    return model, problem
+
+
+def test_problem_solve_runs_voussoir():
+    """Issue: problem.set_solver(compas_voussoir.Voussoir(...)); problem.solve() said "Solver
+    'voussoir' is not recognised" (compas_dem 0.6 dispatches on a fixed list of names).
+    Importing compas_voussoir wraps Problem.solve (compas_voussoir.install): a Voussoir solver
+    runs voussoir, with problem.solve()'s runtime options over the solver's parameters; any
+    other solver reaches compas_dem's own code; the problem with its solver survives compas's
+    JSON round trip; uninstall() puts compas_dem's Problem.solve back."""
+    import compas
+    from compas_dem.problem import Solver
+
+    model, problem = sliding_block_problem(mu=0.6, push=0.1)
+    problem.set_solver(cv.Voussoir(analysis="limit", live="Push", density=2000.0))
+    assert cv.installed()
+    r = problem.solve()
+    weight = 2000.0 * 0.008 * 9.81
+    # The block slides at μ W: the multiplier of the 0.1 W push is 6 (measured 6 to 1e-8).
+    assert r.metadata["multiplier"] == pytest.approx(6.0, rel=1e-6)
+    assert r.metadata["multiplier"] * 0.1 * weight == pytest.approx(0.6 * weight, rel=1e-6)
+    assert cv.solve(problem).metadata["multiplier"] == r.metadata["multiplier"]
+    # Runtime options win over the solver's parameters, as in compas_dem.
+    assert problem.solve(check_dead_load=False).metadata["carries_dead_load"] is None
+    # JSON round trip: a plain compas_dem Solver named "voussoir".
+    back = compas.json_loads(compas.json_dumps(problem))
+    back.load_model(model)
+    assert back._solver.name == "voussoir"
+    assert back.solve().metadata["multiplier"] == pytest.approx(6.0, rel=1e-6)
+    # Other solvers still go to compas_dem (its own error for a model without materials).
+    problem.set_solver(Solver.RBE())
+    with pytest.raises(Exception) as other:
+        problem.solve()
+    assert "not recognised" not in str(other.value)
+    problem.set_solver(cv.Voussoir(analysis="limit", live="Push", density=2000.0))
+    try:
+        assert cv.uninstall() is True
+        assert not cv.installed()
+        with pytest.raises(ValueError, match="not recognised"):
+            problem.solve()
+    finally:
+        cv.install()
+    assert cv.install() is False  # idempotent
+    assert problem.solve().metadata["multiplier"] == pytest.approx(6.0, rel=1e-6)
+    # A misspelt parameter is refused when the solver is made, not at the solve.
+    with pytest.raises(TypeError, match="'lve'"):
+        cv.Voussoir(analysis="limit", lve="Push")
+
+
+def test_stiffnesses_are_per_unit_area_and_odd_ones_warned():
+    """compas_dem's set_joint_model docstring gives kn, kt in N/m; compas_voussoir reads Pa/m
+    (per unit joint area, 3DEC's jkn/jks). A value outside 1e8–1e14 Pa/m (masonry joints) is
+    warned about (StiffnessUnitsWarning, pointing at the caller's line), with what it would be
+    in Pa/m as a whole joint's N/m over the joints' median area (the 13-voussoir arch's joints:
+    0.2 × 0.15 = 0.03 m²). The units are in the Results' metadata."""
+    model = BlockModel.from_template(ArchTemplate(rise=0.4, span=1.2, thickness=0.2, depth=0.15, n=13))
+    model.add_supports([0, 12])
+    problem = Problem(model)
+    problem.set_contact_model("MohrCoulomb", phi=35.0)
+    # 4 GPa/m over a 0.03 m² joint is 1.2e8 N/m: inside the Pa/m range, no way to tell. A
+    # softer joint's 3e7 N/m (1e9 Pa/m) is below it.
+    problem.set_joint_model(kn=3e7, kt=1.2e7)
+    with pytest.warns(cv.StiffnessUnitsWarning) as caught:
+        r = cv.solve(problem, analysis="limit", live=[], density=2000.0)
+    texts = [str(w.message) for w in caught if issubclass(w.category, cv.StiffnessUnitsWarning)]
+    assert len(texts) == 2
+    kn_text = next(t for t in texts if "kn" in t)
+    assert "3e+07 Pa/m is below" in kn_text and "N/m" in kn_text
+    assert "median area is 0.03 m²" in kn_text and "1e+09 Pa/m" in kn_text
+    assert all(w.filename == __file__ for w in caught)
+    assert r.metadata["joint_law"]["units"] == "Pa/m"
+    assert r.metadata["joint_law"]["units_warning"] and "Pa/m" in r.metadata["units"]["kn"]
+    # Within the range: no warning (4e9 Pa/m, the reference arch's), the default neither.
+    import warnings
+
+    problem.set_joint_model(kn=4e9, kt=1.6e9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", cv.StiffnessUnitsWarning)
+        cv.to_voussoir(problem, density=2000.0)
+        cv.to_voussoir(problem, density=2000.0, kn=1e14, ks=4e13)
+    # An interface's own stiffness, named as given.
+    with pytest.warns(cv.StiffnessUnitsWarning, match=r"interfaces\[\(5, 6\)\]\['kn'\] = 5e\+15"):
+        cv.to_voussoir(problem, density=2000.0, interfaces={(5, 6): {"kn": 5e15}})
+    # Not a stiffness at all: refused, named.
+    with pytest.raises(ValueError, match="kn = -1"):
+        cv.to_voussoir(problem, density=2000.0, kn=-1.0)
+    problem.set_joint_model(kn=math.nan, kt=1e9)
+    with pytest.raises(ValueError, match="joint model's kn"):
+        cv.to_voussoir(problem, density=2000.0)
+
+
+def test_limit_analysis_answers_whether_the_dead_load_is_carried():
+    """A zero live load (or live=[]) asks whether the dead load alone is carried (voussoir.limit
+    refuses a zero live load: compas_voussoir asks its dead-load check with the dead load
+    reversed as the probe, which it cancels at multiplier 1). An arch that cannot stand is an
+    answer, carries_dead_load False with the status, not an error. The semicircular arch of
+    16 voussoirs (intrados radius 1 m, end voussoirs fixed, μ 1) stands down to a thickness of
+    0.0654 m (bisected: carried at 0.06540, not at 0.06539); check_dead_load=False passes through
+    (it was a TypeError from voussoir.Model) and gives the same multiplier unchecked."""
+    for live, load in (("Live", 0.0), ([], 1.0)):  # a zero live load; no live load
+        model, problem = semicircular_arch(load_on=4, load=load)
+        r = cv.solve(problem, analysis="limit", live=live, density=2000.0)
+        assert r.metadata["carries_dead_load"] is True and r.metadata["multiplier"] is None
+        assert r.metadata["status"] == "Solved" and r.metadata["dead_load_only"] is True
+        assert set(r.nodes()) == set(range(16)) and not list(r.edges())
+    for thickness, stands in ((0.0655, True), (0.0653, False)):
+        model, problem = semicircular_arch(thickness=thickness, load_on=4)
+        r = cv.solve(problem, analysis="limit", live=[], density=2000.0)
+        assert r.metadata["carries_dead_load"] is stands, thickness
+        assert r.metadata["status"] == ("Solved" if stands else "infeasible")
+    # With a live load: the thin arch's answer is False (it raised VoussoirError), checked or not.
+    model, problem = semicircular_arch(thickness=0.05, load_on=4)
+    for check in (True, False):
+        r = cv.solve(problem, analysis="limit", live="Live", density=2000.0, check_dead_load=check)
+        assert r.metadata["carries_dead_load"] is False
+        assert r.metadata["multiplier"] is None and r.metadata["status"] == "infeasible"
+        assert "cannot carry its own weight" in r.metadata["reason"]
+    # The 0.2 m arch: 2271.6 N at voussoir 4, checked or not.
+    model, problem = semicircular_arch(load_on=4)
+    checked = cv.solve(problem, analysis="limit", live="Live", density=2000.0)
+    unchecked = cv.solve(problem, analysis="limit", live="Live", density=2000.0, check_dead_load=False)
+    assert checked.metadata["carries_dead_load"] is True and unchecked.metadata["carries_dead_load"] is None
+    assert checked.metadata["multiplier"] == pytest.approx(2271.6, rel=1e-4)
+    assert unchecked.metadata["multiplier"] == pytest.approx(checked.metadata["multiplier"], rel=1e-9)
+    # The other options of voussoir.limit pass through too: a 16-plane pyramid is a lower bound
+    # within 1 − cos(π/16) = 1.9 %.
+    pyramid = cv.solve(problem, analysis="limit", live="Live", density=2000.0, friction="pyramid", facets=16)
+    assert 0.98 * checked.metadata["multiplier"] <= pyramid.metadata["multiplier"] <= checked.metadata["multiplier"] * (1 + 1e-6)
+
+
+def test_a_static_run_that_does_not_settle_returns_flagged_results():
+    """The block on its support (μ 0.2) pushed by 0.5 W never settles: it slides on. Results
+    come back all the same with settled False, a NotSettledWarning, and the history of the
+    unbalanced-force ratio (it stays at 0.29, the net force over the load) and the kinetic
+    energy (growing as the block speeds up). A model without supports is refused, naming the
+    cause (it was "unbalanced-force ratio target not reached ... (last value inf)")."""
+    model, problem = sliding_block_problem()
+    with pytest.warns(cv.NotSettledWarning, match="did not settle"):
+        r = cv.solve(problem, analysis="static", density=2000.0, max_steps=5000)
+    md = r.metadata
+    assert md["settled"] is False and md["settle_steps"] == 5000
+    h = md["history"]
+    assert len(h["step"]) == len(h["unbalanced_ratio"]) == len(h["kinetic_energy"]) == len(h["time"]) > 100
+    assert h["step"] == sorted(h["step"]) and h["step"][-1] == md["steps"]
+    assert min(h["unbalanced_ratio"][len(h["step"]) // 2 :]) > 0.2  # far above the 1e-5 target
+    assert h["kinetic_energy"][-1] > h["kinetic_energy"][len(h["step"]) // 2] > 0.0
+    assert r.displacement(1)[0] > 0.1  # it slid
+    # A settled run has the same flag and history.
+    model, problem = sliding_block_problem(mu=0.6, push=0.1)
+    r = cv.solve(problem, analysis="static", density=2000.0)
+    assert r.metadata["settled"] is True and r.metadata["history"]["unbalanced_ratio"][-1] < 1e-5
+    # An arch too thin to stand (the semicircle at 0.05 m; the limit analysis says it stands
+    # down to 0.0654 m) collapses in the DEM: not settled after 10 000 steps, the ratio and
+    # the kinetic energy high (measured at 20 000 steps: 0.72, 92 J, the blocks 1.9 m down);
+    # at 0.08 m it settles (3479 steps).
+    model, problem = semicircular_arch(thickness=0.05)
+    with pytest.warns(cv.NotSettledWarning):
+        r = cv.solve(problem, analysis="static", density=2000.0, max_steps=10000)
+    assert r.metadata["settled"] is False and r.metadata["unbalanced_ratio"] > 0.1
+    assert r.metadata["history"]["kinetic_energy"][-1] > 1.0
+    assert max(np.linalg.norm(r.displacement(n)) for n in r.nodes()) > 0.1
+    model, problem = semicircular_arch(thickness=0.08)
+    assert cv.solve(problem, analysis="static", density=2000.0, max_steps=10000).metadata["settled"] is True
+    # No support at all.
+    free = BlockModel.from_template(ArchTemplate(rise=0.4, span=1.2, thickness=0.2, depth=0.15, n=5))
+    problem = Problem(free)
+    problem.set_contact_model("MohrCoulomb", phi=30.0)
+    with pytest.raises(ValueError, match="no support"):
+        cv.solve(problem, analysis="static", density=2000.0)
+    with pytest.raises(ValueError, match="no support"):
+        cv.solve(problem, analysis="capacity", capacity={"block": 1}, density=2000.0)
+    # The limit analysis answers instead: not carried.
+    assert cv.solve(problem, analysis="limit", live=[], density=2000.0).metadata["carries_dead_load"] is False
+
+
+def test_support_reactions_balance_the_loads():
+    """compas_voussoir.reactions(results): per support, the force and moment on it from the
+    structure (global frame). Summed over the supports they are the weight of the free blocks
+    plus the applied loads: the settled DEM of the reference arch (1 N on the plate), force to
+    2e-8 (measured) within the 1e-5 settle ratio, moments about the origin (at the settled
+    positions) to 1e-6 relative; the limit analysis at collapse (weight + multiplier × live)
+    to 5e-13 measured (asserted 1e-9). The reactions survive compas's JSON round trip."""
+    import compas
+
+    model, plate, problem = reference_problem()
+    conv = cv.to_voussoir(problem, density=DENSITY, densities={plate: STEEL})
+    m = conv.model
+    free = [i for i in range(len(m)) if not m.block(i).is_fixed]
+    weight = sum(m.block(i).mass for i in free) * 9.81
+    plate_point = np.mean(np.asarray(model.graph.node_element(plate).modelgeometry.to_vertices_and_faces()[0]), axis=0)
+    supports = {e.graphnode for e in model.elements() if e.is_support}
+
+    r = cv.solve(problem, analysis="static", density=DENSITY, densities={plate: STEEL})
+    assert r.metadata["settled"] and "on the support" in r.metadata["reaction_on"]
+    reactions = cv.reactions(r, about=(0, 0, 0))
+    assert set(reactions) == supports
+    F = sum(x["force"] for x in reactions.values())
+    M = sum(x["moment"] for x in reactions.values())
+    assert F[2] == pytest.approx(-(weight + 1.0), rel=1e-6)
+    assert abs(F[0]) < 1e-5 * weight and abs(F[1]) < 1e-9 * weight
+    # The loads' moment about the origin at the settled positions (the live load's point
+    # moves with the plate).
+    def moved(node, p):
+        T = np.asarray(r.transformation(node).matrix)
+        return T[:3, :3] @ p + T[:3, 3]
+
+    expected = sum(np.cross(moved(conv.node[i], conv.centroids[i]), [0, 0, -m.block(i).mass * 9.81]) for i in free)
+    expected = expected + np.cross(moved(plate, plate_point), [0, 0, -1.0])
+    assert np.allclose(M, expected, rtol=0, atol=1e-6 * weight)
+    # Each support's thrust is inward (the force on the support pushes it outward).
+    for node, x in cv.reactions(r).items():
+        assert x["force"][2] < 0 and np.sign(x["force"][0]) == np.sign(x["point"][0])
+    back = compas.json_loads(compas.json_dumps(r))
+    assert all(np.allclose(cv.reactions(back)[n]["force"], x["force"]) for n, x in cv.reactions(r).items())
+
+    lim = cv.solve(problem, analysis="limit", live="Live", density=DENSITY, densities={plate: STEEL}, fixity={plate: PLATE_IN_PLANE})
+    lam = lim.metadata["multiplier"]
+    reactions = cv.reactions(lim, about=(0, 0, 0))
+    F = sum(x["force"] for x in reactions.values())
+    M = sum(x["moment"] for x in reactions.values())
+    assert np.allclose(F, [0, 0, -(weight + lam)], rtol=0, atol=1e-9 * (weight + lam))
+    expected = sum(np.cross(conv.centroids[i], [0, 0, -m.block(i).mass * 9.81]) for i in free)
+    expected = expected + np.cross(plate_point, [0, 0, -lam])
+    assert np.allclose(M, expected, rtol=0, atol=1e-9 * (weight + lam))
+
+
+def test_hinge_sides_of_the_four_hinge_mechanism():
+    """The semicircular arch (intrados radius 1 m, 0.2 m thick, 16 voussoirs, μ 1) under a
+    point load on voussoir 4 (at 56° from the right springing): the classic four-hinge
+    mechanism, 2271.6 N. Per hinged joint the Results say which side the pivot is on:
+    from the right, intrados (joint 1–2, 22.5°), extrados under the load (4–5, 56.2°),
+    intrados (10–11, 123.8°), extrados (14–15, 168.8°): the sides alternate, the joint under
+    the load opening at the intrados. Checked against the geometry: the pivot corners lie on
+    the intrados (radius 1) or the extrados (1.2), the opening ones on the other. The centre
+    is found from the hinged joints' planes; given explicitly, the same."""
+    model, problem = semicircular_arch(load_on=4)
+    r = cv.solve(problem, analysis="limit", live="Live", density=2000.0)
+    hinges = sorted(r.metadata["hinges"], key=lambda h: math.atan2(h["pivot_point"][2], h["pivot_point"][0]))
+    assert [tuple(h["edge"]) for h in hinges] == [(1, 2), (4, 5), (10, 11), (14, 15)]
+    assert [h["side"] for h in hinges] == ["intrados", "extrados", "intrados", "extrados"]
+    assert [h["opens_on"] for h in hinges] == ["extrados", "intrados", "extrados", "intrados"]
+    for h in hinges:
+        radius = {"intrados": 1.0, "extrados": 1.2}
+        pivot = np.asarray(h["pivot"])
+        opens = np.asarray(h["opens"])
+        assert len(pivot) == 2 and len(opens) == 2  # an edge across the arch's depth
+        assert np.allclose(np.hypot(pivot[:, 0], pivot[:, 2]), radius[h["side"]], atol=1e-9)
+        assert np.allclose(np.hypot(opens[:, 0], opens[:, 2]), radius[h["opens_on"]], atol=1e-9)
+        assert h["opening"] > 0 and abs(abs(h["axis"][1]) - 1.0) < 1e-9  # turning about the depth
+        assert r.edge_attribute(tuple(h["edge"]), "hinge")["side"] == h["side"]
+        # Its corners: the pivot closed, the others open.
+        status = dict(zip(map(tuple, np.round(r.contact_point(tuple(h["edge"])), 12)), r.status(tuple(h["edge"]))))
+        assert {status[tuple(np.round(p, 12))] for p in pivot} == {"closed"}
+        assert {status[tuple(np.round(p, 12))] for p in opens} == {"open"}
+    given = cv.solve(problem, analysis="limit", live="Live", density=2000.0, centre=(0.0, 0.1, 0.0))
+    assert [h["side"] for h in given.metadata["hinges"]] == [h["side"] for h in r.metadata["hinges"]]
+    # A block rocking on its base has no intrados: the pivot edge is given, no side. The cube
+    # pushed at its centroid (μ 2: it tips before it slides) turns about its far edge (x = 0.1)
+    # at a push of W (b/h = 1): the multiplier of 0.1 W is 10 (measured 9.99996).
+    model, problem = sliding_block_problem(mu=2.0, push=0.1)
+    r = cv.solve(problem, analysis="limit", live="Push", density=2000.0)
+    (h,) = r.metadata["hinges"]
+    assert h["side"] is None and np.allclose(np.asarray(h["pivot"])[:, 0], 0.1)
+    assert np.allclose(h["towards"], [1.0, 0.0, 0.0], atol=1e-9)
+    assert r.metadata["multiplier"] == pytest.approx(10.0, rel=1e-5)

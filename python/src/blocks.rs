@@ -49,11 +49,12 @@ impl PyBlock {
         min: &Bound<'_, PyAny>,
         max: &Bound<'_, PyAny>,
         density: f64,
-        material: u16,
+        material: i64,
         fixed: Option<&Bound<'_, PyAny>>,
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let material = crate::convert::whole(material, "material", u64::from(u16::MAX))? as u16;
         let b = RigidBlock::cuboid(name, vec3(min, "min")?, vec3(max, "max")?, density).py()?;
         finish(b, material, fixed, velocity, angular_velocity)
     }
@@ -68,11 +69,12 @@ impl PyBlock {
         vertices: &Bound<'_, PyAny>,
         density: f64,
         faces: Option<Vec<Vec<usize>>>,
-        material: u16,
+        material: i64,
         fixed: Option<&Bound<'_, PyAny>>,
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let material = crate::convert::whole(material, "material", u64::from(u16::MAX))? as u16;
         let pts = points(vertices, "vertices")?;
         let b = match faces {
             Some(f) => RigidBlock::from_faces(name, &pts, &f, density),
@@ -209,13 +211,16 @@ pub fn arch(
     rise: f64,
     thickness: f64,
     width: f64,
-    voussoirs: usize,
+    voussoirs: i64,
     density: f64,
     abutment_outer_width: f64,
     abutment_depth: f64,
-    voussoir_material: u16,
-    abutment_material: u16,
+    voussoir_material: i64,
+    abutment_material: i64,
 ) -> PyResult<Vec<PyBlock>> {
+    let voussoirs = crate::convert::whole(voussoirs, "voussoirs", usize::MAX as u64)? as usize;
+    let voussoir_material = crate::convert::whole(voussoir_material, "voussoir_material", u64::from(u16::MAX))? as u16;
+    let abutment_material = crate::convert::whole(abutment_material, "abutment_material", u64::from(u16::MAX))? as u16;
     let spec = arch_spec(
         span,
         rise,
@@ -265,13 +270,17 @@ pub(crate) fn arch_spec(
 #[pyfunction]
 #[pyo3(signature = (*, bricks_per_course=10, courses=10, brick=None, density=2000.0, material=0, base_material=0))]
 pub fn running_bond_wall(
-    bricks_per_course: usize,
-    courses: usize,
+    bricks_per_course: i64,
+    courses: i64,
     brick: Option<&Bound<'_, PyAny>>,
     density: f64,
-    material: u16,
-    base_material: u16,
+    material: i64,
+    base_material: i64,
 ) -> PyResult<Vec<PyBlock>> {
+    let bricks_per_course = crate::convert::whole(bricks_per_course, "bricks_per_course", usize::MAX as u64)? as usize;
+    let courses = crate::convert::whole(courses, "courses", usize::MAX as u64)? as usize;
+    let material = crate::convert::whole(material, "material", u64::from(u16::MAX))? as u16;
+    let base_material = crate::convert::whole(base_material, "base_material", u64::from(u16::MAX))? as u16;
     let default = WallSpec::default();
     let spec = WallSpec {
         bricks_per_course,
@@ -293,8 +302,9 @@ pub fn multi_leaf_wall(
     height: f64,
     leaves: Option<&Bound<'_, PyAny>>,
     density: f64,
-    material: u16,
+    material: i64,
 ) -> PyResult<Vec<PyBlock>> {
+    let material = crate::convert::whole(material, "material", u64::from(u16::MAX))? as u16;
     let spec = MultiLeafSpec {
         length,
         height,
@@ -323,14 +333,18 @@ pub fn rubble_wall(
     thickness: f64,
     height: f64,
     stone_size: f64,
-    leaves: usize,
+    leaves: i64,
     jitter: f64,
     through_stones: f64,
-    seed: u64,
+    seed: i64,
     density: f64,
-    material: u16,
-    base_material: u16,
+    material: i64,
+    base_material: i64,
 ) -> PyResult<Vec<PyBlock>> {
+    let leaves = crate::convert::whole(leaves, "leaves", usize::MAX as u64)? as usize;
+    let seed = crate::convert::whole(seed, "seed", u64::MAX)?;
+    let material = crate::convert::whole(material, "material", u64::from(u16::MAX))? as u16;
+    let base_material = crate::convert::whole(base_material, "base_material", u64::from(u16::MAX))? as u16;
     let spec = RubbleWallSpec {
         length,
         thickness,
@@ -357,11 +371,14 @@ pub fn barrel_vault(
     radius: f64,
     thickness: f64,
     ring_length: f64,
-    rings: usize,
-    voussoirs: usize,
+    rings: i64,
+    voussoirs: i64,
     density: f64,
-    material: u16,
+    material: i64,
 ) -> PyResult<Vec<PyBlock>> {
+    let rings = crate::convert::whole(rings, "rings", usize::MAX as u64)? as usize;
+    let voussoirs = crate::convert::whole(voussoirs, "voussoirs", usize::MAX as u64)? as usize;
+    let material = crate::convert::whole(material, "material", u64::from(u16::MAX))? as u16;
     let spec = BarrelVaultSpec {
         radius,
         thickness,
@@ -381,14 +398,19 @@ pub fn barrel_vault(
 #[pyo3(signature = (*, blocks=None, radius=None, thickness=None, per_course=None, oculus_angle=None, density=None, material=0))]
 #[allow(clippy::too_many_arguments)]
 pub fn dome(
-    blocks: Option<usize>,
+    blocks: Option<i64>,
     radius: Option<f64>,
     thickness: Option<f64>,
     per_course: Option<Vec<usize>>,
     oculus_angle: Option<f64>,
     density: Option<f64>,
-    material: u16,
+    material: i64,
 ) -> PyResult<Vec<PyBlock>> {
+    let blocks = blocks
+        .map(|v| crate::convert::whole(v, "blocks", usize::MAX as u64))
+        .transpose()?
+        .map(|v| v as usize);
+    let material = crate::convert::whole(material, "material", u64::from(u16::MAX))? as u16;
     let mut spec = DomeSpec::with_blocks(blocks.unwrap_or(200));
     if let Some(r) = radius {
         spec.radius = r;

@@ -41,9 +41,11 @@ fn density_kwargs<'py>(py: Python<'py>, density: SubcontactDensity) -> PyResult<
 pub fn check_density_convergence<'py>(
     py: Python<'py>,
     run: &Bound<'py, PyAny>,
-    subcontacts_per_edge: u16,
+    subcontacts_per_edge: i64,
     subcontact_spacing: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let subcontacts_per_edge =
+        crate::convert::whole(subcontacts_per_edge, "subcontacts_per_edge", u64::from(u16::MAX))? as u16;
     if !run.is_callable() {
         return Err(pyo3::exceptions::PyTypeError::new_err(
             "check_density_convergence: run must be callable",

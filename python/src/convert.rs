@@ -246,3 +246,9 @@ pub fn json_to_py<'py>(py: Python<'py>, value: &serde_json::Value) -> PyResult<B
 pub fn result<'py>(py: Python<'py>, kind: &str, data: Bound<'py, PyDict>) -> PyResult<Bound<'py, PyAny>> {
     py.import("voussoir._results")?.getattr("Result")?.call1((kind, data))
 }
+
+/// A whole-number argument in `[0, max]` (`ValueError` naming `what` otherwise: `material=-1`
+/// raised PyO3's `OverflowError` naming nothing when the argument was declared unsigned).
+pub fn whole(value: i64, what: &str, max: u64) -> PyResult<u64> {
+    Int(Ok(value)).at_most(what, max)
+}

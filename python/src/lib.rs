@@ -24,6 +24,10 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    // NumPy's C API, taken now: taken first where a result is returned after a long run, its
+    // import would meet a pending Ctrl-C and rust-numpy would panic ("Failed to access NumPy
+    // array API capsule") instead of raising KeyboardInterrupt.
+    numpy::PyArray1::<f64>::zeros(py, 0, false);
     m.add("VoussoirError", py.get_type::<errors::VoussoirError>())?;
     m.add("VoussoirIOError", py.get_type::<errors::VoussoirIOError>())?;
     m.add_class::<laws::PyCoulombSlip>()?;

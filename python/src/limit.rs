@@ -69,12 +69,14 @@ pub fn limit<'py>(
     live_loads: &Bound<'py, PyAny>,
     fixity: Option<&Bound<'py, PyDict>>,
     friction: &str,
-    facets: usize,
+    facets: i64,
     check_dead_load: bool,
-    max_iterations: u32,
+    max_iterations: i64,
     joints: Option<&Bound<'py, PyAny>>,
     mechanism_tolerance: f64,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let facets = crate::convert::whole(facets, "facets", usize::MAX as u64)? as usize;
+    let max_iterations = crate::convert::whole(max_iterations, "max_iterations", u64::from(u32::MAX))? as u32;
     if !(mechanism_tolerance.is_finite() && mechanism_tolerance > 0.0) {
         return Err(bad(format!(
             "mechanism_tolerance = {mechanism_tolerance}: must be positive and finite"

@@ -192,14 +192,18 @@ pub fn arch_joints<'py>(
     rise: f64,
     thickness: f64,
     width: f64,
-    voussoirs: usize,
+    voussoirs: i64,
     density: f64,
     abutment_outer_width: f64,
     abutment_depth: f64,
-    voussoir_material: u16,
-    abutment_material: u16,
-    first_block: u32,
+    voussoir_material: i64,
+    abutment_material: i64,
+    first_block: i64,
 ) -> PyResult<Bound<'py, PyList>> {
+    let voussoirs = crate::convert::whole(voussoirs, "voussoirs", usize::MAX as u64)? as usize;
+    let voussoir_material = crate::convert::whole(voussoir_material, "voussoir_material", u64::from(u16::MAX))? as u16;
+    let abutment_material = crate::convert::whole(abutment_material, "abutment_material", u64::from(u16::MAX))? as u16;
+    let first_block = crate::convert::whole(first_block, "first_block", u64::from(u32::MAX))? as u32;
     let spec = arch_spec(
         span,
         rise,

@@ -117,7 +117,7 @@ pub fn arch_static<'py>(
     ks: Option<f64>,
     width: f64,
     mode: &str,
-    per_edge: u16,
+    per_edge: i64,
     servo_increment: f64,
     servo_ratio: f64,
     rate: Option<f64>,
@@ -127,6 +127,7 @@ pub fn arch_static<'py>(
     convergence_check: bool,
     label: Option<String>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let per_edge = crate::convert::whole(per_edge, "per_edge", u64::from(u16::MAX))? as u16;
     let base = StaticCase::baseline();
     let mut case = match rate {
         Some(r) => {
@@ -305,12 +306,13 @@ pub fn arch_impact<'py>(
     width: f64,
     duration: f64,
     friction_deg: f64,
-    per_edge: u16,
+    per_edge: i64,
     guide: &str,
     base: &str,
     release: &str,
     offsets_mm: Vec<f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let per_edge = crate::convert::whole(per_edge, "per_edge", u64::from(u16::MAX))? as u16;
     let all = impact::setups();
     let chosen = all.iter().find(|s| s.name == setup).cloned().ok_or_else(|| {
         bad(format!(

@@ -2,9 +2,12 @@
 index arguments, sizes that would abort, endless inputs, series written twice."""
 
 import itertools
+import json
+import os
 import pathlib
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -102,9 +105,36 @@ def test_endless_iterables_are_refused():
 
 def test_load_checkpoint_of_an_endless_file_is_refused_at_once():
     start = time.monotonic()
-    with pytest.raises(vs.VoussoirIOError, match="NUL byte"):
+    with pytest.raises(vs.VoussoirIOError, match="a device: only a regular file is read"):
         vs.Model.load_checkpoint("/dev/zero")
     assert time.monotonic() - start < 1
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are POSIX")
+def test_named_pipes_are_refused_on_load(tmp_path):
+    """A scene, checkpoint or CSV given as a named pipe is refused at once, naming it (the load
+    blocked for ever, holding the GIL, deaf to Ctrl-C). Should it block again, a writer opened
+    after 5 s unblocks it, and the test fails on its time."""
+    fifo = tmp_path / "pipe.json"
+    os.mkfifo(fifo)
+
+    def unblock():
+        try:
+            os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+        except OSError:
+            pass
+
+    for load in (vs.Model.load_scene, vs.Model.load_checkpoint, vs.TimeHistory.from_csv):
+        timer = threading.Timer(5.0, unblock)
+        timer.start()
+        start = time.monotonic()
+        try:
+            with pytest.raises(vs.VoussoirIOError, match="a named pipe: only a regular file is read") as e:
+                load(fifo)
+        finally:
+            timer.cancel()
+        assert time.monotonic() - start < 1, load
+        assert str(fifo) in str(e.value)
 
 
 def test_two_series_of_one_name_in_one_folder(tmp_path, model):
@@ -163,3 +193,49 @@ def test_a_block_added_into_another_after_the_first_step_is_refused():
     assert m.block_count == 2
     m.run_steps(5)
     assert m.velocities()[1, 2] > -1e-2
+
+
+def test_round3_arguments_and_files_say_what_is_wrong(tmp_path):
+    """Probe 3, F14: a negative material names the argument (PyO3's OverflowError named
+    nothing), ``add_blocks`` takes any iterable as its stub says (a generator raised TypeError),
+    ``draw.save`` of an empty model says so (numpy's message), a scene key given twice and
+    ``monitor_interval: 0`` are refused on load (they loaded the last value, and as 1)."""
+    m = vs.Model()
+    with pytest.raises(ValueError, match="material = -1"):
+        m.add_cuboid("a", (0, 0, 0), (1, 1, 1), 2000.0, material=-1)
+    with pytest.raises(ValueError, match="material = 70000"):
+        vs.Block.cuboid("a", (0, 0, 0), (1, 1, 1), 2000.0, material=70000)
+    with pytest.raises(ValueError, match="voussoir_material = -2"):
+        vs.build.arch(voussoir_material=-2)
+    with pytest.raises(ValueError, match="n = -1"):
+        m.run_steps(-1)
+    with pytest.raises(ValueError, match="max_steps = -5"):
+        m.run_to_equilibrium(1e-5, -5)
+
+    blocks = vs.build.arch()
+    indices = m.add_blocks(b for b in blocks)
+    assert indices == list(range(len(blocks)))
+    with pytest.raises(TypeError, match=r"blocks\[1\]: expected a Block, got str; no block was added"):
+        vs.Model().add_blocks(iter([blocks[0], "stone"]))
+    with pytest.raises(TypeError, match="expected an iterable of Block, got int"):
+        m.add_blocks(3)
+
+    pytest.importorskip("matplotlib")
+    with pytest.raises(vs.VoussoirError, match="no blocks"):
+        vs.draw.save(vs.Model(), tmp_path / "empty.png")
+    assert not list(tmp_path.iterdir())
+
+    scene = block_on_base()
+    path = tmp_path / "scene.json"
+    scene.save_scene(path)
+    text = path.read_text()
+    assert '"density":' in text
+    with pytest.raises(vs.VoussoirError, match=r"blocks\[0\]\.density.*duplicate key `density`"):
+        vs.Model.from_scene_json(text.replace('"density":', '"density": 1.0, "density":', 1))
+    checkpoint = scene.to_checkpoint_string()
+    with pytest.raises(vs.VoussoirError, match="duplicate key `step`"):
+        vs.Model.from_checkpoint_string(checkpoint.replace('"step":', '"step": 0, "step":', 1))
+    doc = json.loads(text)
+    doc["monitor_interval"] = 0
+    with pytest.raises(vs.VoussoirError, match="monitor_interval.*at least 1"):
+        vs.Model.from_scene_json(json.dumps(doc))

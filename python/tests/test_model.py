@@ -3,6 +3,8 @@
 import math
 import os
 import signal
+import subprocess
+import sys
 import threading
 import time
 
@@ -448,6 +450,52 @@ def test_ctrl_c_stops_a_long_first_step():
     assert m.step_count == 0
     m.step()
     assert m.step_count == 1
+
+
+_PUSH_OVER_INTERRUPTED = """
+import os, signal, threading, time
+import voussoir as vs
+signal.signal(signal.SIGINT, signal.default_int_handler)
+m = vs.Model()
+m.set_joint_law(0, 0, vs.CoulombSlip.dry(1e9, 4e8, 30.0))
+m.set_joint_law(0, 1, vs.CoulombSlip.dry(1e9, 4e8, 0.0))
+m.add_cuboid("base", (-1, -1, -0.2), (1, 1, 0), 2500.0, fixed=True)
+m.add_cuboid("cube", (0, 0, 0), (0.2, 0.2, 0.2), 2500.0)
+pusher = m.add_cuboid(
+    "pusher", (-0.1, 0.05, 0.05), (0.0, 0.15, 0.15), 2500.0, material=1,
+    fixed={"translation": [0.0, "fixed", "fixed"], "rotation": ["fixed"] * 3},
+)
+m.run_steps(200)
+sent = []
+def interrupt():
+    sent.append(time.perf_counter())
+    os.kill(os.getpid(), signal.SIGINT)
+threading.Timer(0.3, interrupt).start()
+try:
+    # A servo that never finds its balance (threshold 1e-300): it waited until max_steps.
+    m.push_over(pusher, (1.0, 0.0, 0.0), 1e-6, max_unbalanced_ratio=1e-300, max_steps=50_000_000)
+except KeyboardInterrupt:
+    print("late", time.perf_counter() - sent[0])
+    n = m.step_count
+    m.run_steps(2)
+    assert m.step_count == n + 2
+    print("usable")
+"""
+
+
+def test_ctrl_c_stops_a_push_over_waiting_for_its_servo(tmp_path):
+    """Ctrl-C reaches a servo that waits for a balance it never finds (it was ignored until
+    ``max_steps``, minutes, then the result's first NumPy array panicked on the pending signal:
+    ``PanicException: Failed to access NumPy array API capsule``). In a fresh process, where
+    NumPy's API is first needed."""
+    script = tmp_path / "push.py"
+    script.write_text(_PUSH_OVER_INTERRUPTED)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    assert "PanicException" not in done.stderr, done.stderr
+    assert done.returncode == 0, done.stderr
+    lines = dict(line.split(" ", 1) if " " in line else (line, "") for line in done.stdout.split("\n") if line)
+    assert "usable" in lines, done.stdout
+    assert float(lines["late"]) < 1.0, done.stdout
 
 
 def test_sharp_block_keeps_its_energy():

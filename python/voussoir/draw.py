@@ -15,6 +15,8 @@ from typing import Optional, Sequence
 
 import numpy as np
 
+from ._voussoir import VoussoirError
+
 __all__ = ["draw", "save"]
 
 _PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
@@ -49,7 +51,8 @@ def draw(
     elevation: float = 20.0,
     azimuth: float = -60.0,
 ):
-    """Draws ``model``'s blocks into ``ax`` (a new figure when None) and returns the axes.
+    """Draws ``model``'s blocks into ``ax`` (a new figure when None) and returns the axes
+    (``VoussoirError`` for a model without blocks).
 
     ``view``: ``"3d"`` (a perspective of the faces, the axis against gravity up, seen from
     ``elevation`` and ``azimuth`` in degrees) or ``"xy"``, ``"xz"``, ``"yz"`` (the faces
@@ -61,6 +64,8 @@ def draw(
     import matplotlib.pyplot as plt
     from matplotlib import cm, colors
 
+    if len(model) == 0:
+        raise VoussoirError("draw: the model has no blocks, nothing to draw; add blocks first")
     if view != "3d" and view not in _PLANES:
         raise ValueError(f"view {view!r}: expected '3d', 'xy', 'xz' or 'yz'")
     if not np.isfinite(displacement_scale):
@@ -136,6 +141,8 @@ def save(model, path, *, dpi: int = 120, **options):
             pass
     import matplotlib.pyplot as plt
 
+    if len(model) == 0:
+        raise VoussoirError(f"draw.save({os.fspath(path)!r}): the model has no blocks, nothing to draw; no file written")
     folder = os.path.dirname(os.fspath(path))
     if folder:
         os.makedirs(folder, exist_ok=True)

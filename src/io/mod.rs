@@ -14,6 +14,7 @@ use std::path::Path;
 use crate::error::Error;
 /// Writes bytes so that a failure never leaves a half-written file (see the function).
 pub use crate::file::{read_text, write_atomically, MAX_TEXT_BYTES};
+pub use crate::json_keys::refuse_duplicate_keys;
 
 /// Writes any serialisable value as pretty JSON (for example an example's `summary.json`),
 /// creating the folder. Non-finite numbers become `null`.

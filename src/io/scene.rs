@@ -108,7 +108,7 @@ pub struct Scene<L> {
     /// Monitors.
     #[serde(default)]
     pub monitors: Vec<MonitorSpec>,
-    /// Sample the monitors every this many steps (default 1).
+    /// Sample the monitors every this many steps (default 1; 0 is refused on load).
     #[serde(default = "one")]
     pub monitor_interval: u64,
 }
@@ -163,11 +163,21 @@ impl<L: ConstitutiveLaw + Serialize + DeserializeOwned> Scene<L> {
                 message: format!("a scene file must be a JSON object {{ ... }} {SCENE_FIELDS}; found {found}"),
             });
         }
+        // serde's derived objects refuse a field given twice; this says so for every object
+        // (a map would keep the last value) with the same message.
+        crate::json_keys::refuse_duplicate_keys(text)?;
         let de = &mut serde_json::Deserializer::from_str(text);
-        serde_path_to_error::deserialize(de).map_err(|e| Error::Checkpoint {
+        let scene: Self = serde_path_to_error::deserialize(de).map_err(|e| Error::Checkpoint {
             path: e.path().to_string(),
             message: struct_as_array_message(&e.inner().to_string()),
-        })
+        })?;
+        if scene.monitor_interval == 0 {
+            return Err(Error::Checkpoint {
+                path: "monitor_interval".into(),
+                message: "0: the monitors are sampled every this many steps, at least 1".into(),
+            });
+        }
+        Ok(scene)
     }
 
     /// Reads a scene file.

@@ -39,6 +39,32 @@ pub(super) struct Pipeline<S> {
     pub timings: Timings,
     /// Asked at a long step's sequential points whether to stop ([`crate::Model::set_interrupt_check`]).
     pub interrupt: Option<crate::model::InterruptCheck>,
+    /// When a step last asked [`Self::interrupt`] before it began (`None`: never).
+    pub interrupt_asked: Option<std::time::Instant>,
+}
+
+/// How often a run of short steps asks the interrupt check, at most: a step asks it before it
+/// begins when this much wall-clock time has passed since the last ask (an ask costs a front
+/// end's signal check; a clock reading costs tens of nanoseconds).
+pub const INTERRUPT_INTERVAL: std::time::Duration = std::time::Duration::from_millis(20);
+
+impl<S> Pipeline<S> {
+    /// Whether the interrupt check, asked now if [`INTERRUPT_INTERVAL`] has passed since it was
+    /// last asked before a step, says to stop.
+    pub fn interrupt_due(&mut self) -> bool {
+        let Some(check) = &self.interrupt else {
+            return false;
+        };
+        let now = std::time::Instant::now();
+        if self
+            .interrupt_asked
+            .is_some_and(|t| now.duration_since(t) < INTERRUPT_INTERVAL)
+        {
+            return false;
+        }
+        self.interrupt_asked = Some(now);
+        check.stop()
+    }
 }
 
 impl<S> Default for Pipeline<S> {
@@ -57,6 +83,7 @@ impl<S> Default for Pipeline<S> {
             max_speed: None,
             timings: Timings::default(),
             interrupt: None,
+            interrupt_asked: None,
         }
     }
 }

@@ -15,8 +15,14 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// first step for blocks that overlap by more than the contact tolerance;
     /// [`Error::MissingJointLaw`] when blocks of materials with no law touch;
     /// [`Error::TimeStepTooLarge`] for a fixed step above the critical one;
-    /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway.
+    /// [`Error::Diverged`] naming the step and block when the state becomes non-finite or runaway;
+    /// [`Error::Interrupted`] when the interrupt check ([`Model::set_interrupt_check`]) says to
+    /// stop, asked before the step (at most every 20 ms of wall-clock time, so that every long
+    /// run, servo wait or push-over honours it) and between the batches of a contact detection.
     pub fn step(&mut self) -> Result<()> {
+        if self.pipeline.interrupt_due() {
+            return Err(Error::Interrupted { step: self.state.step });
+        }
         self.state.step(&mut self.pipeline)
     }
 

@@ -342,12 +342,15 @@ impl<L: ConstitutiveLaw> Model<L> {
             .ok_or(Error::UnknownBlock { id, count })
     }
 
-    /// Sets the check a long step asks, between the batches of a contact detection, whether to
-    /// stop (`None` removes it): a front end watching for Ctrl-C or a deadline. When it returns
-    /// `true` the step stops with [`Error::Interrupted`] before it changes any contact or block:
-    /// the model is as before the step, and its next step detects every contact afresh. The
-    /// first detection of a 100k-block wall asks it about every 25 ms on 2 cores. Not saved in
-    /// checkpoints.
+    /// Sets the check a step asks whether to stop (`None` removes it): a front end watching for
+    /// Ctrl-C or a deadline. A step asks it before it begins, when 20 ms of wall-clock time have
+    /// passed since it was last asked there (so that every run, servo wait and push-over, with
+    /// or without contact detection, honours it within a step), and a long step asks it between
+    /// the batches of its contact detection (about every 25 ms in the first detection of a
+    /// 100k-block wall on 2 cores). When it returns `true` the step stops with
+    /// [`Error::Interrupted`] before it changes any contact or block: the model is as before the
+    /// step (after an interrupted detection, its next step detects every contact afresh). Not
+    /// saved in checkpoints.
     ///
     /// ```
     /// use std::sync::atomic::{AtomicBool, Ordering};

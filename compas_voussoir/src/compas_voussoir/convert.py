@@ -6,8 +6,12 @@ Conventions (those of ``compas_dem`` and its other engines):
 - a block is an element of the model's graph, named by its graph node; ``is_support`` blocks
   are fixed;
 - the contact model is Mohr–Coulomb (``phi`` in degrees, ``c`` cohesion in Pa, ``t_c``
-  tensile strength in Pa); the joint model's ``kn``, ``kt`` are stiffnesses per unit area
-  (Pa/m, 3DEC's ``jkn``, ``jks``);
+  tensile strength in Pa); the joint model's ``kn``, ``kt`` are stiffnesses **per unit
+  area** (Pa/m, 3DEC's ``jkn``, ``jks``), not the N/m of ``compas_dem``'s
+  ``Problem.set_joint_model`` docstring: a joint of area ``A`` with ``kn`` Pa/m is a spring of
+  ``kn·A`` N/m. A value outside ``PLAUSIBLE_STIFFNESS`` (1e8–1e14 Pa/m) is used as given but
+  warned about (:class:`StiffnessUnitsWarning`), with the Pa/m it would be if it were a
+  whole joint's N/m;
 - loads are resolved to the block centroids by ``compas_dem``'s own
   ``resolve_centroidal_loads`` (point, surface and body loads), as for LMGC90; a ``"ramp"``
   load rises from zero over ``ramp_time`` and holds, an ``"instantaneous"`` one acts from the
@@ -15,6 +19,10 @@ Conventions (those of ``compas_dem`` and its other engines):
   constant rate over ``ramp_time``.
 """
 
+import math
+import os
+import sys
+import warnings
 from dataclasses import dataclass, field
 from typing import Dict, Optional
 
@@ -26,6 +34,33 @@ import voussoir as vs
 #: (Pulatsu et al. 2021); ``docs/theory.md`` §4.1 says how to choose them.
 DEFAULT_KN = 4e9
 DEFAULT_KS = 1.6e9
+
+#: The joint stiffnesses per unit area (Pa/m) of masonry joints, from a soft lime-mortar bed
+#: (E ≈ 0.1–1 GPa over 10–20 mm: 5e9–1e11) or a dry joint (measured 1e9–1e11) down to a very
+#: soft one with a decade to spare (1e8), up to stone on stone (E ≈ 50 GPa over a 1 mm
+#: asperity layer: 5e13) with a factor to spare (1e14). A whole-joint stiffness in N/m is the
+#: per-area one times the joint's area (0.01–0.5 m² for stones and bricks): a value given in
+#: N/m is one to two decades smaller, and a value below 1e8 "Pa/m" is most likely N/m (or a
+#: slip of the exponent); above 1e14 Pa/m the DEM's time step (∝ 1/√kn) becomes tiny for no
+#: gain in accuracy (the rigid limit is reached long before; docs/theory.md §4.1).
+PLAUSIBLE_STIFFNESS = (1e8, 1e14)
+
+#: The ``voussoir.Model`` keywords that ``to_voussoir`` and the analyses pass on (gravity comes
+#: from the problem; ``contact_tolerance`` and ``subcontacts_per_edge`` have their own).
+MODEL_OPTIONS = ("subcontact_spacing", "time_step", "safety", "mode", "max_speed", "impact_step")
+
+_SOURCE_NAMES = {
+    "kn=": "kn",
+    "ks=": "ks",
+    "joint model kn": "the joint model's kn (problem.set_joint_model)",
+    "joint model kt": "the joint model's kt (problem.set_joint_model)",
+}
+
+
+class StiffnessUnitsWarning(UserWarning):
+    """A joint stiffness outside :data:`PLAUSIBLE_STIFFNESS` (1e8–1e14 Pa/m): compas_voussoir
+    reads ``kn``, ``kt`` per unit area (Pa/m); ``compas_dem``'s ``set_joint_model`` docstring
+    says N/m (a whole joint's spring). The value is used as given."""
 
 
 @dataclass
@@ -64,8 +99,19 @@ def _density(block, node, density, densities):
     )
 
 
+def _stiffness(value, name):
+    """A joint stiffness (Pa/m) as a float; ``name`` says where it came from."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise ValueError(f"{name} = {value!r}: a joint stiffness per unit area (Pa/m) expected, a number")
+    v = float(value)
+    if not math.isfinite(v) or v <= 0.0:
+        raise ValueError(f"{name} = {value!r}: a joint stiffness per unit area (Pa/m) must be positive and finite")
+    return v
+
+
 def joint_law(problem, kn=None, ks=None):
-    """The ``voussoir.CoulombSlip`` of the problem's contact and joint models, and its parameters."""
+    """The ``voussoir.CoulombSlip`` of the problem's contact and joint models, and its parameters
+    (``kn``, ``ks`` in Pa/m: per unit joint area; ``sources`` says where each came from)."""
     props = problem.contact_properties
     cm = props.contact_model
     if cm is None:
@@ -74,13 +120,94 @@ def joint_law(problem, kn=None, ks=None):
     cohesion = float(cm.c or 0.0)
     tension = float(cm.t_c or 0.0)
     jm = props.joint_model
-    default = jm is None or jm.kn is None
-    kn = float(kn if kn is not None else (jm.kn if not default else DEFAULT_KN))
-    if ks is None:
-        ks = jm.kt if (jm is not None and jm.kt is not None) else (DEFAULT_KS if default else 0.4 * kn)
-    ks = float(ks)
+    if kn is not None:
+        kn, kn_from = _stiffness(kn, "kn"), "kn="
+    elif jm is not None and jm.kn is not None:
+        kn, kn_from = _stiffness(jm.kn, "the joint model's kn (problem.set_joint_model)"), "joint model kn"
+    else:
+        kn, kn_from = DEFAULT_KN, "default"
+    if ks is not None:
+        ks, ks_from = _stiffness(ks, "ks"), "ks="
+    elif jm is not None and jm.kt is not None:
+        ks, ks_from = _stiffness(jm.kt, "the joint model's kt (problem.set_joint_model)"), "joint model kt"
+    elif kn_from == "default":
+        ks, ks_from = DEFAULT_KS, "default"
+    else:
+        ks, ks_from = 0.4 * kn, "0.4 kn"
+    default = kn_from == "default"
     law = vs.CoulombSlip(kn, ks, phi, residual_friction_deg=phi, cohesion=cohesion, tensile_strength=tension)
-    return law, {"kn": kn, "ks": ks, "phi": phi, "cohesion": cohesion, "tensile_strength": tension, "default_stiffness": default}
+    return law, {
+        "kn": kn,
+        "ks": ks,
+        "units": "Pa/m",
+        "phi": phi,
+        "cohesion": cohesion,
+        "tensile_strength": tension,
+        "default_stiffness": default,
+        "sources": {"kn": kn_from, "ks": ks_from},
+    }
+
+
+def _polygon_area(points):
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    if len(p) < 3:
+        return 0.0
+    return 0.5 * float(np.linalg.norm(np.cross(p - p[0], np.roll(p, -1, axis=0) - p[0]).sum(axis=0)))
+
+
+def joint_areas(m):
+    """The areas (m²) of the contacts of the ``voussoir.Model`` ``m`` as one step finds them
+    (on a copy: ``m`` is not stepped); ``None`` when they cannot be found."""
+    try:
+        copy = vs.Model.from_checkpoint_string(m.to_checkpoint_string())
+        copy.step()
+        areas = [_polygon_area(p) for p in copy.contacts()["polygon"]]
+    except (ValueError, MemoryError, OSError):
+        return None
+    areas = [a for a in areas if a > 0.0]
+    return np.asarray(areas) if areas else None
+
+
+def warn(warning):
+    """``warnings.warn`` pointing at the first caller outside compas_voussoir (the user's line,
+    whichever way the call came: ``solve``, ``run``, ``problem.solve()``)."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    level, frame = 2, sys._getframe(1)
+    while frame is not None and os.path.dirname(os.path.abspath(frame.f_code.co_filename)) == here:
+        frame, level = frame.f_back, level + 1
+    warnings.warn(warning, stacklevel=level)
+
+
+def check_stiffnesses(values, m=None):
+    """Warns (:class:`StiffnessUnitsWarning`) for each ``{name: stiffness}`` outside
+    :data:`PLAUSIBLE_STIFFNESS`, with what it would be in Pa/m if it were a whole joint's N/m
+    (divided by the median area of the joints of ``m``, when given). Returns the names warned
+    about."""
+    lo, hi = PLAUSIBLE_STIFFNESS
+    odd = {name: v for name, v in values.items() if not lo <= v <= hi}
+    if not odd:
+        return []
+    areas = joint_areas(m) if m is not None else None
+    area = float(np.median(areas)) if areas is not None else None
+    for name, v in odd.items():
+        where = "below" if v < lo else "above"
+        text = (
+            f"{name} = {v:.4g} Pa/m is {where} the {lo:.0e}–{hi:.0e} Pa/m of masonry joints. compas_voussoir reads "
+            "joint stiffnesses per unit area (Pa/m, 3DEC's jkn/jks), not the N/m of compas_dem's "
+            "set_joint_model docstring"
+        )
+        if area is not None:
+            per_area = v / area
+            plausible = lo <= per_area <= hi
+            text += (
+                f"; if {v:.4g} is a whole joint's stiffness in N/m, divide it by the joint's area: these joints' "
+                f"median area is {area:.4g} m², which gives {per_area:.4g} Pa/m"
+                + ("" if plausible else " (still outside the range)")
+            )
+        else:
+            text += "; if it is a whole joint's stiffness in N/m, divide it by the joint's area (m²)"
+        warn(StiffnessUnitsWarning(text + ". The value is used as given."))
+    return list(odd)
 
 
 def to_voussoir(
@@ -103,9 +230,17 @@ def to_voussoir(
     graph node. ``kn``, ``ks`` (Pa/m) override the joint model. ``interfaces`` maps a pair of
     graph nodes to the Mohr–Coulomb and stiffness values of that interface only
     (``{"phi", "c", "t_c", "kn", "kt"}``, missing ones taken from the problem), as
-    ``compas_3dec``'s per-interface properties.
+    ``compas_3dec``'s per-interface properties. Stiffnesses are per unit joint area (Pa/m);
+    one outside :data:`PLAUSIBLE_STIFFNESS` is warned about (:class:`StiffnessUnitsWarning`).
+    ``model_options``: the ``voussoir.Model`` keywords in :data:`MODEL_OPTIONS`.
     """
     model = model if model is not None else problem.model
+    unknown = sorted(set(model_options) - set(MODEL_OPTIONS))
+    if unknown:
+        raise TypeError(
+            f"unexpected keyword argument{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}; "
+            f"voussoir.Model options are {', '.join(MODEL_OPTIONS)}"
+        )
     law, params = joint_law(problem, kn, ks)
     g = _gravity(problem)
     m = vs.Model(
@@ -122,11 +257,31 @@ def to_voussoir(
         rho = _density(element, n, density, densities)
         i = m.add_polyhedron(f"block {n}", vertices, rho, faces=faces, fixed=bool(element.is_support))
         index[n], node[i] = i, n
-    for (a, b), values in (interfaces or {}).items():
+    for n in densities or {}:
+        if n not in index:
+            raise ValueError(f"densities: block {n!r} is not a node of the model's graph")
+    stiffnesses = {} if params["default_stiffness"] else {_SOURCE_NAMES[params["sources"]["kn"]]: params["kn"]}
+    if params["sources"]["ks"] in ("ks=", "joint model kt"):
+        stiffnesses[_SOURCE_NAMES[params["sources"]["ks"]]] = params["ks"]
+    if interfaces is not None and not isinstance(interfaces, dict):
+        raise ValueError(f"interfaces = {interfaces!r}: a dict {{(u, v): {{'phi', 'c', 't_c', 'kn', 'kt'}}}} expected")
+    for key, values in (interfaces or {}).items():
+        if not (isinstance(key, tuple) and len(key) == 2):
+            raise ValueError(f"interfaces: key {key!r} is not a pair of graph nodes (u, v)")
+        a, b = key
         if a not in index or b not in index:
             raise ValueError(f"interfaces: no block {a if a not in index else b} in the model")
-        kn_i = float(values.get("kn", params["kn"]))
-        ks_i = float(values.get("kt", params["ks"] if "kn" not in values else 0.4 * kn_i))
+        extra = sorted(set(values) - {"phi", "c", "t_c", "kn", "kt"})
+        if extra:
+            raise ValueError(f"interfaces[{key!r}]: unknown keys {extra}; expected phi, c, t_c, kn, kt")
+        kn_i = _stiffness(values["kn"], f"interfaces[{key!r}]['kn']") if "kn" in values else params["kn"]
+        if "kt" in values:
+            ks_i = _stiffness(values["kt"], f"interfaces[{key!r}]['kt']")
+        else:
+            ks_i = params["ks"] if "kn" not in values else 0.4 * kn_i
+        for name in ("kn", "kt"):
+            if name in values:
+                stiffnesses[f"interfaces[{key!r}]['{name}']"] = kn_i if name == "kn" else ks_i
         phi_i = float(values.get("phi", params["phi"]))
         m.set_interface_law(
             index[a],
@@ -140,6 +295,7 @@ def to_voussoir(
                 tensile_strength=float(values.get("t_c", params["tensile_strength"]) or 0.0),
             ),
         )
+    params["units_warning"] = check_stiffnesses(stiffnesses, m)
     return Conversion(
         model=m,
         index=index,
@@ -177,11 +333,12 @@ def centroidal_loads(problem, model, conversion):
 
 def live_loads(problem, model, conversion, names):
     """The point, surface and body loads of the boundary conditions named ``names`` as
-    ``voussoir.limit`` live loads (a force at a point, N per unit multiplier)."""
+    ``voussoir.limit`` live loads (a force at a point, N per unit multiplier); loads of zero
+    force are left out (none left: only the dead load is to be checked)."""
     groups = [bc for bc in problem.boundary_conditions if bc.name in names]
     missing = set(names) - {bc.name for bc in groups}
     if missing:
-        raise ValueError(f"no boundary condition named {sorted(missing)}; the problem has {[bc.name for bc in problem.boundary_conditions]}")
+        raise ValueError(f"live: no boundary condition named {sorted(missing)}; the problem has {[bc.name for bc in problem.boundary_conditions]}")
     loads = []
     for bc in groups:
         for e in bc.point_loads:
@@ -207,6 +364,6 @@ def live_loads(problem, model, conversion, names):
                 loads.append(
                     {"block": i, "point": list(conversion.centroids[i]), "force": list(np.asarray(e.acceleration) * mass)}
                 )
-    if not loads:
-        raise ValueError(f"the boundary conditions {sorted(names)} hold no loads")
-    return loads
+    # A zero live load asks only whether the dead load is carried: dropped here (the limit
+    # analysis then checks the dead load alone).
+    return [load for load in loads if np.any(np.asarray(load["force"], dtype=float) != 0.0)]

@@ -69,6 +69,8 @@ impl PyModel {
     /// A model from scene JSON, with its monitors (laws with or without their kind).
     #[staticmethod]
     pub(crate) fn from_scene_json(text: &str) -> PyResult<Self> {
+        // Before `normalised`, whose `Value` would keep a duplicate key's last value.
+        voussoir::io::refuse_duplicate_keys(text).py()?;
         let scene = match normalised(text) {
             Some(t) => Scene::<AnyLaw>::from_json(&t),
             None => Scene::<AnyLaw>::from_json(text),
@@ -107,6 +109,7 @@ impl PyModel {
     /// A model from checkpoint JSON (of this package, or of a Rust model with one law type).
     #[staticmethod]
     fn from_checkpoint_string(text: &str) -> PyResult<Self> {
+        voussoir::io::refuse_duplicate_keys(text).py()?;
         let model = match normalised(text) {
             Some(t) => Model::<AnyLaw>::from_checkpoint_str(&t),
             None => Model::<AnyLaw>::from_checkpoint_str(text),

@@ -145,7 +145,7 @@ impl PyModel {
     fn new(
         gravity: Option<&Bound<'_, PyAny>>,
         contact_tolerance: f64,
-        subcontacts_per_edge: u16,
+        subcontacts_per_edge: i64,
         subcontact_spacing: Option<f64>,
         time_step: Option<f64>,
         safety: f64,
@@ -153,6 +153,8 @@ impl PyModel {
         max_speed: f64,
         impact_step: Option<f64>,
     ) -> PyResult<Self> {
+        let subcontacts_per_edge =
+            crate::convert::whole(subcontacts_per_edge, "subcontacts_per_edge", u64::from(u16::MAX))? as u16;
         let mut params = ModelParameters::default();
         if let Some(g) = gravity {
             params.gravity = vec3(g, "gravity")?;
@@ -317,10 +319,31 @@ impl PyModel {
         Ok(this.model.add_block(block.inner.clone()).py()?.index())
     }
 
-    /// Adds blocks (a list from ``voussoir.build``, say); returns their indices. All or nothing:
-    /// when one is refused, none is added (the error names the first refused, by its position
-    /// in the list).
-    fn add_blocks(&self, py: Python<'_>, blocks: Vec<PyRef<'_, PyBlock>>) -> PyResult<Vec<usize>> {
+    /// Adds blocks (any iterable of ``Block``: a list from ``voussoir.build``, a generator);
+    /// returns their indices. All or nothing: when one is refused, none is added (the error
+    /// names the first refused, by its position in the iterable).
+    fn add_blocks(&self, py: Python<'_>, blocks: &Bound<'_, PyAny>) -> PyResult<Vec<usize>> {
+        // Taken in full before the model is locked: a generator may read the model.
+        let mut taken: Vec<PyRef<'_, PyBlock>> = Vec::new();
+        let items = blocks.try_iter().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "blocks: expected an iterable of Block, got {}",
+                blocks.get_type().name().map_or_else(|_| "?".into(), |n| n.to_string())
+            ))
+        })?;
+        for (k, item) in items.enumerate() {
+            if k == crate::convert::MAX_ITEMS {
+                return Err(crate::convert::too_many("blocks"));
+            }
+            let item = item?;
+            taken.push(item.extract().map_err(|_| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "blocks[{k}]: expected a Block, got {}; no block was added",
+                    item.get_type().name().map_or_else(|_| "?".into(), |n| n.to_string())
+                ))
+            })?);
+        }
+        let blocks = taken;
         let mut this = self.lock(py);
         // The checks of `add_block` depend on the parameters only: tried on an empty model first.
         let mut trial = Model::<AnyLaw>::new(*this.model.parameters()).py()?;
@@ -346,7 +369,7 @@ impl PyModel {
         min: &Bound<'_, PyAny>,
         max: &Bound<'_, PyAny>,
         density: f64,
-        material: u16,
+        material: i64,
         fixed: Option<&Bound<'_, PyAny>>,
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
@@ -368,7 +391,7 @@ impl PyModel {
         vertices: &Bound<'_, PyAny>,
         density: f64,
         faces: Option<Vec<Vec<usize>>>,
-        material: u16,
+        material: i64,
         fixed: Option<&Bound<'_, PyAny>>,
         velocity: Option<&Bound<'_, PyAny>>,
         angular_velocity: Option<&Bound<'_, PyAny>>,
@@ -429,9 +452,10 @@ impl PyModel {
         fallen_travel: Option<f64>,
         sample_travel: Option<f64>,
         smoothing_window: f64,
-        max_steps: u64,
+        max_steps: i64,
         progress: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
+        let max_steps = crate::convert::whole(max_steps, "max_steps", u64::MAX)?;
         let direction = vec3(direction, "direction")?;
         let mut guard = self.lock(py);
         let id = guard.id(&block, "block index")?;

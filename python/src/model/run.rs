@@ -215,11 +215,13 @@ impl PyModel {
     #[pyo3(signature = (n, callback=None, every=1000, *, progress=false))]
     fn run_steps(
         slf: &Bound<'_, Self>,
-        n: u64,
+        n: i64,
         callback: Option<&Bound<'_, PyAny>>,
-        every: u64,
+        every: i64,
         progress: bool,
     ) -> PyResult<bool> {
+        let n = crate::convert::whole(n, "n", u64::MAX)?;
+        let every = crate::convert::whole(every, "every", u64::MAX)?;
         Ok(Self::run(slf, Goal::Steps(n), callback, every, progress)?.1)
     }
 
@@ -230,9 +232,10 @@ impl PyModel {
         slf: &Bound<'_, Self>,
         t: f64,
         callback: Option<&Bound<'_, PyAny>>,
-        every: u64,
+        every: i64,
         progress: bool,
     ) -> PyResult<bool> {
+        let every = crate::convert::whole(every, "every", u64::MAX)?;
         Ok(Self::run(slf, Goal::Time(t), callback, every, progress)?.1)
     }
 
@@ -244,11 +247,13 @@ impl PyModel {
     fn run_to_equilibrium(
         slf: &Bound<'_, Self>,
         ratio: f64,
-        max_steps: u64,
+        max_steps: i64,
         callback: Option<&Bound<'_, PyAny>>,
-        every: u64,
+        every: i64,
         progress: bool,
     ) -> PyResult<u64> {
+        let max_steps = crate::convert::whole(max_steps, "max_steps", u64::MAX)?;
+        let every = crate::convert::whole(every, "every", u64::MAX)?;
         Ok(Self::run(
             slf,
             Goal::Equilibrium {

@@ -172,6 +172,8 @@ where
             path: e.path().to_string(),
             message: e.inner().to_string(),
         };
+        // A key given twice would be read as its last value by `Value`.
+        crate::json_keys::refuse_duplicate_keys(text)?;
         let mut value: serde_json::Value = serde_json::from_str(text)
             .map_err(|e| corrupt("(document)", &format!("not a complete JSON document: {e}")))?;
         // The format and version first, so that a file of another version is named as such
