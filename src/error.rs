@@ -329,8 +329,10 @@ pub enum Error {
         /// What was asked and why it cannot be done.
         what: String,
     },
-    /// A run reached its step budget before its stopping condition.
-    #[error("{what} not reached after {steps} steps (last value {last})")]
+    /// A run reached its step budget before its stopping condition. An infinite unbalanced-force
+    /// ratio says that no contact carries a force (nothing supports the blocks, or they have
+    /// not touched yet): the message says so.
+    #[error("{what} not reached after {steps} steps (last value {last}){}", not_converged_hint(.last))]
     NotConverged {
         /// What was being waited for.
         what: &'static str,
@@ -424,5 +426,15 @@ pub(crate) fn io_error(path: &std::path::Path, e: &std::io::Error) -> Error {
     Error::Io {
         path: path.display().to_string(),
         message: e.to_string(),
+    }
+}
+
+/// What an infinite last value of [`Error::NotConverged`] means.
+fn not_converged_hint(last: &Real) -> &'static str {
+    if last.is_infinite() {
+        ": no contact carries a force, so nothing holds the blocks up; a model settles on a fixed \
+         block or a block with a prescribed motion under it"
+    } else {
+        ""
     }
 }

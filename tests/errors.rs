@@ -719,6 +719,26 @@ fn equilibrium_not_reached() {
     );
 }
 
+/// A model with nothing fixed falls: `run_to_equilibrium` ends with an infinite ratio (no
+/// contact carries a force) and says what that means (it said only "last value inf").
+#[test]
+fn equilibrium_without_a_support_says_so() {
+    let mut model: Model = Model::new(ModelParameters::default()).unwrap();
+    model
+        .set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0).unwrap())
+        .unwrap();
+    model
+        .add_block(RigidBlock::cuboid("stone", Vector::ZERO, Vector::splat(0.2), 2500.0).unwrap())
+        .unwrap();
+    let e = model.run_to_equilibrium(1e-5, 200).unwrap_err();
+    assert!(matches!(e, Error::NotConverged { last, .. } if last.is_infinite()), "{e:?}");
+    assert_names(&e.to_string(), &["200 steps", "no contact carries a force", "fixed"]);
+    // A finite last value keeps the plain message.
+    let mut model = slab_and_cube(ModelParameters::default());
+    let e = model.run_to_equilibrium(1e-12, 5).unwrap_err();
+    assert!(!e.to_string().contains("no contact"), "{e}");
+}
+
 /// File and checkpoint errors: writing a checkpoint below a regular file fails with `Io` naming
 /// the path; corrupt checkpoint text fails with `Checkpoint` naming where.
 #[test]

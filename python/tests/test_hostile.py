@@ -239,3 +239,13 @@ def test_round3_arguments_and_files_say_what_is_wrong(tmp_path):
     doc["monitor_interval"] = 0
     with pytest.raises(vs.VoussoirError, match="monitor_interval.*at least 1"):
         vs.Model.from_scene_json(json.dumps(doc))
+
+
+def test_equilibrium_without_a_support_says_why():
+    """Probe 3, F12: a model with nothing fixed falls, and ``run_to_equilibrium`` says that no
+    contact carries a force (it said only "last value inf")."""
+    m = vs.Model()
+    m.set_joint_law(0, 0, vs.CoulombSlip.dry(1e9, 4e8, 30.0))
+    m.add_cuboid("stone", (0, 0, 0), (0.2, 0.2, 0.2), 2500.0)
+    with pytest.raises(vs.VoussoirError, match="no contact carries a force.*fixed"):
+        m.run_to_equilibrium(1e-5, 200)
