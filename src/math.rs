@@ -14,6 +14,13 @@ pub fn is_finite_vector(v: Vector) -> bool {
     v.x.is_finite() && v.y.is_finite() && v.z.is_finite()
 }
 
+/// Returns `true` for a pose with a finite translation and a finite unit rotation (to 1e-9,
+/// as blocks are checked): what a file may hold.
+#[inline]
+pub(crate) fn is_unit_pose(p: &Pose) -> bool {
+    is_finite_vector(p.translation) && p.rotation.is_finite() && (p.rotation.length() - 1.0).abs() <= 1e-9
+}
+
 /// An orthonormal pair `(u, v)` spanning the plane perpendicular to the unit vector `n`,
 /// such that `(u, v, n)` is right-handed.
 #[inline]

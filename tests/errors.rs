@@ -731,7 +731,10 @@ fn equilibrium_without_a_support_says_so() {
         .add_block(RigidBlock::cuboid("stone", Vector::ZERO, Vector::splat(0.2), 2500.0).unwrap())
         .unwrap();
     let e = model.run_to_equilibrium(1e-5, 200).unwrap_err();
-    assert!(matches!(e, Error::NotConverged { last, .. } if last.is_infinite()), "{e:?}");
+    assert!(
+        matches!(e, Error::NotConverged { last, .. } if last.is_infinite()),
+        "{e:?}"
+    );
     assert_names(&e.to_string(), &["200 steps", "no contact carries a force", "fixed"]);
     // A finite last value keeps the plain message.
     let mut model = slab_and_cube(ModelParameters::default());

@@ -3,8 +3,6 @@
 mod changes;
 #[cfg(feature = "serde")]
 mod checkpoint;
-#[cfg(feature = "serde")]
-mod checkpoint_tested;
 mod contact_pass;
 mod detection;
 mod energy;

@@ -14,12 +14,12 @@
 //! `read.rs` reads and checks one.
 
 mod read;
+mod tested;
 mod write;
 
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
-use super::checkpoint_tested::TestedEntry;
 use super::ModelParameters;
 use crate::block::{RigidBlock, Wrench};
 use crate::contact::{AnchorPlane, ContactWrench};
@@ -28,8 +28,9 @@ use crate::geometry::{ContactKind, SubKey};
 use crate::integrate::{CriticalStep, Damping};
 use crate::law::{ConstitutiveLaw, LawTable};
 use crate::law::{JointForce, JointStatus};
-use crate::math::{is_finite_vector, Pose, Real, Rotation, Vector, Vector2};
+use crate::math::{Pose, Real, Rotation, Vector, Vector2};
 use crate::model::Energies;
+use tested::TestedEntry;
 
 const FORMAT: &str = "voussoir-checkpoint";
 /// Version 9 stores joints through [`ContactEntry`], apart from the step's storage layout, so
@@ -164,11 +165,6 @@ struct SubContactEntry<S> {
     status: JointStatus,
     state: S,
     dashpot: Vector,
-}
-
-/// Whether a pose is finite with a unit rotation (to 1e-9, as blocks are checked).
-pub(super) fn pose_ok(p: &Pose) -> bool {
-    is_finite_vector(p.translation) && p.rotation.is_finite() && (p.rotation.length() - 1.0).abs() <= 1e-9
 }
 
 /// The checksum of a checkpoint document (without its checksum field): CRC-32 (IEEE) of its

@@ -7,9 +7,9 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
+use super::tested::{check_slacks, tested_pairs};
 use super::{
-    checksum_of, law_type_name, pose_ok, ContactEntry, Header, Snapshot, CHECKSUM, FORMAT, MAX_COUNT, MIN_STORED_BOUND,
-    VERSION,
+    checksum_of, law_type_name, ContactEntry, Header, Snapshot, CHECKSUM, FORMAT, MAX_COUNT, MIN_STORED_BOUND, VERSION,
 };
 use crate::block::Block;
 use crate::contact::{ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord};
@@ -17,22 +17,22 @@ use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::integrate::{CentralDifference, CriticalStep, TimeStep};
 use crate::law::ConstitutiveLaw;
+use crate::math::is_unit_pose;
 use crate::math::{is_finite_vector, Real, Vector};
-use crate::model::checkpoint_tested::{check_slacks, tested_pairs};
 use crate::model::{Model, ModelParameters};
 
-/// The step's storage rebuilt from checkpointed joints: contacts, their references and
+/// The contacts of a checkpoint as the step stores them: the pairs, their references and
 /// wrenches, the sub-contacts and their records (each contact's range in order).
-#[allow(clippy::type_complexity)]
-fn into_storage<S>(
-    entries: Vec<ContactEntry<S>>,
-) -> (
-    Vec<ContactPair>,
-    Vec<ContactReference>,
-    Vec<ContactWrench>,
-    Vec<SubContact<S>>,
-    Vec<SubContactRecord>,
-) {
+struct Storage<S> {
+    pairs: Vec<ContactPair>,
+    references: Vec<ContactReference>,
+    wrenches: Vec<ContactWrench>,
+    subs: Vec<SubContact<S>>,
+    sub_records: Vec<SubContactRecord>,
+}
+
+/// The step's storage rebuilt from checkpointed joints.
+fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Storage<S> {
     let total = entries.iter().map(|e| e.subcontacts.len()).sum();
     let (mut pairs, mut references, mut wrenches) = (
         Vec::with_capacity(entries.len()),
@@ -91,7 +91,13 @@ fn into_storage<S>(
         });
         wrenches.push(e.wrench);
     }
-    (pairs, references, wrenches, subs, records)
+    Storage {
+        pairs,
+        references,
+        wrenches,
+        subs,
+        sub_records: records,
+    }
 }
 
 impl<L> Model<L>
@@ -164,385 +170,24 @@ where
     /// [`Error::CheckpointChecksum`], [`Error::CheckpointLawType`],
     /// [`Error::CheckpointContactLaw`] and [`Error::CheckpointBlock`] as above; never a panic.
     pub fn from_checkpoint_str(text: &str) -> Result<Self> {
-        let corrupt = |path: &str, message: &str| Error::Checkpoint {
-            path: path.into(),
-            message: message.into(),
-        };
-        let typed_error = |e: serde_path_to_error::Error<serde_json::Error>| Error::Checkpoint {
-            path: e.path().to_string(),
-            message: e.inner().to_string(),
-        };
-        // A key given twice would be read as its last value by `Value`.
-        crate::json_keys::refuse_duplicate_keys(text)?;
-        let mut value: serde_json::Value = serde_json::from_str(text)
-            .map_err(|e| corrupt("(document)", &format!("not a complete JSON document: {e}")))?;
-        // The format and version first, so that a file of another version is named as such
-        // rather than failing on the first field that changed.
-        let Ok(header) = Header::deserialize(&value) else {
-            // Let the typed reading say which field is wrong.
-            return Err(match serde_path_to_error::deserialize::<_, Snapshot<L>>(value) {
-                Err(e) => typed_error(e),
-                Ok(_) => corrupt("format", &format!("not a {FORMAT}")),
-            });
-        };
-        if header.format != FORMAT {
-            return Err(corrupt("format", &format!("\"{}\" is not a {FORMAT}", header.format)));
-        }
-        if header.version != VERSION {
-            return Err(corrupt(
-                "version",
-                &format!(
-                    "{FORMAT} version {}; this build reads version {VERSION}",
-                    header.version
-                ),
-            ));
-        }
-        // The checksum over the rest: any value changed since the save is refused here.
-        let stored = match value.as_object_mut().and_then(|m| m.remove(CHECKSUM)) {
-            Some(serde_json::Value::String(s)) => s,
-            Some(_) => return Err(corrupt(CHECKSUM, "not a string")),
-            None => return Err(corrupt(CHECKSUM, "missing: the file is truncated or was edited")),
-        };
-        let computed = checksum_of(&value);
-        if stored != computed {
-            return Err(Error::CheckpointChecksum { stored, computed });
-        }
-        // The law type before the laws, which would fail on the first field that differs.
-        if let (Some(written), Some(loading)) = (header.law_type.as_deref(), law_type_name::<L>()) {
-            if written != loading {
-                return Err(Error::CheckpointLawType {
-                    written: written.into(),
-                    loading: loading.into(),
-                });
-            }
-        }
-        let snap: Snapshot<L> = serde_path_to_error::deserialize(value).map_err(typed_error)?;
-        if snap.format != FORMAT || snap.version != VERSION {
-            return Err(corrupt("format", &format!("not a {FORMAT} version {VERSION}")));
-        }
-        snap.params.validate()?;
-        snap.damping.validate()?;
-        let n = snap.blocks.len();
-        if !snap.joints.check() {
-            return Err(corrupt("joints", "law index out of range"));
-        }
-        // Laws are validated as on `set_joint_law` (serde only checks their shape).
-        for (k, law) in snap.joints.laws().iter().enumerate() {
-            crate::law::check_law(law).map_err(|e| corrupt(&format!("joints.laws[{k}]"), &e.to_string()))?;
-        }
-        if snap.ref_poses.len() != n {
-            return Err(corrupt("ref_poses", "one pose per block expected"));
-        }
-        if let Some(i) = snap.ref_poses.iter().position(|p| !pose_ok(p)) {
-            return Err(corrupt(
-                &format!("ref_poses[{i}]"),
-                "not a finite pose with a unit rotation",
-            ));
-        }
-        let tested = tested_pairs(&snap.tested, n)?;
-        if snap.last_forces.len() != n {
-            return Err(corrupt("last_forces", "one pair of wrenches per block expected"));
-        }
-        check_run_state(&snap)?;
-        let (pairs, references, wrenches, subs, sub_records) = into_storage(snap.contacts);
-        if let Some(k) = pairs
-            .iter()
-            .position(|p| tested.binary_search_by_key(&(p.a, p.b), |t| (t.a, t.b)).is_err())
-        {
-            return Err(corrupt(
-                &format!("contacts[{k}].blocks"),
-                "a contact between blocks the narrow phase did not test",
-            ));
-        }
-        if let Some(k) = wrenches
-            .iter()
-            .position(|w| !(is_finite_vector(w.force) && is_finite_vector(w.moment_a) && is_finite_vector(w.moment_b)))
-        {
-            return Err(corrupt(&format!("contacts[{k}].wrench"), "non-finite force or moment"));
-        }
-        let mut next = 0usize;
-        for (k, p) in pairs.iter().enumerate() {
-            let faces_ok = match p.kind {
-                crate::geometry::ContactKind::FaceFace { face_a, face_b } => {
-                    (p.a as usize) < n
-                        && (p.b as usize) < n
-                        && (face_a as usize) < snap.blocks[p.a as usize].shape_face_count()
-                        && (face_b as usize) < snap.blocks[p.b as usize].shape_face_count()
-                }
-                crate::geometry::ContactKind::Nodes => {
-                    (p.a as usize) < n
-                        && (p.b as usize) < n
-                        && (p.first as usize + p.count as usize) <= subs.len().min(sub_records.len())
-                        && nodes_fit(
-                            (snap.blocks[p.a as usize].shape(), snap.blocks[p.b as usize].shape()),
-                            &subs[p.range()],
-                            &sub_records[p.range()],
-                        )
-                }
-            };
-            if !orthonormal(p.normal, p.tangent) {
-                return Err(corrupt(&format!("contacts[{k}].tangent"), "joint axes not orthonormal"));
-            }
-            if !orthonormal(p.anchors.u, p.anchors.v) {
-                return Err(corrupt(
-                    &format!("contacts[{k}].anchors"),
-                    "anchor plane axes not orthonormal",
-                ));
-            }
-            let sorted = k == 0 || (pairs[k - 1].a, pairs[k - 1].b) < (p.a, p.b);
-            let (start, end) = (p.first as usize, p.first as usize + p.count as usize);
-            let ok = faces_ok
-                && sorted
-                && (p.a as usize) < n
-                && (p.b as usize) < n
-                && p.a < p.b
-                && (p.law as usize) < snap.joints.laws().len()
-                && start == next
-                && end <= subs.len();
-            if !ok {
-                return Err(corrupt(
-                    &format!("contacts[{k}]"),
-                    "inconsistent block, law or sub-contact indices",
-                ));
-            }
-            // The law is the one detection gives the pair: the interface's own, else the one
-            // its materials map to. A law set since the last detection takes effect at the next
-            // step's full detection (`pending_detection`), so the contact may still hold the
-            // law it was detected with (any law of the table).
-            let (material_a, material_b) = (
-                snap.blocks[p.a as usize].material(),
-                snap.blocks[p.b as usize].material(),
-            );
-            let expected = snap
-                .joints
-                .index_for((BlockId(p.a), material_a), (BlockId(p.b), material_b));
-            if expected != Some(p.law) && !snap.pending_detection {
-                return Err(Error::CheckpointContactLaw {
-                    contact: k,
-                    a: BlockId(p.a),
-                    b: BlockId(p.b),
-                    material_a,
-                    material_b,
-                    law: p.law,
-                    expected: expected.map_or_else(|| "no law".into(), |e| format!("law {e}")),
-                });
-            }
-            next = end;
-        }
-        if next != subs.len() {
-            return Err(corrupt("contacts", "sub-contacts outside every contact"));
-        }
-        if let Some(i) = subs.iter().position(|s| s.area < 0.0) {
-            let k = pairs.partition_point(|p| p.first as usize + p.count as usize <= i);
-            let j = i - pairs[k].first as usize;
-            return Err(corrupt(
-                &format!("contacts[{k}].subcontacts[{j}].area"),
-                "negative area",
-            ));
-        }
-        // The step that relates each block's angular velocity to its angular momentum.
-        let step = snap.dt.max(snap.drift);
-        let mut model = Model::new(snap.params)?;
-        for (i, mut b) in snap.blocks.into_iter().enumerate() {
-            b.restore()
-                .map_err(|e| corrupt(&format!("blocks[{i}]"), &e.to_string()))?;
-            let block_error = |field: String, message: String| Error::CheckpointBlock {
-                block: BlockId(i as u32),
-                name: b.name().to_owned(),
-                field,
-                message,
-            };
-            b.check_derived()
-                .map_err(|(field, message)| block_error(field, message))?;
-            if !pose_ok(b.initial_pose()) {
-                return Err(block_error(
-                    "initial_pose".into(),
-                    "is not a finite pose with a unit rotation".into(),
-                ));
-            }
-            let s = *b.state();
-            let from_w = b.world_inertia_times(s.angular_velocity);
-            let tolerance =
-                (1e-9 + 2.0 * s.angular_velocity.length() * step) * s.angular_momentum.length().max(from_w.length());
-            // (Written so that a NaN is refused too.)
-            let consistent = (from_w - s.angular_momentum).length() <= tolerance;
-            if !consistent {
-                return Err(block_error(
-                    "state.angular_velocity".into(),
-                    format!(
-                        "{:?} disagrees with the angular momentum {:?} (the inertia gives {:?} for it)",
-                        s.angular_velocity, s.angular_momentum, from_w
-                    ),
-                ));
-            }
-            model.add_block(b)?;
-        }
-        // Blocks that were built from one shape share it again (a wall's bricks).
-        crate::block::share_shapes(&mut model.state.blocks);
-        model.state.laws = snap.joints;
-        model.state.integrator = Box::new(CentralDifference::new(snap.damping));
-        model.state.pairs = pairs;
-        model.state.references = references;
-        model.state.wrenches = wrenches;
-        model.state.subs = subs;
-        model.state.sub_records = sub_records;
-        for (k, p) in model.state.pairs.iter_mut().enumerate() {
-            let (a, b) = (&model.state.blocks[p.a as usize], &model.state.blocks[p.b as usize]);
-            p.cache_local_faces(Block::shape(a), Block::shape(b));
-            p.cells = crate::contact::CellSummary::of(&model.state.subs[p.range()]);
-            // Dashpot forces still held must be seen (and their work booked) by the next step.
-            p.dashpots |= model.state.sub_records[p.range()]
-                .iter()
-                .any(|r| r.dashpot != Vector::ZERO);
-            // A cell's half sizes are lengths: finite (a huge number read into an `f32` is
-            // infinite, and would be saved as `null`) and not negative.
-            if let Some(j) = model.state.subs[p.range()]
-                .iter()
-                .position(|s| !s.half.iter().all(|h| h.is_finite() && *h >= 0.0))
-            {
-                return Err(corrupt(
-                    &format!("contacts[{k}].subcontacts[{j}].half"),
-                    "must be finite lengths, not negative",
-                ));
-            }
-            // The stored spring moments are those of the stored forces, up to summation order,
-            // with each normal force placed within its cell's rectangle (where the step put it,
-            // `contact/spread.rs`, at the poses before the step's advance).
-            let law = &model.state.laws.laws()[p.law as usize];
-            let subs = &model.state.subs[p.range()];
-            let (anchored, _) = p.springs_of(subs, law, None);
-            let reach = |k: usize| subs.iter().map(|s| s.force.normal.max(0.0) * s.half()[k]).sum::<Real>();
-            let scale = 1e-9 * (anchored.force.length() + anchored.per_x.length() + anchored.per_y.length());
-            let placed = ForceMoments {
-                force: p.springs.force,
-                per_x: anchored.per_x,
-                per_y: anchored.per_y,
-            };
-            let within = |offset: Vector, reach: Real| offset.length() <= reach * (1.0 + 1e-9) + scale;
-            let consistent = p.springs.force.is_finite()
-                && placed.matches(&anchored)
-                && within(p.springs.per_x - anchored.per_x, reach(0))
-                && within(p.springs.per_y - anchored.per_y, reach(1))
-                && p.spread_energy >= 0.0
-                && p.spread_energy.is_finite();
-            if !consistent {
-                return Err(corrupt(
-                    &format!("contacts[{k}].springs"),
-                    "inconsistent with the sub-contact forces",
-                ));
-            }
-        }
-        // The joints' elastic energy is saved with the model: it must be a number (a sub-contact
-        // of a tiny area, or a huge force, would make it infinite and the saved file unreadable).
-        for (k, p) in model.state.pairs.iter().enumerate() {
-            let law = &model.state.laws.laws()[p.law as usize];
-            let subs = &model.state.subs[p.range()];
-            if let Some(j) = subs
-                .iter()
-                .position(|s| !law.elastic_energy(s.area, &s.force, &s.state).is_finite())
-            {
-                return Err(corrupt(
-                    &format!("contacts[{k}].subcontacts[{j}]"),
-                    "forces and area whose elastic energy is not finite",
-                ));
-            }
-        }
-        if !model.elastic_energy().is_finite() {
-            return Err(corrupt("contacts", "the joints' elastic energy is not finite"));
-        }
-        model.state.ref_poses = snap.ref_poses;
+        let mut snap = parse_snapshot::<L>(text)?;
+        let tested = check_snapshot(&snap)?;
+        let storage = into_storage(std::mem::take(&mut snap.contacts));
+        check_contacts(&snap, &storage, &tested)?;
+        let pending_detection = snap.pending_detection;
+        let mut model = restore_blocks(snap.params, std::mem::take(&mut snap.blocks), snap.dt.max(snap.drift))?;
+        restore_contacts(&mut model, std::mem::take(&mut snap.joints), snap.damping, storage)?;
         check_slacks(&model.state.blocks, &tested, &model.state.params.contact)?;
         model.state.tested = tested;
-        model.state.drift = if snap.drift > 0.0 && snap.started {
-            snap.drift
-        } else {
-            0.0
-        };
-        model.state.refine_until = snap.refine_until;
-        model.state.refine_omega2 = snap.refine_omega2;
-        model.state.refine_travel = snap.refine_travel;
-        model.state.refining = snap.refining;
-        for (k, m) in snap.motions.into_iter().enumerate() {
-            let block = BlockId(m.block);
-            if !(m.start.is_finite() && m.start <= snap.time) {
-                return Err(corrupt(
-                    &format!("motions[{k}].start"),
-                    "not a finite time before the checkpoint's",
-                ));
-            }
-            let start = m.start;
-            model
-                .set_base_motion(block, Some(m.motion))
-                .map_err(|e| corrupt(&format!("motions[{k}]"), &e.to_string()))?;
-            if let Some(last) = model.state.motions.iter_mut().find(|a| a.block == block.0) {
-                last.start = start;
-            }
-        }
-        for (k, h) in snap.load_histories.into_iter().enumerate() {
-            if !(h.start.is_finite() && h.start <= snap.time) {
-                return Err(corrupt(
-                    &format!("load_histories[{k}].start"),
-                    "not a finite time before the checkpoint's",
-                ));
-            }
-            let (block, start) = (BlockId(h.block), h.start);
-            model
-                .set_load_history(block, Some(h.load))
-                .map_err(|e| corrupt(&format!("load_histories[{k}]"), &e.to_string()))?;
-            if let Some(last) = model.state.load_histories.iter_mut().find(|a| a.block == block.0) {
-                last.start = start;
-            }
-        }
-        model.state.refining.sort_unstable();
-        model.state.refining.dedup();
-        model.state.step = snap.step;
-        model.state.time = snap.time;
-        model.state.energy = snap.energy;
-        model.state.started = snap.started;
-        model.state.unbalanced_ratio = snap.unbalanced_ratio.unwrap_or(Real::INFINITY);
-        model.state.detections = snap.detections;
-        for (r, &(reaction, damping)) in model.state.records.iter_mut().zip(&snap.last_forces) {
-            r.reaction = reaction;
-            r.damping = damping;
-        }
-        model.state.changes.clear();
-        let redetect = !model.state.started || snap.pending_detection;
+        restore_excitations(&mut model, &mut snap)?;
+        restore_run(&mut model, &snap);
+        let redetect = !model.state.started || pending_detection;
         if redetect {
             model.state.changes.insert(crate::model::changes::Changes::DETECTION);
         }
         model.state.rebuild_block_index(&mut model.pipeline);
-        // The time step: the stored bounds must give the stored critical step, and none may
-        // be far below the bound the blocks and contacts give now (the stored ones are as of
-        // their last evaluation: contacts that shrank since leave them higher, a contact grows
-        // by up to 5 % before they are re-evaluated). A step due for re-evaluation is
-        // re-evaluated by the next step anyway.
         if !redetect {
-            if snap.bounds.len() != n {
-                return Err(corrupt("bounds", "one bound per block expected"));
-            }
-            if let Some(i) = snap.bounds.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
-                return Err(corrupt(&format!("bounds[{i}]"), "a finite value ≥ 0 expected"));
-            }
-            let bound_areas: Vec<Real> = model.state.references.iter().map(|r| r.bound_area).collect();
-            // An error here is a fixed step above the re-evaluated limit: checked below.
-            let _ = model.state.refresh_time_step(&mut model.pipeline);
-            for (r, area) in model.state.references.iter_mut().zip(bound_areas) {
-                r.bound_area = area;
-            }
-            for (i, (stored, fresh)) in snap.bounds.iter().zip(&model.pipeline.bounds).enumerate() {
-                if *stored < MIN_STORED_BOUND * fresh.omega_squared {
-                    return Err(corrupt(
-                        &format!("bounds[{i}]"),
-                        &format!(
-                            "{stored} 1/s² in the file, the blocks and contacts give {} 1/s²",
-                            fresh.omega_squared
-                        ),
-                    ));
-                }
-            }
-            for (bound, stored) in model.pipeline.bounds.iter_mut().zip(&snap.bounds) {
-                bound.omega_squared = *stored;
-            }
+            restore_bounds(&mut model, &snap.bounds)?;
             let from_bounds = model.state.integrator.critical_step(&model.pipeline.bounds);
             check_time_step(&snap.params, snap.dt, snap.critical, from_bounds)?;
         }
@@ -559,6 +204,458 @@ where
         let text = crate::file::read_text(path)?;
         Self::from_checkpoint_str(&text)
     }
+}
+
+/// `Error::Checkpoint` at `path`.
+fn corrupt(path: &str, message: &str) -> Error {
+    Error::Checkpoint {
+        path: path.into(),
+        message: message.into(),
+    }
+}
+
+/// serde's error at its path.
+fn typed_error(e: serde_path_to_error::Error<serde_json::Error>) -> Error {
+    Error::Checkpoint {
+        path: e.path().to_string(),
+        message: e.inner().to_string(),
+    }
+}
+
+/// Phase 1, the document: JSON without a key given twice, the format and version (first, so
+/// that a file of another version is named as such rather than failing on the first field that
+/// changed), the checksum, the law type (before the laws, which would fail on the first field
+/// that differs), then the typed snapshot.
+fn parse_snapshot<L>(text: &str) -> Result<Snapshot<L>>
+where
+    L: ConstitutiveLaw + DeserializeOwned,
+    L::State: DeserializeOwned,
+{
+    // A key given twice would be read as its last value by `Value`.
+    crate::json_keys::refuse_duplicate_keys(text)?;
+    let mut value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| corrupt("(document)", &format!("not a complete JSON document: {e}")))?;
+    let Ok(header) = Header::deserialize(&value) else {
+        // Let the typed reading say which field is wrong.
+        return Err(match serde_path_to_error::deserialize::<_, Snapshot<L>>(value) {
+            Err(e) => typed_error(e),
+            Ok(_) => corrupt("format", &format!("not a {FORMAT}")),
+        });
+    };
+    if header.format != FORMAT {
+        return Err(corrupt("format", &format!("\"{}\" is not a {FORMAT}", header.format)));
+    }
+    if header.version != VERSION {
+        return Err(corrupt(
+            "version",
+            &format!(
+                "{FORMAT} version {}; this build reads version {VERSION}",
+                header.version
+            ),
+        ));
+    }
+    // The checksum over the rest: any value changed since the save is refused here.
+    let stored = match value.as_object_mut().and_then(|m| m.remove(CHECKSUM)) {
+        Some(serde_json::Value::String(s)) => s,
+        Some(_) => return Err(corrupt(CHECKSUM, "not a string")),
+        None => return Err(corrupt(CHECKSUM, "missing: the file is truncated or was edited")),
+    };
+    let computed = checksum_of(&value);
+    if stored != computed {
+        return Err(Error::CheckpointChecksum { stored, computed });
+    }
+    if let (Some(written), Some(loading)) = (header.law_type.as_deref(), law_type_name::<L>()) {
+        if written != loading {
+            return Err(Error::CheckpointLawType {
+                written: written.into(),
+                loading: loading.into(),
+            });
+        }
+    }
+    let snap: Snapshot<L> = serde_path_to_error::deserialize(value).map_err(typed_error)?;
+    if snap.format != FORMAT || snap.version != VERSION {
+        return Err(corrupt("format", &format!("not a {FORMAT} version {VERSION}")));
+    }
+    Ok(snap)
+}
+
+/// Phase 2, the snapshot apart from its contacts: parameters, damping and laws validated as
+/// `Model::new`, `set_damping` and `set_joint_law` do (serde only checks their shape); the
+/// reference poses; the tested pairs (returned, checked); one pair of last forces per block;
+/// the run's counters and clock.
+fn check_snapshot<L: ConstitutiveLaw>(snap: &Snapshot<L>) -> Result<Vec<crate::model::detection::TestedPair>> {
+    snap.params.validate()?;
+    snap.damping.validate()?;
+    let n = snap.blocks.len();
+    if !snap.joints.check() {
+        return Err(corrupt("joints", "law index out of range"));
+    }
+    for (k, law) in snap.joints.laws().iter().enumerate() {
+        crate::law::check_law(law).map_err(|e| corrupt(&format!("joints.laws[{k}]"), &e.to_string()))?;
+    }
+    if snap.ref_poses.len() != n {
+        return Err(corrupt("ref_poses", "one pose per block expected"));
+    }
+    if let Some(i) = snap.ref_poses.iter().position(|p| !is_unit_pose(p)) {
+        return Err(corrupt(
+            &format!("ref_poses[{i}]"),
+            "not a finite pose with a unit rotation",
+        ));
+    }
+    let tested = tested_pairs(&snap.tested, n)?;
+    if snap.last_forces.len() != n {
+        return Err(corrupt("last_forces", "one pair of wrenches per block expected"));
+    }
+    check_run_state(snap)?;
+    Ok(tested)
+}
+
+/// Phase 3, the contacts against the blocks, the laws and the tested pairs: every contact
+/// between blocks the narrow phase tested, finite wrenches, faces and nodes that exist, axes
+/// orthonormal, contacts sorted with contiguous sub-contact ranges covering every sub-contact,
+/// each contact's law the one detection gives its pair, areas not negative.
+fn check_contacts<L: ConstitutiveLaw>(
+    snap: &Snapshot<L>,
+    storage: &Storage<L::State>,
+    tested: &[crate::model::detection::TestedPair],
+) -> Result<()> {
+    let Storage {
+        pairs,
+        wrenches,
+        subs,
+        sub_records,
+        ..
+    } = storage;
+    let n = snap.blocks.len();
+    if let Some(k) = pairs
+        .iter()
+        .position(|p| tested.binary_search_by_key(&(p.a, p.b), |t| (t.a, t.b)).is_err())
+    {
+        return Err(corrupt(
+            &format!("contacts[{k}].blocks"),
+            "a contact between blocks the narrow phase did not test",
+        ));
+    }
+    if let Some(k) = wrenches
+        .iter()
+        .position(|w| !(is_finite_vector(w.force) && is_finite_vector(w.moment_a) && is_finite_vector(w.moment_b)))
+    {
+        return Err(corrupt(&format!("contacts[{k}].wrench"), "non-finite force or moment"));
+    }
+    let mut next = 0usize;
+    for (k, p) in pairs.iter().enumerate() {
+        let faces_ok = match p.kind {
+            crate::geometry::ContactKind::FaceFace { face_a, face_b } => {
+                (p.a as usize) < n
+                    && (p.b as usize) < n
+                    && (face_a as usize) < snap.blocks[p.a as usize].shape_face_count()
+                    && (face_b as usize) < snap.blocks[p.b as usize].shape_face_count()
+            }
+            crate::geometry::ContactKind::Nodes => {
+                (p.a as usize) < n
+                    && (p.b as usize) < n
+                    && (p.first as usize + p.count as usize) <= subs.len().min(sub_records.len())
+                    && nodes_fit(
+                        (snap.blocks[p.a as usize].shape(), snap.blocks[p.b as usize].shape()),
+                        &subs[p.range()],
+                        &sub_records[p.range()],
+                    )
+            }
+        };
+        if !orthonormal(p.normal, p.tangent) {
+            return Err(corrupt(&format!("contacts[{k}].tangent"), "joint axes not orthonormal"));
+        }
+        if !orthonormal(p.anchors.u, p.anchors.v) {
+            return Err(corrupt(
+                &format!("contacts[{k}].anchors"),
+                "anchor plane axes not orthonormal",
+            ));
+        }
+        let sorted = k == 0 || (pairs[k - 1].a, pairs[k - 1].b) < (p.a, p.b);
+        let (start, end) = (p.first as usize, p.first as usize + p.count as usize);
+        let ok = faces_ok
+            && sorted
+            && (p.a as usize) < n
+            && (p.b as usize) < n
+            && p.a < p.b
+            && (p.law as usize) < snap.joints.laws().len()
+            && start == next
+            && end <= subs.len();
+        if !ok {
+            return Err(corrupt(
+                &format!("contacts[{k}]"),
+                "inconsistent block, law or sub-contact indices",
+            ));
+        }
+        // The law is the one detection gives the pair: the interface's own, else the one
+        // its materials map to. A law set since the last detection takes effect at the next
+        // step's full detection (`pending_detection`), so the contact may still hold the
+        // law it was detected with (any law of the table).
+        let (material_a, material_b) = (
+            snap.blocks[p.a as usize].material(),
+            snap.blocks[p.b as usize].material(),
+        );
+        let expected = snap
+            .joints
+            .index_for((BlockId(p.a), material_a), (BlockId(p.b), material_b));
+        if expected != Some(p.law) && !snap.pending_detection {
+            return Err(Error::CheckpointContactLaw {
+                contact: k,
+                a: BlockId(p.a),
+                b: BlockId(p.b),
+                material_a,
+                material_b,
+                law: p.law,
+                expected: expected.map_or_else(|| "no law".into(), |e| format!("law {e}")),
+            });
+        }
+        next = end;
+    }
+    if next != subs.len() {
+        return Err(corrupt("contacts", "sub-contacts outside every contact"));
+    }
+    if let Some(i) = subs.iter().position(|s| s.area < 0.0) {
+        let k = pairs.partition_point(|p| p.first as usize + p.count as usize <= i);
+        let j = i - pairs[k].first as usize;
+        return Err(corrupt(
+            &format!("contacts[{k}].subcontacts[{j}].area"),
+            "negative area",
+        ));
+    }
+    Ok(())
+}
+
+/// Phase 4, the blocks: each restored (its shape rebuilt) and its derived data checked against
+/// its vertices and density, its initial pose a finite unit pose, its angular velocity the
+/// inertia's image of its angular momentum to within the rotation of one `step`; added to a
+/// new model of `params`, blocks of one shape sharing it again (a wall's bricks).
+fn restore_blocks<L: ConstitutiveLaw>(
+    params: ModelParameters,
+    blocks: Vec<crate::block::RigidBlock>,
+    step: Real,
+) -> Result<Model<L>> {
+    let mut model = Model::new(params)?;
+    for (i, mut b) in blocks.into_iter().enumerate() {
+        b.restore()
+            .map_err(|e| corrupt(&format!("blocks[{i}]"), &e.to_string()))?;
+        let block_error = |field: String, message: String| Error::CheckpointBlock {
+            block: BlockId(i as u32),
+            name: b.name().to_owned(),
+            field,
+            message,
+        };
+        b.check_derived()
+            .map_err(|(field, message)| block_error(field, message))?;
+        if !is_unit_pose(b.initial_pose()) {
+            return Err(block_error(
+                "initial_pose".into(),
+                "is not a finite pose with a unit rotation".into(),
+            ));
+        }
+        let s = *b.state();
+        let from_w = b.world_inertia_times(s.angular_velocity);
+        let tolerance =
+            (1e-9 + 2.0 * s.angular_velocity.length() * step) * s.angular_momentum.length().max(from_w.length());
+        // (Written so that a NaN is refused too.)
+        let consistent = (from_w - s.angular_momentum).length() <= tolerance;
+        if !consistent {
+            return Err(block_error(
+                "state.angular_velocity".into(),
+                format!(
+                    "{:?} disagrees with the angular momentum {:?} (the inertia gives {:?} for it)",
+                    s.angular_velocity, s.angular_momentum, from_w
+                ),
+            ));
+        }
+        model.add_block(b)?;
+    }
+    crate::block::share_shapes(&mut model.state.blocks);
+    Ok(model)
+}
+
+/// Phase 5, the contacts into the model with the laws and the integrator: each contact's
+/// local faces and cell summary re-derived, its stored spring moments checked against its
+/// sub-contact forces (each normal force within its cell's rectangle), its cells' half sizes
+/// finite lengths, and every sub-contact's elastic energy (and their sum) finite.
+fn restore_contacts<L: ConstitutiveLaw>(
+    model: &mut Model<L>,
+    laws: crate::law::LawTable<L>,
+    damping: crate::integrate::Damping,
+    storage: Storage<L::State>,
+) -> Result<()> {
+    model.state.laws = laws;
+    model.state.integrator = Box::new(CentralDifference::new(damping));
+    model.state.pairs = storage.pairs;
+    model.state.references = storage.references;
+    model.state.wrenches = storage.wrenches;
+    model.state.subs = storage.subs;
+    model.state.sub_records = storage.sub_records;
+    for (k, p) in model.state.pairs.iter_mut().enumerate() {
+        let (a, b) = (&model.state.blocks[p.a as usize], &model.state.blocks[p.b as usize]);
+        p.cache_local_faces(Block::shape(a), Block::shape(b));
+        p.cells = crate::contact::CellSummary::of(&model.state.subs[p.range()]);
+        // Dashpot forces still held must be seen (and their work booked) by the next step.
+        p.dashpots |= model.state.sub_records[p.range()]
+            .iter()
+            .any(|r| r.dashpot != Vector::ZERO);
+        // A cell's half sizes are lengths: finite (a huge number read into an `f32` is
+        // infinite, and would be saved as `null`) and not negative.
+        if let Some(j) = model.state.subs[p.range()]
+            .iter()
+            .position(|s| !s.half.iter().all(|h| h.is_finite() && *h >= 0.0))
+        {
+            return Err(corrupt(
+                &format!("contacts[{k}].subcontacts[{j}].half"),
+                "must be finite lengths, not negative",
+            ));
+        }
+        // The stored spring moments are those of the stored forces, up to summation order,
+        // with each normal force placed within its cell's rectangle (where the step put it,
+        // `contact/spread.rs`, at the poses before the step's advance).
+        let law = &model.state.laws.laws()[p.law as usize];
+        let subs = &model.state.subs[p.range()];
+        let (anchored, _) = p.springs_of(subs, law, None);
+        let reach = |k: usize| subs.iter().map(|s| s.force.normal.max(0.0) * s.half()[k]).sum::<Real>();
+        let scale = 1e-9 * (anchored.force.length() + anchored.per_x.length() + anchored.per_y.length());
+        let placed = ForceMoments {
+            force: p.springs.force,
+            per_x: anchored.per_x,
+            per_y: anchored.per_y,
+        };
+        let within = |offset: Vector, reach: Real| offset.length() <= reach * (1.0 + 1e-9) + scale;
+        let consistent = p.springs.force.is_finite()
+            && placed.matches(&anchored)
+            && within(p.springs.per_x - anchored.per_x, reach(0))
+            && within(p.springs.per_y - anchored.per_y, reach(1))
+            && p.spread_energy >= 0.0
+            && p.spread_energy.is_finite();
+        if !consistent {
+            return Err(corrupt(
+                &format!("contacts[{k}].springs"),
+                "inconsistent with the sub-contact forces",
+            ));
+        }
+    }
+    // The joints' elastic energy is saved with the model: it must be a number (a sub-contact
+    // of a tiny area, or a huge force, would make it infinite and the saved file unreadable).
+    for (k, p) in model.state.pairs.iter().enumerate() {
+        let law = &model.state.laws.laws()[p.law as usize];
+        let subs = &model.state.subs[p.range()];
+        if let Some(j) = subs
+            .iter()
+            .position(|s| !law.elastic_energy(s.area, &s.force, &s.state).is_finite())
+        {
+            return Err(corrupt(
+                &format!("contacts[{k}].subcontacts[{j}]"),
+                "forces and area whose elastic energy is not finite",
+            ));
+        }
+    }
+    if !model.elastic_energy().is_finite() {
+        return Err(corrupt("contacts", "the joints' elastic energy is not finite"));
+    }
+    Ok(())
+}
+
+/// Phase 6, the base motions and load histories, each started at a finite time before the
+/// checkpoint's and set as `set_base_motion` and `set_load_history` set them (against the
+/// blocks' fixity).
+fn restore_excitations<L: ConstitutiveLaw>(model: &mut Model<L>, snap: &mut Snapshot<L>) -> Result<()> {
+    for (k, m) in std::mem::take(&mut snap.motions).into_iter().enumerate() {
+        let block = BlockId(m.block);
+        if !(m.start.is_finite() && m.start <= snap.time) {
+            return Err(corrupt(
+                &format!("motions[{k}].start"),
+                "not a finite time before the checkpoint's",
+            ));
+        }
+        let start = m.start;
+        model
+            .set_base_motion(block, Some(m.motion))
+            .map_err(|e| corrupt(&format!("motions[{k}]"), &e.to_string()))?;
+        if let Some(last) = model.state.motions.iter_mut().find(|a| a.block == block.0) {
+            last.start = start;
+        }
+    }
+    for (k, h) in std::mem::take(&mut snap.load_histories).into_iter().enumerate() {
+        if !(h.start.is_finite() && h.start <= snap.time) {
+            return Err(corrupt(
+                &format!("load_histories[{k}].start"),
+                "not a finite time before the checkpoint's",
+            ));
+        }
+        let (block, start) = (BlockId(h.block), h.start);
+        model
+            .set_load_history(block, Some(h.load))
+            .map_err(|e| corrupt(&format!("load_histories[{k}]"), &e.to_string()))?;
+        if let Some(last) = model.state.load_histories.iter_mut().find(|a| a.block == block.0) {
+            last.start = start;
+        }
+    }
+    Ok(())
+}
+
+/// Phase 7, the run's state as stored: reference poses, drift and impact refinement, counters,
+/// clock, energies, the last reactions and damping forces; no change owed.
+fn restore_run<L: ConstitutiveLaw>(model: &mut Model<L>, snap: &Snapshot<L>) {
+    let state = &mut model.state;
+    state.ref_poses.clone_from(&snap.ref_poses);
+    state.drift = if snap.drift > 0.0 && snap.started {
+        snap.drift
+    } else {
+        0.0
+    };
+    state.refine_until = snap.refine_until;
+    state.refine_omega2 = snap.refine_omega2;
+    state.refine_travel = snap.refine_travel;
+    state.refining.clone_from(&snap.refining);
+    state.refining.sort_unstable();
+    state.refining.dedup();
+    state.step = snap.step;
+    state.time = snap.time;
+    state.energy = snap.energy;
+    state.started = snap.started;
+    state.unbalanced_ratio = snap.unbalanced_ratio.unwrap_or(Real::INFINITY);
+    state.detections = snap.detections;
+    for (r, &(reaction, damping)) in state.records.iter_mut().zip(&snap.last_forces) {
+        r.reaction = reaction;
+        r.damping = damping;
+    }
+    state.changes.clear();
+}
+
+/// Phase 8, the stability bounds (when no detection is owed): one finite bound per block, none
+/// far below what the blocks and contacts give now (the stored ones are as of their last
+/// evaluation: contacts that shrank since leave them higher, a contact grows by up to 5 %
+/// before they are re-evaluated); the stored ones are then taken, bit for bit.
+fn restore_bounds<L: ConstitutiveLaw>(model: &mut Model<L>, bounds: &[Real]) -> Result<()> {
+    if bounds.len() != model.state.blocks.len() {
+        return Err(corrupt("bounds", "one bound per block expected"));
+    }
+    if let Some(i) = bounds.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
+        return Err(corrupt(&format!("bounds[{i}]"), "a finite value ≥ 0 expected"));
+    }
+    let bound_areas: Vec<Real> = model.state.references.iter().map(|r| r.bound_area).collect();
+    // An error here is a fixed step above the re-evaluated limit: checked by the caller.
+    let _ = model.state.refresh_time_step(&mut model.pipeline);
+    for (r, area) in model.state.references.iter_mut().zip(bound_areas) {
+        r.bound_area = area;
+    }
+    for (i, (stored, fresh)) in bounds.iter().zip(&model.pipeline.bounds).enumerate() {
+        if *stored < MIN_STORED_BOUND * fresh.omega_squared {
+            return Err(corrupt(
+                &format!("bounds[{i}]"),
+                &format!(
+                    "{stored} 1/s² in the file, the blocks and contacts give {} 1/s²",
+                    fresh.omega_squared
+                ),
+            ));
+        }
+    }
+    for (bound, stored) in model.pipeline.bounds.iter_mut().zip(bounds) {
+        bound.omega_squared = *stored;
+    }
+    Ok(())
 }
 
 /// Whether `a` and `b` are unit vectors normal to each other, to round-off (1e-9).

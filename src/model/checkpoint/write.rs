@@ -6,10 +6,10 @@ use std::path::Path;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
 
+use super::tested::TestedEntry;
 use super::{checksum_of, law_type_name, ContactEntry, Snapshot, SubContactEntry, CHECKSUM, FORMAT, VERSION};
 use crate::error::{Error, Result};
 use crate::law::ConstitutiveLaw;
-use crate::model::checkpoint_tested::TestedEntry;
 use crate::model::Model;
 
 impl<L: ConstitutiveLaw> Model<L> {

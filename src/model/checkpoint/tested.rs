@@ -3,11 +3,11 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::detection::TestedPair;
 use crate::block::{Block, RigidBlock};
 use crate::error::{Error, Result};
 use crate::geometry::{detect, BlockGeometry, ContactParameters, NarrowPhaseScratch};
 use crate::math::{Pose, Real};
+use crate::model::detection::TestedPair;
 
 /// A pair the narrow phase tested, as checkpoints store it.
 #[derive(Serialize, Deserialize)]
@@ -18,10 +18,6 @@ pub(super) struct TestedEntry {
     pub relative: Pose,
     /// The separation beyond the tolerance of a pair found apart (m).
     pub slack: Real,
-}
-
-fn pose_ok(p: &Pose) -> bool {
-    super::checkpoint::pose_ok(p)
 }
 
 /// The tested pairs of a checkpoint of `n` blocks, checked: pairs `a < b < n` in strictly
@@ -41,7 +37,7 @@ pub(super) fn tested_pairs(entries: &[TestedEntry], n: usize) -> Result<Vec<Test
                 "block pairs a < b < block count, in increasing order, expected",
             ));
         }
-        if !pose_ok(&e.relative) {
+        if !crate::math::is_unit_pose(&e.relative) {
             return Err(corrupt(
                 &format!("tested[{k}].relative"),
                 "not a finite pose with a unit rotation",
