@@ -95,6 +95,7 @@ pub mod math;
 pub mod model;
 pub mod monitor;
 pub mod scenes;
+pub mod signal;
 
 pub use block::{Block, BlockId, RigidBlock};
 pub use contact::Contact;

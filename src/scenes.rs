@@ -129,7 +129,7 @@ fn wall_and_base(blocks: usize, spacing: Real) -> Result<(crate::Model, usize)> 
 /// # Errors
 /// As [`benchmark_wall_with_spacing`].
 pub fn shaking_wall(blocks: usize, spacing: Real) -> Result<crate::Model> {
-    use crate::loading::{BaseMotion, MotionKind, TimeHistory};
+    use crate::signal::{BaseMotion, MotionKind, TimeHistory};
     let (mut model, bases) = wall_and_base(blocks, spacing)?;
     model.set_damping(crate::integrate::Damping::None)?;
     let omega = 2.0 * core::f64::consts::PI * SHAKE_FREQUENCY;

@@ -5,11 +5,11 @@
 mod central_difference;
 mod damping;
 mod stability;
-mod time_step;
+mod critical_step;
 
 pub use central_difference::CentralDifference;
 pub use damping::Damping;
-pub use time_step::{critical_time_step, CriticalStep, Stiffness6, StiffnessBound, TimeStep};
+pub use critical_step::{critical_time_step, CriticalStep, Stiffness6, StiffnessBound, TimeStep};
 
 pub(crate) use stability::{block_bound, contact_eigenvalues, AreaMoments, ContactStiffness};
 

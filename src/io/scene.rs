@@ -49,12 +49,12 @@ pub struct BlockSpec {
     /// [`Model::set_base_motion`]: `{"kind": "Acceleration", "axes": [{"times": [..], "values":
     /// [..]}, null, null]}`; the driven axes must be fixed or prescribed in `fixity`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub motion: Option<crate::loading::BaseMotion>,
+    pub motion: Option<crate::signal::BaseMotion>,
     /// Time-varying load from time 0, replacing `load` (see [`Model::set_load_history`]):
     /// `{"load": {"force": [..], "moment": [..]}, "history": {"times": [..], "values": [..]}}`,
     /// the wrench scaled by the history's factor.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub load_history: Option<crate::loading::LoadHistory>,
+    pub load_history: Option<crate::signal::LoadHistory>,
 }
 
 /// The joint law between two materials.

@@ -75,12 +75,10 @@
 //! # Ok::<(), voussoir::Error>(())
 //! ```
 
-mod excitation;
-mod load_history;
 mod pushover;
 mod servo;
 
-pub use excitation::{BaseMotion, MotionKind, TimeHistory};
-pub use load_history::LoadHistory;
+pub use crate::math::Convergence;
+pub use crate::signal::{BaseMotion, LoadHistory, MotionKind, TimeHistory};
 pub use pushover::{PushOver, PushOverResult, PushOverSample, PushOverStop};
-pub use servo::{Convergence, Servo};
+pub use servo::Servo;

@@ -5,7 +5,7 @@ use std::ops::ControlFlow;
 use crate::error::{positive, Error, Result};
 use crate::ids::BlockId;
 use crate::law::ConstitutiveLaw;
-use crate::math::{is_finite_vector, Real, Vector};
+use crate::math::{is_finite_vector, Convergence, Real, Vector};
 use crate::model::{Model, Observer};
 
 /// Servo-controlled displacement loading: `block` advances by `increment` along `direction`
@@ -185,33 +185,3 @@ impl Servo {
 
 /// The largest servo advance per step, as a fraction of the contact tolerance.
 const SERVO_TRAVEL: Real = 0.5;
-
-/// A quantity from a quasi-static run and from the same run refined (half the increment and
-/// threshold of a servo, or half the rate of a rate-loaded run): how far the answer is from
-/// converged.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-pub struct Convergence {
-    /// The quantity from the run.
-    pub value: Real,
-    /// The quantity from the refined run.
-    pub refined: Real,
-}
-
-impl Convergence {
-    /// `|refined − value| / |value|` (infinite for a zero `value` with a non-zero `refined`,
-    /// zero when both are zero).
-    pub fn relative_change(&self) -> Real {
-        let change = (self.refined - self.value).abs();
-        if change == 0.0 {
-            0.0
-        } else {
-            change / self.value.abs()
-        }
-    }
-
-    /// Whether the refinement moved the quantity by at most `tolerance` (relative).
-    pub fn converged(&self, tolerance: Real) -> bool {
-        self.relative_change() <= tolerance
-    }
-}

@@ -8,8 +8,8 @@ use crate::block::{Block, Dof, Fixity};
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::law::ConstitutiveLaw;
-use crate::loading::{BaseMotion, LoadHistory};
 use crate::math::Real;
+use crate::signal::{BaseMotion, LoadHistory};
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -87,7 +87,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     ///
     /// # Example
     /// ```
-    /// use voussoir::loading::{BaseMotion, MotionKind, TimeHistory};
+    /// use voussoir::signal::{BaseMotion, MotionKind, TimeHistory};
     /// use voussoir::prelude::*;
     ///
     /// let mut model: Model = Model::new(ModelParameters::default())?;
@@ -176,7 +176,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// as every force's (`docs/theory.md` §6).
     ///
     /// ```
-    /// use voussoir::loading::{LoadHistory, TimeHistory};
+    /// use voussoir::signal::{LoadHistory, TimeHistory};
     /// use voussoir::prelude::*;
     ///
     /// let params = ModelParameters { gravity: Vector::ZERO, ..ModelParameters::default() };

@@ -229,4 +229,4 @@ fn is_finite_state(s: &crate::block::BlockState) -> bool {
 }
 
 #[cfg(test)]
-mod tests;
+mod model_tests;

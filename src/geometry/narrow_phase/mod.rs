@@ -80,12 +80,12 @@ impl SubcontactDensity {
     /// assert!(c.converged(0.005) && !c.converged(0.002));
     /// # Ok::<(), voussoir::Error>(())
     /// ```
-    pub fn check_convergence<F>(&self, run: F) -> Result<crate::loading::Convergence>
+    pub fn check_convergence<F>(&self, run: F) -> Result<crate::math::Convergence>
     where
         F: Fn(SubcontactDensity) -> Result<Real> + Sync,
     {
         let (value, refined) = rayon::join(|| run(*self), || run(self.refined()));
-        Ok(crate::loading::Convergence {
+        Ok(crate::math::Convergence {
             value: value?,
             refined: refined?,
         })

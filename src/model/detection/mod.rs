@@ -18,7 +18,7 @@ mod pairs;
 mod splice;
 mod staging;
 #[cfg(test)]
-mod tests;
+mod detection_tests;
 
 pub(crate) use pairs::TestedPair;
 use pairs::*;
