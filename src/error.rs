@@ -341,22 +341,26 @@ pub enum Error {
         /// The last value of the monitored quantity.
         last: Real,
     },
-    /// Limit analysis: no set of admissible contact forces carries the dead loads (gravity and
-    /// the blocks' constant loads), with or without the live load: the structure cannot carry
-    /// its own weight.
+    /// Limit analysis of a live load: no set of admissible contact forces carries the dead
+    /// loads (gravity and the blocks' constant loads), with or without the live load: the
+    /// structure cannot carry its own weight. (The dead-load question alone,
+    /// `LimitProblem::dead_load`, answers that without an error; Python raises
+    /// `voussoir.LimitInfeasibleError`.)
     #[error("limit analysis: the structure cannot carry its own weight: {reason}")]
     LimitInfeasible {
         /// What was found, e.g. the negative multiplier it would need.
         reason: String,
     },
     /// Limit analysis: the load multiplier has no upper bound, e.g. the live load acts only on
-    /// supports' constrained degrees of freedom or is carried straight into them.
+    /// supports' constrained degrees of freedom or is carried straight into them. (Python:
+    /// `voussoir.LimitUnboundedError`.)
     #[error("limit analysis: the load multiplier is unbounded: {reason}")]
     LimitUnbounded {
         /// The live loads concerned.
         reason: String,
     },
     /// Limit analysis: the conic solver (Clarabel) stopped without a solution or a certificate.
+    /// (Python: `voussoir.LimitSolverError`.)
     #[error("limit analysis: the conic solver stopped with status {status} after {iterations} iterations")]
     LimitSolver {
         /// Clarabel's status, e.g. `MaxIterations` or `NumericalError`.

@@ -114,9 +114,13 @@ pub mod prelude {
     pub use crate::block::{Block, BlockId, Dof, Fixity, RigidBlock, Wrench};
     pub use crate::contact::{Contact, DisplacementMode};
     pub use crate::error::{Error, Result};
-    pub use crate::geometry::{ContactParameters, SubcontactDensity};
+    #[allow(deprecated)]
+    pub use crate::geometry::SubcontactDensity;
+    pub use crate::geometry::{ContactParameters, SubContactDensity};
     pub use crate::integrate::{CentralDifference, Damping, Integrator, TimeStep};
-    pub use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, LawTable, LinearElastic, MaterialId};
+    pub use crate::law::{
+        AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, LawTable, LinearElastic, MaterialId, MortarJoint,
+    };
     pub use crate::math::{Pose, Real, Rotation, Vector};
     pub use crate::model::{Energies, Model, ModelParameters, Observer};
     pub use crate::monitor::{Component, EnergyTerm, Monitor, MonitorId, Probe, Recorder};

@@ -143,10 +143,10 @@ pub fn shaking_wall(blocks: usize, spacing: Real) -> Result<crate::Model> {
 
 /// The model parameters of the benchmark walls: defaults, sub-contacts at most `spacing` apart.
 fn params_for(spacing: Real) -> crate::ModelParameters {
-    use crate::geometry::{ContactParameters, SubcontactDensity};
+    use crate::geometry::{ContactParameters, SubContactDensity};
     crate::ModelParameters {
         contact: ContactParameters {
-            density: SubcontactDensity::Spacing(spacing),
+            density: SubContactDensity::Spacing(spacing),
             ..ContactParameters::default()
         },
         ..crate::ModelParameters::default()

@@ -21,7 +21,7 @@ fn moving_wall() -> Result<Model> {
     let params = ModelParameters {
         gravity: Vector::new(6.0, 0.0, -9.81), // beyond tan 25° × g: the courses slide
         contact: ContactParameters {
-            density: SubcontactDensity::PerEdge(4),
+            density: SubContactDensity::PerEdge(4),
             ..ContactParameters::default()
         },
         ..ModelParameters::default()

@@ -5,7 +5,7 @@
 use crate::common;
 
 use voussoir::block::Dof;
-use voussoir::geometry::{ContactParameters, SubcontactDensity};
+use voussoir::geometry::{ContactParameters, SubContactDensity};
 use voussoir::prelude::*;
 
 /// The eight corners of the unit cube, index = x + 2y + 4z.
@@ -387,7 +387,7 @@ fn bad_contact_and_run_parameters() {
         ),
         (
             ContactParameters {
-                density: SubcontactDensity::PerEdge(0),
+                density: SubContactDensity::PerEdge(0),
                 ..ContactParameters::default()
             },
             "contact.density.per_edge",
@@ -395,7 +395,7 @@ fn bad_contact_and_run_parameters() {
         ),
         (
             ContactParameters {
-                density: SubcontactDensity::Spacing(-0.01),
+                density: SubContactDensity::Spacing(-0.01),
                 ..ContactParameters::default()
             },
             "contact.density.spacing",
@@ -905,11 +905,11 @@ fn sub_contact_grids_too_dense_are_errors() {
         },
         ..ModelParameters::default()
     };
-    let e = Model::<CoulombSlip>::new(dense(SubcontactDensity::PerEdge(65535))).unwrap_err();
+    let e = Model::<CoulombSlip>::new(dense(SubContactDensity::PerEdge(65535))).unwrap_err();
     assert_names(&e.to_string(), &["contact.density.per_edge", "65535"]);
-    assert!(Model::<CoulombSlip>::new(dense(SubcontactDensity::PerEdge(1000))).is_ok());
+    assert!(Model::<CoulombSlip>::new(dense(SubContactDensity::PerEdge(1000))).is_ok());
     // A spacing is checked against each block as it comes.
-    let mut model: Model = Model::new(dense(SubcontactDensity::Spacing(1e-9))).unwrap();
+    let mut model: Model = Model::new(dense(SubContactDensity::Spacing(1e-9))).unwrap();
     let e = model.add_block(common::cube("stone", Vector::ZERO)).unwrap_err();
     assert_names(&e.to_string(), &["contact.density.spacing", "stone"]);
     assert!(model.blocks().is_empty());
@@ -917,7 +917,7 @@ fn sub_contact_grids_too_dense_are_errors() {
     let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).unwrap());
     model.add_block(common::cube("stone", Vector::ZERO)).unwrap();
     let e = model
-        .set_parameters(dense(SubcontactDensity::Spacing(1e-7)))
+        .set_parameters(dense(SubContactDensity::Spacing(1e-7)))
         .unwrap_err();
     assert_names(&e.to_string(), &["contact.density.spacing", "stone"]);
     assert_eq!(*model.parameters(), ModelParameters::default());

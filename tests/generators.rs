@@ -18,7 +18,7 @@ fn settle(blocks: Vec<RigidBlock>, gravity: Vector, spacing: f64) -> Result<(f64
     let params = ModelParameters {
         gravity,
         contact: ContactParameters {
-            density: SubcontactDensity::Spacing(spacing),
+            density: SubContactDensity::Spacing(spacing),
             ..ContactParameters::default()
         },
         ..ModelParameters::default()

@@ -27,6 +27,7 @@ mod limit_analysis;
 mod load_history;
 mod mixed_laws;
 mod model_changes;
+mod mortar;
 mod moving_detection;
 mod pushover;
 mod quasi_static;

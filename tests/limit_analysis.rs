@@ -1,6 +1,8 @@
 //! Limit analysis (`voussoir::analysis::limit`) against closed forms: a block pushed up an
-//! incline, a pier pushed at its top (overturning or sliding), a symmetric wedge in a V, and the
-//! minimum thickness of a semicircular arch. Derivations in `docs/theory.md` §9.
+//! incline, a pier pushed at its top (overturning or sliding), a symmetric wedge in a V, the
+//! minimum thickness of a semicircular arch, and the dead-load question alone (a block on an
+//! incline stands while the slope is below the friction angle). Derivations in
+//! `docs/theory.md` §9.
 //!
 //! Tolerances: the programme is solved by an interior-point method to Clarabel's default
 //! tolerances (gap and feasibility 1e-8, relative to the programme scaled by the blocks' weight),
@@ -8,7 +10,9 @@
 //! tests allow 1e-6 of the weight, except the arch (see there).
 #![cfg(feature = "limit")]
 
-use voussoir::analysis::limit::{FrictionModel, JointStrength, LimitOptions, LimitProblem, LiveLoad};
+use voussoir::analysis::limit::{
+    DeadLoadResult, FrictionModel, JointStrength, LimitAnswer, LimitContact, LimitOptions, LimitProblem, LiveLoad,
+};
 use voussoir::analysis::{HingeSide, JointRef};
 use voussoir::build::arch::{AbutmentShape, Arch, ArchSpec};
 use voussoir::prelude::*;
@@ -458,4 +462,273 @@ fn typed_errors() {
     assert_eq!(with.contact_count(), 1);
     assert!(JointStrength::from_degrees(90.0, 0.0).is_err());
     assert!(JointStrength::new(0.5, -1.0).is_err());
+}
+
+/// The largest imbalance of the free blocks `free` of `model` under gravity and the corner
+/// forces of `contacts`: force (N) and moment about the block's centroid (N·m).
+fn imbalance(model: &Model, contacts: &[LimitContact], free: &[usize]) -> (Real, Real) {
+    let gravity = model.parameters().gravity;
+    let (mut force, mut moment): (Real, Real) = (0.0, 0.0);
+    for &k in free {
+        let block = &model.blocks()[k];
+        let centre = block.state().pose.translation;
+        let mut f = gravity * block.mass_properties().mass;
+        let mut m = Vector::ZERO;
+        for c in contacts {
+            let sign = if c.blocks.1 .0 as usize == k {
+                1.0
+            } else if c.blocks.0 .0 as usize == k {
+                -1.0
+            } else {
+                continue;
+            };
+            for v in &c.vertices {
+                let on = sign * (c.normal * v.normal_force + v.shear_force);
+                f += on;
+                m += (v.point - centre).cross(on);
+            }
+        }
+        force = force.max(f.length());
+        moment = moment.max(m.length());
+    }
+    (force, moment)
+}
+
+/// The corner forces of an admissible state: compression only, shear within `μ n` (to `tol`).
+fn admissible(contacts: &[LimitContact], mu: Real, tol: Real) -> bool {
+    contacts
+        .iter()
+        .flat_map(|c| &c.vertices)
+        .all(|v| v.normal_force >= -tol && v.shear_force.length() <= mu * v.normal_force + tol)
+}
+
+/// Whether the certificate of a dead load not carried moves the blocks admissibly: every
+/// corner opens by at least `μ` times its slip (to `tol` of the largest corner rate).
+fn admissible_motion(dead: &DeadLoadResult, mu: Real, tol: Real) -> bool {
+    let corners = || dead.contacts.iter().flat_map(|c| &c.vertices);
+    let scale = corners().map(|v| v.opening.hypot(v.sliding)).fold(0.0, Real::max);
+    scale > 0.0 && corners().all(|v| v.opening >= mu * v.sliding - tol * scale)
+}
+
+/// The dead-load question alone on a block on a slope ψ (gravity tilted) with friction angle φ:
+/// carried while `tan ψ ≤ tan φ` (sliding governs: the 0.4 m × 0.1 m block tips at
+/// `tan ψ = 4`), with the contact forces of an admissible state that balance the weight;
+/// beyond, not carried, with the solver's certificate: the block moving down the slope, its
+/// joint opening by at least `tan φ` of the slip (associative flow). The friction pyramid of m facets, inscribed, carries it while
+/// `tan ψ ≤ μ cos(π/m)`. `analyse` with no live load, or a zero one, asks the same question;
+/// `solve` still wants a live load.
+#[test]
+fn dead_load_of_a_block_on_an_incline() {
+    let phi_deg: Real = 30.0;
+    let (lo, hi) = (Vector::new(0.0, 0.0, 0.0), Vector::new(0.4, 0.4, 0.1));
+    let weight = RHO * 0.016 * G;
+    let on_slope = |psi_deg: Real| {
+        let psi = psi_deg.to_radians();
+        detected(
+            G * Vector::new(psi.sin(), 0.0, -psi.cos()),
+            phi_deg,
+            vec![
+                fixed_box("ramp", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.4, 1.4, 0.0)),
+                RigidBlock::cuboid("block", lo, hi, RHO).unwrap(),
+            ],
+        )
+    };
+    let options = LimitOptions::default();
+    let mu = phi_deg.to_radians().tan();
+    for (psi_deg, carried) in [(0.0, true), (20.0, true), (29.0, true), (31.0, false), (45.0, false)] {
+        let model = on_slope(psi_deg);
+        let problem = LimitProblem::from_model(&model).unwrap();
+        let dead = problem.dead_load(&options).unwrap();
+        assert_eq!(dead.carried, carried, "ψ = {psi_deg}°: {dead:?}");
+        assert_eq!(problem.carries_dead_load(&options).unwrap(), carried);
+        if carried {
+            assert!(
+                dead.reason.is_none() && dead.status.contains("Solved"),
+                "{}",
+                dead.status
+            );
+            // The forces balance the weight: the one contact's resultant is −W, to round-off
+            // of the interior point's 1e-8.
+            let (force, moment) = imbalance(&model, &dead.contacts, &[1]);
+            println!(
+                "incline ψ = {psi_deg}°: carried ({}), imbalance {:.1e} W, {:.1e} W·m",
+                dead.status,
+                force / weight,
+                moment / weight
+            );
+            assert!(force < 1e-8 * weight && moment < 1e-8 * weight * 0.1);
+            assert!(admissible(&dead.contacts, mu, 1e-8 * weight));
+            // No mechanism.
+            assert!(dead
+                .blocks
+                .iter()
+                .all(|b| b.velocity == Vector::ZERO && b.angular_velocity == Vector::ZERO));
+        } else {
+            let reason = dead.reason.as_deref().unwrap();
+            println!("incline ψ = {psi_deg}°: not carried ({}): {reason}", dead.status);
+            assert!(dead.status.contains("PrimalInfeasible"), "{}", dead.status);
+            assert!(reason.contains("#1 (\"block\")"), "{reason}");
+            // No forces; the certificate: the block moves down the slope (+x), its joint
+            // opening by at least tan φ of its slip at every corner (kinematically admissible),
+            // the dead load's power the weight.
+            assert!(dead
+                .contacts
+                .iter()
+                .flat_map(|c| &c.vertices)
+                .all(|v| v.normal_force == 0.0 && v.shear_force == Vector::ZERO));
+            let (v, w) = dead.block_velocity(BlockId(1)).unwrap();
+            println!("  certificate: v = {v}, ω = {w}");
+            assert!(v.x > 0.0 && v.y.abs() < 1e-6 * v.x, "{v} {w}");
+            assert!(admissible_motion(&dead, mu, 1e-6));
+            assert!(dead.contacts[0].vertices.iter().any(|c| c.sliding > 1e-3 * v.x));
+            let power = model.parameters().gravity.dot(v) * RHO * 0.016;
+            assert!((power - weight).abs() < 1e-6 * weight, "{power} vs {weight}");
+        }
+        // The same through `analyse`, with no live load or a zero one.
+        let zero = LiveLoad {
+            block: BlockId(1),
+            point: 0.5 * (lo + hi),
+            force: Vector::ZERO,
+        };
+        for live in [&[][..], &[zero][..]] {
+            let answer = problem.analyse(live, &options).unwrap();
+            assert_eq!(answer.multiplier(), None);
+            let LimitAnswer::DeadLoad(again) = answer else {
+                panic!("a dead-load answer expected")
+            };
+            assert_eq!(again.carried, carried);
+        }
+        // `solve` wants a live load and says where the dead-load question is.
+        let error = problem.solve(&[zero], &options).unwrap_err();
+        assert!(
+            matches!(error, Error::InvalidParameter { .. }) && error.to_string().contains("dead_load"),
+            "{error}"
+        );
+    }
+    // The inscribed pyramid: carried while tan ψ ≤ μ cos(π/16) (ψ ≤ 29.52°).
+    let pyramid = LimitOptions {
+        friction: FrictionModel::Pyramid { facets: 16 },
+        ..options
+    };
+    let limit = (mu * (std::f64::consts::PI / 16.0).cos()).atan().to_degrees();
+    for (psi_deg, carried) in [(limit - 0.05, true), (limit + 0.05, false)] {
+        let model = on_slope(psi_deg);
+        let problem = LimitProblem::from_model(&model).unwrap();
+        let dead = problem.dead_load(&pyramid).unwrap();
+        assert_eq!(dead.carried, carried, "pyramid, ψ = {psi_deg}°");
+        assert!(
+            problem.carries_dead_load(&options).unwrap(),
+            "the cone carries it at ψ = {psi_deg}°"
+        );
+        if carried {
+            let (force, _) = imbalance(&model, &dead.contacts, &[1]);
+            assert!(force < 1e-8 * weight, "{force}");
+        }
+    }
+    // With a live load, `analyse` is `solve`: pushed up the slope of 20° at W tan(ψ + φ).
+    let model = on_slope(20.0);
+    let problem = LimitProblem::from_model(&model).unwrap();
+    let psi = 20f64.to_radians();
+    let push = LiveLoad {
+        block: BlockId(1),
+        point: 0.5 * (lo + hi),
+        force: Vector::new(-psi.cos(), 0.0, -psi.sin()),
+    };
+    let answer = problem.analyse(&[push], &options).unwrap();
+    let expected = weight * (psi + phi_deg.to_radians()).tan();
+    assert!((answer.multiplier().unwrap() - expected).abs() < 1e-6 * weight);
+    assert!(matches!(answer, LimitAnswer::Collapse(_)));
+    // A bad block is still refused, live load or not.
+    let stray = LiveLoad {
+        block: BlockId(9),
+        force: Vector::ZERO,
+        ..push
+    };
+    assert!(matches!(
+        problem.analyse(&[stray], &options),
+        Err(Error::UnknownBlock { .. })
+    ));
+}
+
+/// The dead-load question on a semicircular arch: at 0.2 m the contact forces of the admissible
+/// state hold every voussoir in equilibrium (force and moment, to the solver's round-off); at
+/// 0.05 m (below Heyman's minimum thickness, `t/R = 0.1075`) it is not carried, and the
+/// solver's certificate is a mechanism in which the crown falls.
+#[test]
+fn dead_load_of_a_semicircular_arch() {
+    let (ri, n) = (1.0, 16);
+    let arch_of = |t: Real| {
+        let spec = ArchSpec {
+            span: 2.0 * ri,
+            rise: ri,
+            thickness: t,
+            width: 0.2,
+            voussoirs: n,
+            density: RHO,
+            abutment: AbutmentShape {
+                outer_width: 0.3,
+                depth: 0.3,
+            },
+            voussoir_material: MaterialId(0),
+            abutment_material: MaterialId(0),
+        };
+        detected(Vector::new(0.0, -G, 0.0), 45.0, Arch::new(&spec).unwrap().blocks)
+    };
+    let strength = |_: &CoulombSlip| Some(JointStrength::new(2.0, 0.0).unwrap());
+    let options = LimitOptions::default();
+    let model = arch_of(0.2);
+    let problem = LimitProblem::from_model_with(&model, strength).unwrap();
+    let dead: DeadLoadResult = problem.dead_load(&options).unwrap();
+    assert!(dead.carried);
+    let free: Vec<usize> = (1..=n).collect();
+    let weight: Real = free.iter().map(|&k| model.blocks()[k].mass_properties().mass * G).sum();
+    let (force, moment) = imbalance(&model, &dead.contacts, &free);
+    println!(
+        "semicircle t = 0.2 m: carried ({}, {} iterations), imbalance {:.1e} W, {:.1e} W·m",
+        dead.status,
+        dead.iterations,
+        force / weight,
+        moment / weight
+    );
+    assert!(force < 1e-8 * weight && moment < 1e-8 * weight * ri);
+    assert!(admissible(&dead.contacts, 2.0, 1e-8 * weight));
+    // The abutments carry the weight between them.
+    let on_abutments: Vector = dead
+        .contacts
+        .iter()
+        .filter(|c| c.blocks.0 == BlockId(0) || c.blocks.1 == BlockId(n as u32 + 1))
+        .map(|c| {
+            if c.blocks.0 == BlockId(0) {
+                c.resultant()
+            } else {
+                -c.resultant()
+            }
+        })
+        .sum();
+    assert!((on_abutments.y - weight).abs() < 1e-8 * weight, "{on_abutments}");
+
+    let model = arch_of(0.05);
+    let problem = LimitProblem::from_model_with(&model, strength).unwrap();
+    let dead = problem.dead_load(&options).unwrap();
+    assert!(!dead.carried);
+    println!(
+        "semicircle t = 0.05 m: not carried ({}): {}",
+        dead.status,
+        dead.reason.as_deref().unwrap_or("")
+    );
+    assert!(dead.status.contains("PrimalInfeasible"), "{}", dead.status);
+    assert!(admissible_motion(&dead, 2.0, 1e-6));
+    let power: Real = free
+        .iter()
+        .map(|&k| {
+            let block = &model.blocks()[k];
+            model.parameters().gravity.dot(dead.blocks[k].velocity) * block.mass_properties().mass
+        })
+        .sum();
+    let weight: Real = free.iter().map(|&k| model.blocks()[k].mass_properties().mass * G).sum();
+    assert!((power - weight).abs() < 1e-6 * weight, "{power} vs {weight}");
+    // The crown sinks.
+    let crown = model.blocks()[n / 2].state().pose.translation;
+    let v = dead.point_velocity(BlockId(n as u32 / 2), crown).unwrap();
+    assert!(v.y < 0.0, "{v}");
 }

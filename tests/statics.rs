@@ -31,7 +31,7 @@ const MAX_STEPS: u64 = 200_000;
 
 /// A model with one dry Coulomb joint law (`ks = 0.4 kn`, φ = 30°), default local damping and the
 /// given sub-contact density.
-fn model(kn: f64, density: SubcontactDensity) -> Model {
+fn model(kn: f64, density: SubContactDensity) -> Model {
     let mut params = ModelParameters::default();
     params.contact.density = density;
     common::model_with(params, CoulombSlip::dry(kn, 0.4 * kn, PHI).unwrap())
@@ -115,7 +115,7 @@ fn joint_sums(m: &Model, a: BlockId, b: BlockId) -> JointSums {
 #[test]
 fn block_on_coincident_base_carries_its_weight_uniformly() {
     let (lo, hi) = ([-0.2, -0.15, 0.0], [0.2, 0.15, 0.2]);
-    let mut m = model(4e9, SubcontactDensity::PerEdge(15));
+    let mut m = model(4e9, SubContactDensity::PerEdge(15));
     let base = m
         .add_block(fixed_cuboid("base", [-0.2, -0.15, -0.2], [0.2, 0.15, 0.0]))
         .unwrap();
@@ -139,7 +139,7 @@ fn block_on_coincident_base_carries_its_weight_uniformly() {
 #[test]
 fn block_smaller_than_base_and_offset_carries_its_weight_uniformly() {
     let (lo, hi) = ([0.13, -0.31, 0.0], [0.53, -0.01, 0.25]);
-    let mut m = model(1e9, SubcontactDensity::PerEdge(15));
+    let mut m = model(1e9, SubContactDensity::PerEdge(15));
     let base = m
         .add_block(fixed_cuboid("base", [-0.5, -0.4, -0.2], [0.6, 0.5, 0.0]))
         .unwrap();
@@ -194,7 +194,7 @@ fn check_uniform_joint(m: &Model, base: BlockId, block: BlockId, w: f64, face: f
 fn overhanging_block_areas_sum_to_the_overlap() {
     let (lo, hi) = ([-0.05, 0.0, 0.0], [0.35, 0.3, 0.2]);
     let (blo, bhi) = ([-0.3, -0.2, -0.2], [0.3, 0.28, 0.0]);
-    let mut m = model(2e9, SubcontactDensity::PerEdge(15));
+    let mut m = model(2e9, SubContactDensity::PerEdge(15));
     let base = m.add_block(fixed_cuboid("base", blo, bhi)).unwrap();
     let block = m.add_block(cuboid("block", lo, hi)).unwrap();
     let steps = settle(&mut m);
@@ -256,7 +256,7 @@ struct Eccentric {
 /// and weight, `N = F + W`, acts at eccentricity `e`.
 fn eccentric(e: f64) -> Eccentric {
     let (lo, hi) = ([-L / 2.0, -B / 2.0, 0.0], [L / 2.0, B / 2.0, H]);
-    let mut m = model(4e9, SubcontactDensity::PerEdge(N_GRID));
+    let mut m = model(4e9, SubContactDensity::PerEdge(N_GRID));
     let base = m
         .add_block(fixed_cuboid("base", [-0.5, -0.5, -0.2], [0.5, 0.5, 0.0]))
         .unwrap();
@@ -425,7 +425,7 @@ fn eccentric_load_beyond_the_kern_gives_partial_contact() {
 fn column_of_three_blocks_joints_carry_the_weight_above() {
     let heights = [0.25, 0.15, 0.2];
     let (x, y) = ((-0.2, 0.2), (-0.15, 0.15));
-    let mut m = model(4e9, SubcontactDensity::PerEdge(15));
+    let mut m = model(4e9, SubContactDensity::PerEdge(15));
     let mut ids = vec![m
         .add_block(fixed_cuboid("base", [x.0, y.0, -0.2], [x.1, y.1, 0.0]))
         .unwrap()];
@@ -479,7 +479,7 @@ fn column_of_three_blocks_joints_carry_the_weight_above() {
 fn a_hinge_turns_as_a_no_tension_winkler_joint() -> Result<()> {
     let (b, d, h, kn): (Real, Real, Real, Real) = (0.2, 0.2, 0.6, 4e11);
     let mut params = ModelParameters::default();
-    params.contact.density = SubcontactDensity::PerEdge(5);
+    params.contact.density = SubContactDensity::PerEdge(5);
     let tilt = (0.97 * b / h).atan();
     params.gravity = 9.81 * Vector::new(tilt.sin(), 0.0, -tilt.cos());
     let mut model: Model = Model::new(params)?;

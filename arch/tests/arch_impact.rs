@@ -202,3 +202,25 @@ fn release_just_above_equals_full_drop() {
     assert!((f.first_peak_disp / a.first_peak_disp - 1.0).abs() < 0.02);
     assert!((f.max_disp / a.max_disp - 1.0).abs() < 0.02);
 }
+
+/// The choices' names are written once (`named_choices!`): each parses from its name in any
+/// case, and an unknown name lists them; the command line offers the same names.
+#[test]
+fn choices_parse_from_their_one_set_of_names() {
+    use voussoir_arch::scenarios::arch_impact::{ImpactorBase, Release};
+    for g in ImpactorGuide::ALL {
+        assert_eq!(g.name().parse::<ImpactorGuide>(), Ok(*g));
+        assert_eq!(g.name().to_uppercase().parse::<ImpactorGuide>(), Ok(*g));
+    }
+    for b in ImpactorBase::ALL {
+        assert_eq!(b.name().parse::<ImpactorBase>(), Ok(*b));
+    }
+    for r in Release::ALL {
+        assert_eq!(r.name().parse::<Release>(), Ok(*r));
+    }
+    assert_eq!(
+        "rope".parse::<ImpactorGuide>().unwrap_err(),
+        "guide \"rope\": expected \"frame\" or \"seat\""
+    );
+    assert_eq!(Release::JustAbove.name(), "above");
+}

@@ -119,7 +119,7 @@ fn static_arch_behaves_like_an_arch() {
 /// **The hinge-governed capacity does not depend on the joints' discretisation.** The
 /// reference arch at φ = 35° (four hinges, no sliding: the limit analysis gives 5.853 kN) at 15
 /// sub-contacts per edge (the paper's) and at the refined 29, through
-/// [`SubcontactDensity::check_convergence`]. With sub-contacts at points the peak moved by 3 %
+/// [`SubContactDensity::check_convergence`]. With sub-contacts at points the peak moved by 3 %
 /// (5685 / 5519 N at 15 / 30, 5960 N at 5).
 ///
 /// The capacity compared is the peak of the load averaged over 0.2 mm of plate travel (ten
@@ -132,16 +132,16 @@ fn static_arch_behaves_like_an_arch() {
 /// times that round-off scatter.
 #[test]
 fn hinge_capacity_converges_with_the_subcontact_density() {
-    use voussoir::geometry::SubcontactDensity;
+    use voussoir::geometry::SubContactDensity;
     let base = case("35", |c| {
         c.friction_deg = 35.0;
         c.max_displacement = 8e-3;
         c.stop_fraction = 0.5;
         c.smoothing_window = 2e-4;
     });
-    let check = SubcontactDensity::PerEdge(base.per_edge)
+    let check = SubContactDensity::PerEdge(base.per_edge)
         .check_convergence(|density| {
-            let SubcontactDensity::PerEdge(per_edge) = density else {
+            let SubContactDensity::PerEdge(per_edge) = density else {
                 unreachable!("per-edge densities")
             };
             let r = run(

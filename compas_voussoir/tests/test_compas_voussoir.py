@@ -457,24 +457,74 @@ def test_stiffnesses_are_per_unit_area_and_odd_ones_warned():
 
 def test_limit_analysis_answers_whether_the_dead_load_is_carried():
     """A zero live load (or live=[]) asks whether the dead load alone is carried (voussoir.limit
-    refuses a zero live load: compas_voussoir asks its dead-load check with the dead load
-    reversed as the probe, which it cancels at multiplier 1). An arch that cannot stand is an
-    answer, carries_dead_load False with the status, not an error. The semicircular arch of
-    16 voussoirs (intrados radius 1 m, end voussoirs fixed, μ 1) stands down to a thickness of
-    0.0654 m (bisected: carried at 0.06540, not at 0.06539); check_dead_load=False passes through
-    (it was a TypeError from voussoir.Model) and gives the same multiplier unchecked."""
-    for live, load in (("Live", 0.0), ([], 1.0)):  # a zero live load; no live load
+    with no live load). Carried, the Results hold the contact forces of an admissible state:
+    every voussoir in equilibrium under its weight and its contacts' forces (force and moment,
+    to round-off), the supports' reactions adding up to the arch's weight. An arch that cannot
+    stand is an answer, carries_dead_load False with the solver's status and a reason naming
+    the blocks that fall, not an error. The semicircular arch of 16 voussoirs (intrados radius
+    1 m, end voussoirs fixed, μ 1) stands down to a thickness of 0.0654 m (bisected: carried
+    at 0.06540, not at 0.06539); check_dead_load=False passes through (it was a TypeError from
+    voussoir.Model) and gives the same multiplier unchecked."""
+    for live, load in (("Live", 0.0), ([], 1.0)):  # a zero live load; no live load (1 N dead)
         model, problem = semicircular_arch(load_on=4, load=load)
         r = cv.solve(problem, analysis="limit", live=live, density=2000.0)
         assert r.metadata["carries_dead_load"] is True and r.metadata["multiplier"] is None
         assert r.metadata["status"] == "Solved" and r.metadata["dead_load_only"] is True
-        assert set(r.nodes()) == set(range(16)) and not list(r.edges())
+        assert r.metadata["mechanism"] is None and r.metadata["hinges"] == [] and "reason" not in r.metadata
+        assert set(r.nodes()) == set(range(16))
+        # The blocks stay where they stand (no mechanism).
+        for n in r.nodes():
+            assert np.allclose(np.asarray(r.transformation(n).matrix), np.eye(4), atol=1e-12)
+        # Every contact of the ring, with forces; each voussoir in equilibrium.
+        edges = list(r.edges())
+        assert len(edges) == 15
+        conv = cv.to_voussoir(problem, density=2000.0)
+        masses = {conv.node[i]: conv.model.block(i).mass for i in conv.node}
+        centroids = {conv.node[i]: np.asarray(conv.centroids[i]) for i in conv.node}
+        g = np.asarray(conv.model.gravity, dtype=float)
+        weight = sum(masses[n] for n in range(1, 15)) * float(np.linalg.norm(g))
+        force = {n: masses[n] * g for n in range(16)}
+        moment = {n: np.zeros(3) for n in range(16)}
+        # live=[]: the "Live" load is a dead load, at compas_dem's centroid of the element.
+        at = np.asarray(list(model.graph.node_element(4).point), dtype=float)
+        force[4] += [0.0, 0.0, -load]
+        moment[4] += np.cross(at - centroids[4], [0.0, 0.0, -load])
+        for u, v in edges:
+            f = np.asarray(r.resultant_global((u, v)), dtype=float)  # on v
+            p = np.asarray(list(r.force_point((u, v))), dtype=float)
+            for node, sign in ((v, 1.0), (u, -1.0)):
+                force[node] += sign * f
+                moment[node] += sign * np.cross(p - centroids[node], f)
+            assert r.resultant_local((u, v))[2] > 0.0  # compression
+        for n in range(1, 15):
+            assert np.linalg.norm(force[n]) < 1e-9 * weight, (n, force[n])
+            assert np.linalg.norm(moment[n]) < 1e-9 * weight, (n, moment[n])
+        total = sum(np.asarray(x["force"]) for x in cv.reactions(r).values())
+        assert total == pytest.approx([0.0, 0.0, -weight - load], abs=1e-9 * weight)
     for thickness, stands in ((0.0655, True), (0.0653, False)):
         model, problem = semicircular_arch(thickness=thickness, load_on=4)
         r = cv.solve(problem, analysis="limit", live=[], density=2000.0)
         assert r.metadata["carries_dead_load"] is stands, thickness
-        assert r.metadata["status"] == ("Solved" if stands else "infeasible")
-    # With a live load: the thin arch's answer is False (it raised VoussoirError), checked or not.
+        if stands:
+            assert r.metadata["status"] == "Solved" and len(list(r.edges())) == 15
+        else:
+            assert r.metadata["status"] in ("PrimalInfeasible", "AlmostPrimalInfeasible")
+            assert "move" in r.metadata["reason"] and not list(r.edges())
+            # The solver's certificate: a motion on which the dead loads (the weight and the
+            # 1 N at voussoir 4's centroid) do work, scaled to a power of the weight (so near
+            # the limit thickness, where the work nearly vanishes, the speeds are large).
+            conv = cv.to_voussoir(problem, density=2000.0)
+            g = np.asarray(conv.model.gravity, dtype=float)
+            mech = r.metadata["mechanism"]
+            power = sum(conv.model.block(i).mass * float(g @ mech[conv.node[i]]["velocity"]) for i in conv.node)
+            at = np.asarray(list(model.graph.node_element(4).point), dtype=float)
+            i4 = conv.index[4]
+            v4 = np.asarray(mech[4]["velocity"]) + np.cross(mech[4]["angular_velocity"], at - conv.centroids[i4])
+            power += float(np.dot([0.0, 0.0, -1.0], v4))
+            weight = sum(conv.model.block(conv.index[n]).mass for n in range(1, 15)) * float(np.linalg.norm(g))
+            assert power == pytest.approx(weight + 1.0, rel=1e-6)
+    # With a live load: the thin arch's answer is False (voussoir raised LimitInfeasibleError),
+    # checked or not.
     model, problem = semicircular_arch(thickness=0.05, load_on=4)
     for check in (True, False):
         r = cv.solve(problem, analysis="limit", live="Live", density=2000.0, check_dead_load=check)
@@ -629,3 +679,14 @@ def test_hinge_sides_of_the_four_hinge_mechanism():
     assert h["side"] is None and np.allclose(np.asarray(h["pivot"])[:, 0], 0.1)
     assert np.allclose(h["towards"], [1.0, 0.0, 0.0], atol=1e-9)
     assert r.metadata["multiplier"] == pytest.approx(10.0, rel=1e-5)
+
+
+def test_model_defaults_are_voussoirs_own():
+    """The sub-contact density and contact tolerance are not restated here: None takes
+    ``voussoir.Model.defaults()`` (issue 46: 15 per edge and 1e-3 were written again)."""
+    import inspect
+
+    for fn in (cv.run, cv.to_voussoir):
+        params = inspect.signature(fn).parameters
+        assert params["subcontacts_per_edge"].default is None
+        assert params["contact_tolerance"].default is None

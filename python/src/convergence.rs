@@ -2,15 +2,15 @@
 
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use voussoir::geometry::SubcontactDensity;
+use voussoir::geometry::SubContactDensity;
 use voussoir::loading::Convergence;
 
 /// The keyword arguments of ``Model`` that give `density`.
-fn density_kwargs<'py>(py: Python<'py>, density: SubcontactDensity) -> PyResult<Bound<'py, PyDict>> {
+fn density_kwargs<'py>(py: Python<'py>, density: SubContactDensity) -> PyResult<Bound<'py, PyDict>> {
     let kwargs = PyDict::new(py);
     match density {
-        SubcontactDensity::PerEdge(n) => kwargs.set_item("subcontacts_per_edge", n)?,
-        SubcontactDensity::Spacing(h) => kwargs.set_item("subcontact_spacing", h)?,
+        SubContactDensity::PerEdge(n) => kwargs.set_item("subcontacts_per_edge", n)?,
+        SubContactDensity::Spacing(h) => kwargs.set_item("subcontact_spacing", h)?,
     }
     Ok(kwargs)
 }
@@ -22,7 +22,7 @@ fn density_kwargs<'py>(py: Python<'py>, density: SubcontactDensity) -> PyResult<
 /// along each edge (``2 n - 1`` per edge, or half the spacing), and reports how much the
 /// quantity it returns (a collapse load, a displacement) changed: the check that an answer does
 /// not depend on how finely the joints are divided (Rust:
-/// ``SubcontactDensity::check_convergence``).
+/// ``SubContactDensity::check_convergence``).
 ///
 /// ``run`` is called with the density as the keyword argument ``Model`` takes
 /// (``subcontacts_per_edge=n`` or ``subcontact_spacing=h``), builds and runs the whole
@@ -52,8 +52,8 @@ pub fn check_density_convergence<'py>(
         ));
     }
     let density = match subcontact_spacing {
-        Some(h) => SubcontactDensity::Spacing(h),
-        None => SubcontactDensity::PerEdge(subcontacts_per_edge),
+        Some(h) => SubContactDensity::Spacing(h),
+        None => SubContactDensity::PerEdge(subcontacts_per_edge),
     };
     let params = voussoir::geometry::ContactParameters {
         density,
@@ -62,7 +62,7 @@ pub fn check_density_convergence<'py>(
     params.validate().map_err(crate::errors::to_py)?;
     let refined_density = density.refined();
     let call =
-        |d: SubcontactDensity| -> PyResult<f64> { run.call((), Some(&density_kwargs(py, d)?))?.extract::<f64>() };
+        |d: SubContactDensity| -> PyResult<f64> { run.call((), Some(&density_kwargs(py, d)?))?.extract::<f64>() };
     let c = Convergence {
         value: call(density)?,
         refined: call(refined_density)?,

@@ -11,14 +11,16 @@ use crate::errors::OrPy;
 
 /// A scene or checkpoint document of a model with one law type, as one of `Model<AnyLaw>`: a
 /// law without its kind (`{"normal_stiffness": ..}` of a `Scene<CoulombSlip>`) is named
-/// (`{"Coulomb": ..}`, or `{"Elastic": ..}` without a friction angle), and so is a
-/// sub-contact's law state.
+/// (`{"Coulomb": ..}`, `{"Mortar": ..}` with a softening shape, or `{"Elastic": ..}` without a
+/// friction angle), and so is a sub-contact's law state.
 pub(crate) fn as_any_law(doc: &mut serde_json::Value) {
     use serde_json::Value;
     fn wrap_law(law: &mut Value) {
         if let Value::Object(map) = law {
-            if !map.contains_key("Coulomb") && !map.contains_key("Elastic") {
-                let kind = if map.contains_key("friction_deg") {
+            if !["Coulomb", "Mortar", "Elastic"].iter().any(|k| map.contains_key(*k)) {
+                let kind = if map.contains_key("softening") {
+                    "Mortar"
+                } else if map.contains_key("friction_deg") {
                     "Coulomb"
                 } else {
                     "Elastic"
@@ -50,6 +52,9 @@ pub(crate) fn as_any_law(doc: &mut serde_json::Value) {
                             Value::Null => *state = serde_json::json!({}),
                             Value::Object(m) if !m.contains_key("coulomb") && m.contains_key("failed") => {
                                 *state = serde_json::json!({ "coulomb": state.take() });
+                            }
+                            Value::Object(m) if !m.contains_key("mortar") && m.contains_key("crack_opening") => {
+                                *state = serde_json::json!({ "mortar": state.take() });
                             }
                             _ => {}
                         }

@@ -17,14 +17,44 @@ create_exception!(
     PyOSError,
     "Reading or writing a file failed (the message names the file). A subclass of OSError."
 );
+create_exception!(
+    voussoir,
+    LimitInfeasibleError,
+    VoussoirError,
+    "Limit analysis with a live load: the dead loads (gravity and the blocks' constant loads) are \
+not carried, with or without the live load, or only with its help (``check_dead_load``): the \
+structure cannot carry its own weight. The dead-load question alone (``carries_dead_load``, or \
+``limit`` with no live load) answers False instead of raising. A subclass of VoussoirError."
+);
+create_exception!(
+    voussoir,
+    LimitUnboundedError,
+    VoussoirError,
+    "Limit analysis: the live load's multiplier has no upper bound (the live load acts on supports' \
+constrained degrees of freedom, goes straight into them, or wedges blocks that friction locks). \
+A subclass of VoussoirError."
+);
+create_exception!(
+    voussoir,
+    LimitSolverError,
+    VoussoirError,
+    "Limit analysis: the conic solver stopped without an answer or a certificate (e.g. at \
+``max_iterations``; the message gives its status). A subclass of VoussoirError."
+);
 
 /// The exception for a Rust error: [`VoussoirIOError`] for [`voussoir::Error::Io`],
 /// `MemoryError` for [`voussoir::Error::TooLarge`] (a size beyond the library's limits),
+/// [`LimitInfeasibleError`], [`LimitUnboundedError`] and [`LimitSolverError`] for
+/// [`voussoir::Error::LimitInfeasible`], [`LimitUnbounded`](voussoir::Error::LimitUnbounded)
+/// and [`LimitSolver`](voussoir::Error::LimitSolver) (subclasses of [`VoussoirError`]),
 /// [`VoussoirError`] for the others, with the same message.
 pub fn to_py(e: voussoir::Error) -> PyErr {
     match e {
         voussoir::Error::Io { .. } => VoussoirIOError::new_err(e.to_string()),
         voussoir::Error::TooLarge { .. } => PyMemoryError::new_err(e.to_string()),
+        voussoir::Error::LimitInfeasible { .. } => LimitInfeasibleError::new_err(e.to_string()),
+        voussoir::Error::LimitUnbounded { .. } => LimitUnboundedError::new_err(e.to_string()),
+        voussoir::Error::LimitSolver { .. } => LimitSolverError::new_err(e.to_string()),
         _ => VoussoirError::new_err(e.to_string()),
     }
 }

@@ -1,7 +1,7 @@
 //! The shipped joint laws.
 
 use pyo3::prelude::*;
-use voussoir::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, LinearElastic};
+use voussoir::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, LinearElastic, MortarJoint, Softening};
 
 use crate::errors::{bad, OrPy};
 
@@ -107,6 +107,192 @@ fn degrees(law: &CoulombSlip, field: &str) -> f64 {
         .unwrap_or(f64::NAN)
 }
 
+/// A mortared joint that cracks in tension and shear and softens by its fracture energies
+/// (Lourenço–Rots' composite interface, per unit area: a crack dissipates its fracture energy
+/// whatever the number of sub-contacts).
+///
+/// ``MortarJoint(kn, ks, friction_deg, residual_friction_deg=None, tensile_strength=0.0,
+/// mode_i_fracture_energy=None, cohesion=0.0, mode_ii_fracture_energy=None, dilatancy_deg=0.0,
+/// softening="exponential", compressive_strength=None)``: stiffnesses in Pa/m, angles in degrees
+/// ([0, 90)), strengths in Pa, fracture energies in J/m² (N/m). The tensile strength softens
+/// with the crack's opening on ``mode_i_fracture_energy`` and the cohesion with its slip on
+/// ``mode_ii_fracture_energy`` (each required with its strength; 0 is brittle, as
+/// ``CoulombSlip``); the friction goes from ``friction_deg`` to ``residual_friction_deg`` as the
+/// cohesion goes; opening erodes the cohesion and slip the tensile strength alike.
+/// ``softening`` is ``"exponential"`` or ``"linear"``. ``dilatancy_deg`` (needs a cohesion and
+/// a mode-II fracture energy) opens a slipping joint, decaying as it softens.
+/// ``compressive_strength`` (Pa) flags sub-contacts whose compression passes it (the law does
+/// not crush) and makes the step slower. The fracture energy consumed is
+/// ``Model.energies()["fracture"]``; see ``docs/theory.md`` §4.2.
+#[pyclass(name = "MortarJoint", module = "voussoir", frozen)]
+#[derive(Clone)]
+pub struct PyMortarJoint {
+    pub inner: MortarJoint,
+}
+
+/// The fracture energy `name` given with a strength: required unless the strength is zero.
+fn fracture_energy(name: &str, strength: f64, energy: Option<f64>) -> PyResult<f64> {
+    match energy {
+        Some(g) => Ok(g),
+        None if strength == 0.0 => Ok(0.0),
+        None => Err(voussoir::Error::InvalidParameter {
+            name: name.into(),
+            value: f64::NAN,
+            expected: "must be given with its strength (0 for a brittle joint)",
+        })
+        .py(),
+    }
+}
+
+#[pymethods]
+impl PyMortarJoint {
+    #[new]
+    #[pyo3(signature = (
+        kn,
+        ks,
+        friction_deg,
+        residual_friction_deg=None,
+        tensile_strength=0.0,
+        mode_i_fracture_energy=None,
+        cohesion=0.0,
+        mode_ii_fracture_energy=None,
+        dilatancy_deg=0.0,
+        softening="exponential",
+        compressive_strength=None,
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        kn: f64,
+        ks: f64,
+        friction_deg: f64,
+        residual_friction_deg: Option<f64>,
+        tensile_strength: f64,
+        mode_i_fracture_energy: Option<f64>,
+        cohesion: f64,
+        mode_ii_fracture_energy: Option<f64>,
+        dilatancy_deg: f64,
+        softening: &str,
+        compressive_strength: Option<f64>,
+    ) -> PyResult<Self> {
+        let g_i = fracture_energy("mode_i_fracture_energy", tensile_strength, mode_i_fracture_energy)?;
+        let g_ii = fracture_energy("mode_ii_fracture_energy", cohesion, mode_ii_fracture_energy)?;
+        let shape = match softening {
+            "exponential" => Softening::Exponential,
+            "linear" => Softening::Linear,
+            other => {
+                return Err(bad(format!(
+                    "softening: expected \"exponential\" or \"linear\", got {other:?}"
+                )))
+            }
+        };
+        let mut builder = MortarJoint::builder(kn, ks, friction_deg)
+            .residual_friction(residual_friction_deg.unwrap_or(friction_deg))
+            .tension(tensile_strength, g_i)
+            .cohesion(cohesion, g_ii)
+            .dilatancy(dilatancy_deg)
+            .softening(shape);
+        if let Some(f_m) = compressive_strength {
+            builder = builder.compressive_strength(f_m);
+        }
+        Ok(Self {
+            inner: builder.build().py()?,
+        })
+    }
+
+    /// Normal stiffness (Pa/m).
+    #[getter]
+    fn kn(&self) -> f64 {
+        self.inner.normal_stiffness()
+    }
+    /// Shear stiffness (Pa/m).
+    #[getter]
+    fn ks(&self) -> f64 {
+        self.inner.shear_stiffness()
+    }
+    /// Initial friction angle (degrees).
+    #[getter]
+    fn friction_deg(&self) -> f64 {
+        mortar_field(&self.inner, "friction_deg")
+    }
+    /// Residual friction angle (degrees).
+    #[getter]
+    fn residual_friction_deg(&self) -> f64 {
+        mortar_field(&self.inner, "residual_friction_deg")
+    }
+    /// Dilatancy angle (degrees).
+    #[getter]
+    fn dilatancy_deg(&self) -> f64 {
+        mortar_field(&self.inner, "dilatancy_deg")
+    }
+    /// Tensile strength (Pa).
+    #[getter]
+    fn tensile_strength(&self) -> f64 {
+        self.inner.tensile_strength()
+    }
+    /// Mode-I fracture energy (J/m²).
+    #[getter]
+    fn mode_i_fracture_energy(&self) -> f64 {
+        self.inner.mode_i_fracture_energy()
+    }
+    /// Cohesion (Pa).
+    #[getter]
+    fn cohesion(&self) -> f64 {
+        self.inner.cohesion()
+    }
+    /// Mode-II fracture energy (J/m²).
+    #[getter]
+    fn mode_ii_fracture_energy(&self) -> f64 {
+        self.inner.mode_ii_fracture_energy()
+    }
+    /// ``"exponential"`` or ``"linear"``.
+    #[getter]
+    fn softening(&self) -> &'static str {
+        match self.inner.softening() {
+            Softening::Exponential => "exponential",
+            Softening::Linear => "linear",
+        }
+    }
+    /// Compressive strength that flags sub-contacts (Pa), or None.
+    #[getter]
+    fn compressive_strength(&self) -> Option<f64> {
+        self.inner.compressive_strength()
+    }
+
+    fn __repr__(&self) -> String {
+        let f_m = match self.compressive_strength() {
+            Some(f) => format!(", compressive_strength={f}"),
+            None => String::new(),
+        };
+        format!(
+            "MortarJoint(kn={:e}, ks={:e}, friction_deg={}, residual_friction_deg={}, tensile_strength={}, \
+             mode_i_fracture_energy={}, cohesion={}, mode_ii_fracture_energy={}, dilatancy_deg={}, softening={:?}{f_m})",
+            self.kn(),
+            self.ks(),
+            self.friction_deg(),
+            self.residual_friction_deg(),
+            self.tensile_strength(),
+            self.mode_i_fracture_energy(),
+            self.cohesion(),
+            self.mode_ii_fracture_energy(),
+            self.dilatancy_deg(),
+            self.softening(),
+        )
+    }
+
+    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+        other.cast::<PyMortarJoint>().is_ok_and(|o| o.get().inner == self.inner)
+    }
+}
+
+/// A field of a mortar joint as it was given (angles in degrees), read from its serialised
+/// form.
+fn mortar_field(law: &MortarJoint, field: &str) -> f64 {
+    serde_json::to_value(law)
+        .ok()
+        .and_then(|v| v.get(field).and_then(serde_json::Value::as_f64))
+        .unwrap_or(f64::NAN)
+}
+
 /// Linear springs with no strength limit: ``LinearElastic(kn, ks)`` in Pa/m.
 #[pyclass(name = "LinearElastic", module = "voussoir", frozen)]
 #[derive(Clone)]
@@ -156,9 +342,12 @@ pub fn law_from_py(obj: &Bound<'_, PyAny>) -> PyResult<AnyLaw> {
     if let Ok(e) = obj.cast::<PyLinearElastic>() {
         return Ok(e.get().inner.into());
     }
+    if let Ok(m) = obj.cast::<PyMortarJoint>() {
+        return Ok(m.get().inner.into());
+    }
     Err(bad(format!(
-        "joint law: expected voussoir.CoulombSlip or voussoir.LinearElastic, got {} (laws written in Python are not \
-supported; see docs/custom-law.md for a law of your own in Rust)",
+        "joint law: expected voussoir.CoulombSlip, voussoir.MortarJoint or voussoir.LinearElastic, got {} (laws written \
+in Python are not supported; see docs/custom-law.md for a law of your own in Rust)",
         obj.get_type().name()?
     )))
 }
@@ -168,6 +357,7 @@ pub fn law_to_py<'py>(py: Python<'py>, law: &AnyLaw) -> PyResult<Bound<'py, PyAn
     match law {
         AnyLaw::Coulomb(c) => Ok(Bound::new(py, PyCoulombSlip { inner: *c })?.into_any()),
         AnyLaw::Elastic(e) => Ok(Bound::new(py, PyLinearElastic { inner: *e })?.into_any()),
+        AnyLaw::Mortar(m) => Ok(Bound::new(py, PyMortarJoint { inner: *m })?.into_any()),
         _ => Err(bad("a law this version of the Python package does not know")),
     }
 }

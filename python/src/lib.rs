@@ -30,8 +30,12 @@ fn _voussoir(m: &Bound<'_, PyModule>) -> PyResult<()> {
     numpy::PyArray1::<f64>::zeros(py, 0, false);
     m.add("VoussoirError", py.get_type::<errors::VoussoirError>())?;
     m.add("VoussoirIOError", py.get_type::<errors::VoussoirIOError>())?;
+    m.add("LimitInfeasibleError", py.get_type::<errors::LimitInfeasibleError>())?;
+    m.add("LimitUnboundedError", py.get_type::<errors::LimitUnboundedError>())?;
+    m.add("LimitSolverError", py.get_type::<errors::LimitSolverError>())?;
     m.add_class::<laws::PyCoulombSlip>()?;
     m.add_class::<laws::PyLinearElastic>()?;
+    m.add_class::<laws::PyMortarJoint>()?;
     m.add_class::<blocks::PyBlock>()?;
     m.add_class::<model::PyModel>()?;
     m.add_class::<series::PySeries>()?;

@@ -2,7 +2,7 @@
 
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PySequence};
-use voussoir::analysis::limit::{FrictionModel, LimitOptions, LimitProblem, LimitResult, LiveLoad};
+use voussoir::analysis::limit::{FrictionModel, LimitAnswer, LimitOptions, LimitProblem, LiveLoad};
 use voussoir::math::Vector;
 
 use crate::convert::{array1, array_n3, vec3, vector, Int};
@@ -21,24 +21,44 @@ use crate::model::PyModel;
 ///
 /// ``live_loads``: a list of ``{"block": i, "point": (x, y, z), "force": (fx, fy, fz)}`` (or
 /// ``(block, point, force)`` tuples): the force ``multiplier * force`` on ``block`` at ``point``
-/// (world, m; N per unit multiplier: with a unit force the multiplier is in newtons).
+/// (world, m; N per unit multiplier: with a unit force the multiplier is in newtons). An empty
+/// list, or live loads whose forces are all zero, asks the dead-load question alone
+/// (``voussoir.carries_dead_load``): whether the dead loads are carried, an answer either way
+/// (``multiplier`` None, ``carries_dead_load`` True or False), not an error.
 /// ``fixity``: ``{block: fixity}`` overrides for the analysis (as ``Model.add_cuboid`` takes
 /// them), e.g. a loading plate left free. ``friction``: ``"cone"`` (exact) or ``"pyramid"``
 /// (``facets`` planes inscribed, a linear programme, a lower bound by at most
 /// ``1 - cos(pi / facets)``). ``check_dead_load``: also check that the dead loads alone are
-/// carried (a second solve); a structure that stands only when pushed raises ``VoussoirError``.
+/// carried (a second solve); a structure that stands only when pushed raises
+/// ``LimitInfeasibleError``.
 /// ``joints``: joints to classify in the mechanism, as ``classify_joints`` takes them (e.g.
 /// ``voussoir.build.arch_joints()``); a joint hinges or slides where its relative motion at
 /// collapse exceeds ``mechanism_tolerance`` of the largest.
 ///
+/// Raises, with a live load, ``LimitInfeasibleError`` when the dead loads are not carried
+/// (the structure cannot carry its own weight, or only with the live load's help),
+/// ``LimitUnboundedError`` when the multiplier has no bound (the live load goes straight into
+/// the supports, or wedges blocks that friction locks), ``LimitSolverError`` when the solver
+/// stops without an answer (e.g. at ``max_iterations``): subclasses of ``VoussoirError``, with
+/// the library's messages; ``VoussoirError`` for bad input.
+///
 /// Returns a dict:
 ///
-/// - ``multiplier``: the collapse multiplier; ``status``, ``iterations``: the solver's;
-///   ``carries_dead_load``: True when checked, None otherwise;
+/// - ``multiplier``: the collapse multiplier (None for the dead-load question); ``status``,
+///   ``iterations``: the solver's (``"Solved"`` or ``"AlmostSolved"``; for a dead load not
+///   carried ``"PrimalInfeasible"`` or ``"AlmostPrimalInfeasible"``); ``carries_dead_load``:
+///   True when checked (always with a live load unless ``check_dead_load=False``, then None),
+///   the answer for the dead-load question; ``reason``: why a dead load is not carried (naming
+///   the blocks that fall), None otherwise;
 /// - ``blocks``: ``centroid``, ``velocity``, ``angular_velocity`` (n × 3 arrays): each block's
 ///   motion in the mechanism, scaled so that the live loads' power is the sum of their
-///   forces' magnitudes;
-/// - ``contacts``: a list, one dict per contact at collapse: ``blocks`` (a, b), ``normal``
+///   forces' magnitudes; for a dead load not carried, the solver's certificate (a motion on
+///   which the dead loads do work: which blocks fall and which way, a blend where several
+///   mechanisms exist), scaled so that the dead loads' power is the free blocks' weight; zero
+///   for a dead load carried;
+/// - ``contacts``: a list, one dict per contact at collapse (for the dead-load question, of the
+///   admissible state that carries it, or with zero forces when it is not carried):
+///   ``blocks`` (a, b), ``normal``
 ///   (a to b), ``points`` (the polygon's corners, m × 3), ``normal_force`` (m, N, compression
 ///   positive), ``shear_force`` (m × 3, on b), ``opening`` and ``sliding`` (m: the mechanism's
 ///   relative motion at each corner), ``resultant`` (the force on b) and
@@ -48,7 +68,8 @@ use crate::model::PyModel;
 /// - with ``joints``: ``joints``, one dict per joint (``joint``, ``opening_intrados``,
 ///   ``opening_extrados``, ``sliding``: the mechanism's rates; ``hinge``: None,
 ///   ``"intrados"`` or ``"extrados"``; ``is_sliding``), and ``mechanism``, e.g.
-///   ``"hinges 4e 8i; sliding 13"``.
+///   ``"hinges 4e 8i; sliding 13"`` (both None for the dead-load question: it has no collapse
+///   mechanism to read).
 ///
 /// >>> import voussoir as vs
 /// >>> m = vs.Model()
@@ -60,6 +81,11 @@ use crate::model::PyModel;
 /// >>> r = vs.limit(m, [{"block": block, "point": (0.2, 0.15, 0.1), "force": (1, 0, 0)}])
 /// >>> round(r["multiplier"] / (2600 * 0.024 * 9.81), 4)  # slides: tan 30°
 /// 0.5774
+/// >>> d = vs.limit(m, [])  # the dead load alone: carried, the base holds the block up
+/// >>> d["multiplier"] is None, d["carries_dead_load"]
+/// (True, True)
+/// >>> round(float(d["contacts"][0]["resultant"][2]) / (2600 * 0.024 * 9.81), 9)
+/// 1.0
 #[pyfunction]
 #[pyo3(signature = (model, live_loads, *, fixity=None, friction="cone", facets=16, check_dead_load=true, max_iterations=200, joints=None, mechanism_tolerance=1e-3))]
 #[allow(clippy::too_many_arguments)]
@@ -106,9 +132,14 @@ pub fn limit<'py>(
         (problem, live_loads_of(live_loads, count)?, refs)
     };
     // The model is free again; the solve lets the GIL go.
-    let result = py.detach(|| problem.solve(&live, &options)).py()?;
-    let d = result_to_py(py, &result, check_dead_load.then_some(true))?;
+    let answer = py.detach(|| problem.analyse(&live, &options)).py()?;
+    let d = result_to_py(py, &answer, check_dead_load)?;
     if let Some(refs) = refs {
+        let LimitAnswer::Collapse(result) = &answer else {
+            d.set_item("joints", py.None())?;
+            d.set_item("mechanism", py.None())?;
+            return crate::convert::result(py, "LimitResult", d);
+        };
         let (motions, mechanism) = {
             let this = model.lock(py);
             result.classify(&this.model, &refs, mechanism_tolerance)
@@ -174,27 +205,29 @@ fn live_loads_of(obj: &Bound<'_, PyAny>, count: usize) -> PyResult<Vec<LiveLoad>
     Ok(live)
 }
 
-/// A [`LimitResult`] as Python data (see [`limit`]).
-fn result_to_py<'py>(
-    py: Python<'py>,
-    r: &LimitResult,
-    carries_dead_load: Option<bool>,
-) -> PyResult<Bound<'py, PyDict>> {
+/// A [`LimitAnswer`] as Python data (see [`limit`]); `checked`: whether a collapse answer
+/// checked the dead loads.
+fn result_to_py<'py>(py: Python<'py>, r: &LimitAnswer, checked: bool) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    d.set_item("multiplier", r.multiplier)?;
-    d.set_item("status", &r.status)?;
-    d.set_item("iterations", r.iterations)?;
+    let (carries_dead_load, reason) = match r {
+        LimitAnswer::Collapse(_) => (checked.then_some(true), None),
+        LimitAnswer::DeadLoad(dead) => (Some(dead.carried), dead.reason.as_deref()),
+    };
+    d.set_item("multiplier", r.multiplier())?;
+    d.set_item("status", r.status())?;
+    d.set_item("iterations", r.iterations())?;
     d.set_item("carries_dead_load", carries_dead_load)?;
+    d.set_item("reason", reason)?;
     let blocks = PyDict::new(py);
-    blocks.set_item("centroid", array_n3(py, r.blocks.iter().map(|b| b.centroid)))?;
-    blocks.set_item("velocity", array_n3(py, r.blocks.iter().map(|b| b.velocity)))?;
+    blocks.set_item("centroid", array_n3(py, r.blocks().iter().map(|b| b.centroid)))?;
+    blocks.set_item("velocity", array_n3(py, r.blocks().iter().map(|b| b.velocity)))?;
     blocks.set_item(
         "angular_velocity",
-        array_n3(py, r.blocks.iter().map(|b| b.angular_velocity)),
+        array_n3(py, r.blocks().iter().map(|b| b.angular_velocity)),
     )?;
     d.set_item("blocks", blocks)?;
     let contacts = PyList::empty(py);
-    for c in &r.contacts {
+    for c in r.contacts() {
         let e = PyDict::new(py);
         e.set_item("blocks", (c.blocks.0 .0, c.blocks.1 .0))?;
         e.set_item("normal", vector(py, c.normal))?;

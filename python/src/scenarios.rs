@@ -16,6 +16,7 @@ use voussoir_arch::scenarios::arch_impact::{
     self as impact, ImpactCase, ImpactResult, ImpactSample, ImpactorBase, ImpactorGuide, Release,
 };
 use voussoir_arch::scenarios::arch_static::{self as statics, ServoLoading, StaticCase, StaticResult};
+use voussoir_arch::scenarios::impact_summary::ImpactSummary;
 
 use crate::convert::json_to_py;
 use crate::errors::{bad, OrPy};
@@ -179,89 +180,22 @@ pub fn arch_static<'py>(
 }
 
 fn release_of(s: &str) -> PyResult<Release> {
-    match s.to_ascii_lowercase().as_str() {
-        "above" => Ok(Release::JustAbove),
-        "full" => Ok(Release::FullHeight),
-        other => Err(bad(format!("release {other:?}: expected \"above\" or \"full\""))),
-    }
+    s.parse().map_err(bad)
 }
 
-fn impact_summary(label: &str, kind: &str, runs: &[ImpactResult]) -> Value {
-    let r = &runs[0];
-    let c = &r.case;
-    let s = &c.setup;
-    let spread = |f: &dyn Fn(&ImpactResult) -> f64| {
-        let v: Vec<f64> = runs.iter().map(f).collect();
-        [
-            v.iter().copied().fold(f64::INFINITY, f64::min),
-            v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        ]
+fn impact_summary(label: &str, kind: &str, runs: &[ImpactResult]) -> PyResult<Value> {
+    let Some(r) = runs.first() else {
+        return Err(bad(
+            "offsets_mm: at least one drop-height offset (0 for the test's own height)",
+        ));
     };
-    let last = r.samples.last().copied();
-    let e = |f: fn(&ImpactSample) -> f64| last.map_or(0.0, |x| f(&x));
+    let refs: Vec<&ImpactResult> = runs.iter().collect();
+    // The summary the command line writes to summary.json, built once (`ImpactSummary`).
+    let mut summary = serde_json::to_value(ImpactSummary::of(label, kind, r, &refs))
+        .map_err(|e| bad(format!("impact summary: {e}")))?;
     let column = |f: fn(&ImpactSample) -> f64| r.samples.iter().map(f).collect::<Vec<_>>();
-    json!({
-        "name": s.name,
-        "label": label,
-        "kind": kind,
-        "guide": c.guide,
-        "base": c.base,
-        "release": c.release,
-        "mass_kg": s.mass,
-        "height_m": c.drop_height(),
-        "v0_m_per_s": r.v0,
-        "contact_speed_m_per_s": r.contact_speed,
-        "impact_energy_j": r.kinetic_energy,
-        "kn_pa_per_m": c.kn,
-        "damping_ratio": c.damping_ratio,
-        "width_m": c.width,
-        "first_peak_disp_m": r.first_peak_disp,
-        "max_disp_m": r.max_disp,
-        "spread_max_disp_m": spread(&|r| r.max_disp),
-        "spread_first_peak_disp_m": spread(&|r| r.first_peak_disp),
-        "max_rise_m": r.max_rise,
-        "max_rise_time_s": r.max_rise_time,
-        "max_velocity_m_per_s": r.max_velocity,
-        "max_accel_m_per_s2": r.max_accel,
-        "max_impact_force_n": r.max_impact_force,
-        "max_impactor_drift_m": r.max_impactor_drift,
-        "max_impactor_rotation_rad": r.max_impactor_rotation,
-        "collapsed": r.collapsed,
-        "collapsed_runs": runs.iter().filter(|r| r.collapsed).count(),
-        "runs_count": runs.len(),
-        "collapse_time_s": r.collapse_time,
-        "energy": {
-            "input_j": e(|x| x.input),
-            "kinetic_j": e(|x| x.kinetic),
-            "elastic_j": e(|x| x.elastic),
-            "friction_j": e(|x| x.friction),
-            "damping_j": e(|x| x.damping),
-            "gravity_work_j": e(|x| x.gravity_work),
-            "final_excess_j": r.final_energy_excess,
-            "max_excess_j": r.max_energy_excess,
-            "max_abs_error_j": r.max_energy_error,
-        },
-        "steps": r.steps,
-        "dt_s": r.dt,
-        "wall_s": r.wall_s,
-        "runs": runs.iter().map(|x| json!({
-            "height_offset_m": x.case.height_offset,
-            "first_peak_disp_m": x.first_peak_disp,
-            "max_disp_m": x.max_disp,
-            "max_velocity_m_per_s": x.max_velocity,
-            "collapsed": x.collapsed,
-            "max_energy_excess_j": x.max_energy_excess,
-            "max_energy_error_j": x.max_energy_error,
-            "wall_s": x.wall_s,
-        })).collect::<Vec<_>>(),
-        "experiment": {
-            "collapsed": s.collapsed,
-            "max_disp_m": s.max_disp,
-            "max_velocity_m_per_s": s.max_velocity,
-            "max_accel_m_per_s2": s.max_accel,
-        },
-        // Not in summary.json: the central run's history_<setup>.csv, SI units.
-        "history": {
+    // Not in summary.json: the central run's history_<setup>.csv, SI units.
+    let history = json!({
             "time_s": column(|x| x.time),
             "disp_m": column(|x| x.disp),
             "velocity_m_per_s": column(|x| x.velocity),
@@ -279,8 +213,11 @@ fn impact_summary(label: &str, kind: &str, runs: &[ImpactResult]) -> Value {
             "gravity_work_j": column(|x| x.gravity_work),
             "input_j": column(|x| x.input),
             "accounted_j": column(|x| x.accounted),
-        },
-    })
+    });
+    if let Value::Object(map) = &mut summary {
+        map.insert("history".into(), history);
+    }
+    Ok(summary)
 }
 
 /// One drop-weight impact test of the reference arch (Pulatsu, Gonen & Lourenço 2021), as
@@ -331,16 +268,8 @@ pub fn arch_impact<'py>(
     c.duration = duration;
     c.friction_deg = friction_deg;
     c.per_edge = per_edge;
-    c.guide = match guide.to_ascii_lowercase().as_str() {
-        "frame" => ImpactorGuide::Frame,
-        "seat" => ImpactorGuide::SeatConstrained,
-        other => return Err(bad(format!("guide {other:?}: expected \"frame\" or \"seat\""))),
-    };
-    c.base = match base.to_ascii_lowercase().as_str() {
-        "sloped" => ImpactorBase::Sloped,
-        "flat" => ImpactorBase::Flat,
-        other => return Err(bad(format!("base {other:?}: expected \"sloped\" or \"flat\""))),
-    };
+    c.guide = guide.parse::<ImpactorGuide>().map_err(bad)?;
+    c.base = base.parse::<ImpactorBase>().map_err(bad)?;
     c.release = release_of(release)?;
     let mut offsets: Vec<f64> = offsets_mm.iter().map(|mm| mm * 1e-3).collect();
     offsets.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
@@ -360,7 +289,7 @@ pub fn arch_impact<'py>(
             .map(|case| impact::run(case, Some(IMPACT_CHECK_TIME), check))
             .collect::<voussoir::Result<Vec<_>>>()
     })?;
-    json_to_py(py, &impact_summary(setup, "main", &runs))
+    json_to_py(py, &impact_summary(setup, "main", &runs)?)
 }
 
 /// The six impact tests with what was observed (name, mass, height, collapsed, max_disp,

@@ -108,3 +108,104 @@ def test_the_docstring_examples_run():
                 runner.run(test)
     assert tested >= 2
     assert runner.failures == 0, runner.summarize()
+
+
+def on_incline(psi_deg):
+    """The block of ``block_on_base`` on a slope of ``psi_deg`` (gravity tilted: down-slope is
+    +x), stepped once."""
+    psi = math.radians(psi_deg)
+    m = block_on_base(gravity=(9.81 * math.sin(psi), 0.0, -9.81 * math.cos(psi)))
+    m.run_steps(1)
+    return m
+
+
+@pytest.mark.parametrize("psi_deg", [0.0, 20.0, 30.0])
+def test_the_dead_load_alone_is_carried_below_the_friction_angle(psi_deg):
+    """No live load: the dead-load question. On a slope shallower than φ = 30.5° the block
+    stands (it would tip only at tan ψ = 2): carries_dead_load True, no multiplier, and the
+    contact forces of an admissible state that balance its weight (to round-off: 1e-14 W
+    measured) with compression only and shear within μ n."""
+    m = on_incline(psi_deg)
+    r = vs.limit(m, [])
+    assert r["multiplier"] is None and r["carries_dead_load"] is True and r["reason"] is None
+    assert r["status"] in ("Solved", "AlmostSolved")
+    (c,) = r["contacts"]
+    weight = m.block(1).mass * np.asarray(m.gravity)
+    assert np.abs(c["resultant"] + weight).max() < 1e-10 * WEIGHT
+    assert (c["normal_force"] >= -1e-10 * WEIGHT).all()
+    assert (np.linalg.norm(c["shear_force"], axis=1) <= MU * c["normal_force"] + 1e-10 * WEIGHT).all()
+    # The moment too: about the block's centroid the corner forces balance (gravity acts there).
+    corners = c["normal_force"][:, None] * c["normal"] + c["shear_force"]
+    moment = np.cross(c["points"] - m.positions()[1], corners).sum(axis=0)
+    assert np.abs(moment).max() < 1e-10 * WEIGHT
+    # No mechanism; joints are not classified.
+    assert not r["blocks"]["velocity"].any() and not r["blocks"]["angular_velocity"].any()
+    assert vs.limit(m, [], joints=[{"blocks": (0, 1), "intrados": (0, 0.15, 0), "extrados": (0.4, 0.15, 0)}])["mechanism"] is None
+    # The same answer from live loads of zero force, and from carries_dead_load.
+    zero = vs.limit(m, [(1, (0.2, 0.15, 0.1), (0.0, 0.0, 0.0))])
+    assert zero["multiplier"] is None and zero["carries_dead_load"] is True
+    assert vs.carries_dead_load(m) is True
+    assert vs.carries_dead_load(m, friction="pyramid", facets=8) is (psi_deg < 29.0)
+
+
+def test_the_dead_load_not_carried_is_an_answer():
+    """Steeper than φ the block slides: carries_dead_load False, not an error, with the
+    solver's status and a reason naming the block; no forces; the certificate moves the block
+    down the slope, its joint opening by at least tan φ of its slip (associative)."""
+    m = on_incline(32.0)
+    r = vs.limit(m, [])
+    assert r["multiplier"] is None and r["carries_dead_load"] is False
+    assert r["status"] in ("PrimalInfeasible", "AlmostPrimalInfeasible")
+    assert 'block #1 ("block") moves' in r["reason"]
+    (c,) = r["contacts"]
+    assert not c["normal_force"].any() and c["application_point"] is None
+    v = r["blocks"]["velocity"][1]
+    assert v[0] > 0 and np.allclose(r["blocks"]["velocity"][0], 0)
+    scale = np.hypot(c["opening"], c["sliding"]).max()
+    assert (c["opening"] >= MU * c["sliding"] - 1e-6 * scale).all()
+    # The dead load's power is the weight.
+    assert m.block(1).mass * float(np.dot(m.gravity, v)) == pytest.approx(WEIGHT, rel=1e-6)
+    assert vs.carries_dead_load(m) is False
+    # With a live load the question is the collapse load, and an arch of blocks that cannot
+    # stand raises (below).
+    with pytest.raises(vs.LimitInfeasibleError, match="cannot carry its own weight"):
+        vs.limit(m, [(1, (0.2, 0.15, 0.1), (0.0, 1.0, 0.0))])
+
+
+def test_limit_errors_have_their_own_classes(stepped):
+    """Infeasible, unbounded and solver failures are subclasses of VoussoirError (and so of
+    ValueError): callers catch them by class, not by message; VoussoirError still catches them."""
+    for cls in (vs.LimitInfeasibleError, vs.LimitUnboundedError, vs.LimitSolverError):
+        assert issubclass(cls, vs.VoussoirError) and issubclass(cls, ValueError)
+        assert cls.__module__ == "voussoir" and cls.__doc__
+    # A slab overhanging its support by three quarters: it cannot stand; pushed, that raises.
+    m = vs.Model()
+    m.set_joint_law(0, 0, vs.CoulombSlip.dry(4e9, 1.6e9, 30.0))
+    m.add_cuboid("base", (-1, -1, -0.2), (0, 1, 0), 2600.0, fixed=True)
+    m.add_cuboid("slab", (-0.1, 0, 0), (0.3, 0.2, 0.1), 2600.0)
+    m.run_steps(1)
+    with pytest.raises(vs.LimitInfeasibleError, match="cannot carry its own weight") as caught:
+        vs.limit(m, [(1, (0.1, 0.1, 0.05), (-1.0, 0.0, 0.0))])
+    assert isinstance(caught.value, vs.VoussoirError)
+    # Lifted at its tip it stands only with the live load's help: refused when checked.
+    lift = [(1, (0.3, 0.1, 0.1), (0.0, 0.0, 1.0))]
+    with pytest.raises(vs.LimitInfeasibleError, match="dead loads alone are not carried"):
+        vs.limit(m, lift)
+    weight = 2600.0 * 0.008 * 9.81
+    assert vs.limit(m, lift, check_dead_load=False)["multiplier"] == pytest.approx(0.5 * weight, rel=1e-6)
+    dead = vs.limit(m, [])
+    assert dead["carries_dead_load"] is False and 'block #1 ("slab") moves' in dead["reason"]
+    # It tips about the support's edge x = 0: its far end falls.
+    assert dead["blocks"]["angular_velocity"][1][1] > 0
+    # A live load on the support: unbounded.
+    with pytest.raises(vs.LimitUnboundedError, match="unbounded"):
+        vs.limit(stepped, [(0, (0, 0, 0), (1, 0, 0))])
+    # The solver stopped at its iteration limit.
+    with pytest.raises(vs.LimitSolverError, match="MaxIterations"):
+        vs.limit(stepped, [(1, (0.2, 0.15, 0.1), (1, 0, 0))], max_iterations=1)
+    with pytest.raises(vs.LimitSolverError):
+        vs.carries_dead_load(stepped, max_iterations=1)
+    # Bad input is still a plain VoussoirError.
+    with pytest.raises(vs.VoussoirError) as bad:
+        vs.limit(stepped, [(1, (0, 0, 0), (1, 0, 0))], friction="pyramid", facets=2)
+    assert not isinstance(bad.value, (vs.LimitInfeasibleError, vs.LimitUnboundedError, vs.LimitSolverError))

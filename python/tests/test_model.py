@@ -631,3 +631,30 @@ def test_a_turned_slab_spins_up_as_its_inertia_tensor_says():
     m.run_steps(4)
     expected = np.linalg.solve(inertia, moment * m.time)
     assert np.allclose(m.angular_velocities()[slab], expected, rtol=1e-6, atol=0)
+
+
+def test_constructor_defaults_come_from_the_library_and_the_stub_agrees():
+    """``Model``'s defaults are the library's ``ModelParameters::default()`` (written once, in
+    Rust); the stub, which shows them to editors, says the same (issue 46)."""
+    import ast
+    import pathlib
+
+    d = vs.Model.defaults()
+    assert d["subcontacts_per_edge"] == 15 and d["contact_tolerance"] == 1e-3
+    assert d["safety"] == 0.5 and d["max_speed"] == 1000.0 and d["impact_step"] == 0.1
+    assert d["mode"] == "large" and tuple(d["gravity"]) == (0.0, 0.0, -9.81)
+    stub = pathlib.Path(vs.__file__).with_name("_voussoir.pyi")
+    tree = ast.parse(stub.read_text())
+    model = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Model")
+    init = next(n for n in model.body if isinstance(n, ast.FunctionDef) and n.name == "__init__")
+    stubbed = {
+        a.arg: ast.literal_eval(v)
+        for a, v in zip(init.args.kwonlyargs, init.args.kw_defaults)
+        if v is not None and a.arg in d and a.arg != "gravity"
+    }
+    assert stubbed == {k: v for k, v in d.items() if k != "gravity"}, stubbed
+    # A model built with the defaults is one built with them spelt out, and with other values
+    # it is not (the scene holds the parameters).
+    spelt = {k: v for k, v in d.items() if k != "mode"}
+    assert vs.Model().to_scene_json() == vs.Model(**spelt).to_scene_json()
+    assert vs.Model().to_scene_json() != vs.Model(contact_tolerance=2e-3).to_scene_json()

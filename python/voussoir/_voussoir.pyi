@@ -22,6 +22,16 @@ class VoussoirError(ValueError):
     """Bad input (block indices out of range name the argument), divergence, no convergence,
     a corrupt scene or checkpoint. Sizes beyond the library's limits raise MemoryError."""
 
+class LimitInfeasibleError(VoussoirError):
+    """Limit analysis with a live load: the dead loads are not carried (the dead-load question
+    alone answers False instead of raising)."""
+
+class LimitUnboundedError(VoussoirError):
+    """Limit analysis: the live load's multiplier has no upper bound."""
+
+class LimitSolverError(VoussoirError):
+    """Limit analysis: the conic solver stopped without an answer or a certificate."""
+
 class VoussoirIOError(OSError):
     """Reading or writing a file failed."""
 
@@ -50,6 +60,47 @@ class CoulombSlip:
     @property
     def tensile_strength(self) -> float: ...
 
+class MortarJoint:
+    """A mortared joint that cracks in tension and shear and softens by its fracture energies
+    (J/m²) per unit area, whatever the sub-contact count; each fracture energy is required with
+    its strength (0: brittle). The fracture energy consumed is ``Model.energies()["fracture"]``."""
+    def __init__(
+        self,
+        kn: float,
+        ks: float,
+        friction_deg: float,
+        residual_friction_deg: Optional[float] = None,
+        tensile_strength: float = 0.0,
+        mode_i_fracture_energy: Optional[float] = None,
+        cohesion: float = 0.0,
+        mode_ii_fracture_energy: Optional[float] = None,
+        dilatancy_deg: float = 0.0,
+        softening: Literal["exponential", "linear"] = "exponential",
+        compressive_strength: Optional[float] = None,
+    ) -> None: ...
+    @property
+    def kn(self) -> float: ...
+    @property
+    def ks(self) -> float: ...
+    @property
+    def friction_deg(self) -> float: ...
+    @property
+    def residual_friction_deg(self) -> float: ...
+    @property
+    def dilatancy_deg(self) -> float: ...
+    @property
+    def tensile_strength(self) -> float: ...
+    @property
+    def mode_i_fracture_energy(self) -> float: ...
+    @property
+    def cohesion(self) -> float: ...
+    @property
+    def mode_ii_fracture_energy(self) -> float: ...
+    @property
+    def softening(self) -> Literal["exponential", "linear"]: ...
+    @property
+    def compressive_strength(self) -> Optional[float]: ...
+
 class LinearElastic:
     def __init__(self, kn: float, ks: float) -> None: ...
     @property
@@ -57,7 +108,7 @@ class LinearElastic:
     @property
     def ks(self) -> float: ...
 
-JointLaw = Union[CoulombSlip, LinearElastic]
+JointLaw = Union[CoulombSlip, MortarJoint, LinearElastic]
 
 class Block:
     @staticmethod
@@ -123,6 +174,9 @@ class Model:
         max_speed: float = 1000.0,
         impact_step: Optional[float] = 0.1,
     ) -> None: ...
+    # The constructor's defaults above, as the library has them (the stub's are checked against it).
+    @staticmethod
+    def defaults() -> Dict[str, Any]: ...
     # building
     def set_joint_law(self, a: int, b: int, law: JointLaw) -> None: ...
     def joint_law(self, a: int, b: int) -> Optional[JointLaw]: ...
@@ -258,6 +312,8 @@ class Model:
     def angular_velocities(self) -> FloatArray: ...
     def contacts(self) -> Dict[str, Any]: ...
     def subcontacts(self) -> Dict[str, Any]: ...
+    # kinetic, initial_kinetic, elastic, gravity_work, load_work, boundary_work, friction,
+    # fracture, damping, joint_work, input, accounted, balance_error (J).
     def energies(self) -> Dict[str, float]: ...
     def reaction(self, block: int) -> Dict[str, FloatArray]: ...
     def contact_wrench(self, block: int) -> Dict[str, FloatArray]: ...
@@ -521,13 +577,21 @@ def limit(
     ``multiplier * force`` at ``point``) for the model's rigid blocks as they stand, no-tension
     Coulomb joints, by limit analysis (a second-order cone programme); the model must have been
     stepped once. Returns ``multiplier``, ``status``, ``iterations``, ``carries_dead_load``,
-    ``blocks`` (``centroid``, ``velocity``, ``angular_velocity``: the mechanism) and
+    ``reason``, ``blocks`` (``centroid``, ``velocity``, ``angular_velocity``: the mechanism) and
     ``contacts`` (per contact: ``blocks``, ``normal``, ``points``, ``normal_force``,
     ``shear_force``, ``opening``, ``sliding``, ``resultant``, ``application_point``); with
     ``joints`` (as ``classify_joints`` takes them) also ``joints`` (per joint: opening rates,
-    sliding, ``hinge``, ``is_sliding``) and ``mechanism`` (e.g. ``"hinges 4e 8i"``)."""
-    ...
+    sliding, ``hinge``, ``is_sliding``) and ``mechanism`` (e.g. ``"hinges 4e 8i"``).
 
+    No live load (``[]``, or forces all zero): the dead-load question alone, an answer either
+    way: ``multiplier`` None, ``carries_dead_load`` True (``contacts`` with the forces of an
+    admissible state) or False (``status`` ``"PrimalInfeasible"``, ``reason``, ``blocks`` the
+    solver's certificate: which blocks fall; zero forces); ``joints``/``mechanism`` None.
+
+    With a live load raises ``voussoir.LimitInfeasibleError`` (dead load not carried),
+    ``voussoir.LimitUnboundedError`` (no bound), ``voussoir.LimitSolverError`` (no answer):
+    subclasses of ``VoussoirError``."""
+    ...
 
 def classify_joints(
     model: Model,

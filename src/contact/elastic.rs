@@ -4,11 +4,10 @@
 //! `docs/theory.md` ("Sub-contact kinematics", "Exact integration over the cells").
 
 use super::closed_lanes::{closed_groups, ClosedJoint, LaneBuild};
-use super::kernel::{tension_free, CellRule, ExactCells};
 use super::lanes::{face_gap, increment, Kinematics, LaneSums, LANES};
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::ForceMoments;
-use super::spread::{cell_response, CellResponse};
+use super::spread::{cell_response, tension_free, CellResponse, CellRule, ExactCells};
 use super::{CellSummary, SubContact};
 use crate::law::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
 use crate::math::{Real, Vector2};
@@ -19,8 +18,8 @@ use crate::math::{Real, Vector2};
 /// it); the others (open, failed, sliding in a regime that does not) go through the law exactly
 /// as in the one-at-a-time loop. `face` holds the gap
 /// coefficients (large displacements), `None` for gaps carried incrementally. Returns the
-/// spring-force sums in the joint axes, taken in sub-contact order, and the energy the law
-/// dissipated.
+/// spring-force sums in the joint axes, taken in sub-contact order, the energy the law
+/// dissipated (fracture work apart), the spread energy and the fracture work.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
@@ -34,10 +33,11 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
     axes: JointAxes,
     dt: Real,
     lanes: LaneBuild,
-) -> (ForceMoments, Real, Real) {
+) -> (ForceMoments, Real, Real, Real) {
     let virgin = L::State::default();
     let mut sums = ForceMoments::default();
     let mut dissipated = 0.0;
+    let mut fracture = 0.0;
     let mut spread_energy = 0.0;
     // `Σ J_xx`, `Σ J_yy` of the all-closed cells in the elastic regime, for their spread energy.
     let mut closed_moments = Vector2::ZERO;
@@ -154,7 +154,9 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
             sub.gap = gap;
             continue;
         }
-        dissipated += update_with_law(law, sub, gap, du_n, du_s, axes, dt).1;
+        let (_, lost, consumed) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        dissipated += lost;
+        fracture += consumed;
         let response = match (cell, exact) {
             (Cell::Closed(anchor_gap, half), Some(e)) => cell_response(anchor_gap, e.slope, half, sub.area),
             (Cell::Closed(anchor_gap, _), None) => CellResponse::at_anchor(anchor_gap),
@@ -171,7 +173,7 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
             * e.normal_stiffness
             * (closed_moments.x * e.slope.x * e.slope.x + closed_moments.y * e.slope.y * e.slope.y);
     }
-    (sums, dissipated, spread_energy)
+    (sums, dissipated, spread_energy, fracture)
 }
 
 /// Whether `sub` is an open, unloaded `virgin` cell that the law keeps open all over (the
@@ -375,6 +377,7 @@ mod tests {
                         coulomb: CoulombState {
                             failed: failed.contains(&k),
                         },
+                        ..AnyState::default()
                     },
                 })
                 .collect()

@@ -6,7 +6,7 @@ use super::elastic::{update_elastic_first, WholeContact};
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
-use super::spread::{cell_response, CellResponse};
+use super::spread::{CellResponse, CellRule, ExactCells};
 use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
@@ -19,8 +19,12 @@ pub(crate) struct ContactStep {
     pub wrench: ContactWrench,
     /// Work done on the joint springs (J), trapezoidal rule.
     pub work: Real,
-    /// Energy the law dissipated at the sub-contacts that slid or changed state (J).
+    /// Energy the law dissipated at the sub-contacts that slid or changed state (J), its
+    /// fracture work apart.
     pub dissipated: Real,
+    /// The law's fracture work at the sub-contacts that changed state (J,
+    /// [`ConstitutiveLaw::fracture_work`]).
+    pub fracture: Real,
     /// Work of the dashpot forces (J, negative: dissipated).
     pub dashpot_work: Real,
     /// Whether a sub-contact is about to close or open fast (see [`KernelContext::impact_speed`]).
@@ -164,10 +168,11 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // are dashpots) one at a time, continuing the sums of the groups.
     let mut done = 0;
     let mut dissipated = 0.0;
+    let mut fracture = 0.0;
     let elastic_regime = if dashpots { None } else { law.elastic_regime() };
     if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
-        (sums, dissipated, spread_energy) = match face_gap_coefficients {
+        (sums, dissipated, spread_energy, fracture) = match face_gap_coefficients {
             Some(g) => {
                 let whole = WholeContact::of(g, &pair.cells);
                 update_elastic_first(
@@ -210,7 +215,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             update_group(group, law, &frame, &mut lanes);
         }
         done = groups.len() * LANES;
-        (sums, dissipated) = lanes.total();
+        (sums, dissipated, fracture) = lanes.total();
     }
     for (sub, record) in subs[done..].iter_mut().zip(records[done..].iter_mut()) {
         let (x, y) = (sub.plane.x, sub.plane.y);
@@ -227,8 +232,9 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         let [du_n, du_1, du_2] = increment(&kinematics, x, y);
         let du_s = Vector2::new(du_1, du_2);
         let gap = face.unwrap_or(sub.gap + du_n);
-        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        let (status, lost, consumed) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
         dissipated += lost;
+        fracture += consumed;
         match cell {
             Some(cell) => exact.add(&mut sums, &mut spread_energy, sub, &cell),
             None => sums.add_joint(&sub.force, sub.plane),
@@ -286,6 +292,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         },
         work: -0.5 * spring_sum,
         dissipated,
+        fracture,
         dashpot_work: -0.5 * dashpot_sum,
         impact,
         busy,
@@ -396,82 +403,6 @@ pub(crate) fn other_face_plane(
     let m = *rotation_other * pair.plane_normal;
     let d = pair.plane_offset + m.dot(x_other);
     (m, m.dot(x_host) - d)
-}
-
-/// How a face-face contact integrates its cells' normal springs (`contact/spread.rs`): exactly
-/// over each cell where the law's normal spring is linear ([`ConstitutiveLaw::elastic_regime`])
-/// and carries no tension in the cell's state ([`ConstitutiveLaw::stays_open`] at the smallest
-/// opening), with the gap geometric (large displacements); at the anchor otherwise.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct ExactCells {
-    /// `k_n` (Pa/m).
-    pub(super) normal_stiffness: Real,
-    /// The gap's slope on the anchor plane, `∂g/∂x`, `∂g/∂y`.
-    pub(super) slope: Vector2,
-    /// Whether a virgin sub-contact carries no tension.
-    pub(super) virgin_without_tension: bool,
-}
-
-impl ExactCells {
-    /// For a contact whose face gap has the coefficients `face` (`None`: not geometric).
-    #[inline(always)]
-    pub(crate) fn of<L: ConstitutiveLaw>(law: &L, face: Option<(Real, Real, Real)>) -> Option<Self> {
-        let (_, gx, gy) = face?;
-        let regime = law.elastic_regime()?;
-        (regime.normal_stiffness > 0.0).then(|| Self {
-            normal_stiffness: regime.normal_stiffness,
-            slope: Vector2::new(-gx, -gy),
-            virgin_without_tension: tension_free(law, &L::State::default()),
-        })
-    }
-}
-
-/// Whether a sub-contact in `state` carries no tension: the law keeps it open at the smallest
-/// opening ([`ConstitutiveLaw::stays_open`]); its cell's normal spring is then integrated
-/// exactly ([`ExactCells`]).
-#[inline]
-pub(crate) fn tension_free<L: ConstitutiveLaw>(law: &L, state: &L::State) -> bool {
-    law.stays_open(1.0, Real::MIN_POSITIVE, state)
-}
-
-/// [`ExactCells`] of a contact, or none.
-pub(crate) trait CellRule {
-    /// The response of `sub`'s cell to the gap `anchor_gap` at its anchor.
-    fn cell<L: ConstitutiveLaw>(&self, law: &L, sub: &SubContact<L::State>, anchor_gap: Real) -> CellResponse;
-    /// Adds `sub`'s spring forces to `sums` (joint axes), its normal force where `cell` puts
-    /// it, and the cell's spread energy to `spread_energy`.
-    fn add<S>(&self, sums: &mut ForceMoments, spread_energy: &mut Real, sub: &SubContact<S>, cell: &CellResponse);
-}
-
-impl CellRule for Option<ExactCells> {
-    #[inline(always)]
-    fn cell<L: ConstitutiveLaw>(&self, law: &L, sub: &SubContact<L::State>, anchor_gap: Real) -> CellResponse {
-        match self {
-            Some(e)
-                if if sub.state == L::State::default() {
-                    e.virgin_without_tension
-                } else {
-                    tension_free(law, &sub.state)
-                } =>
-            {
-                cell_response(anchor_gap, e.slope, sub.half(), sub.area)
-            }
-            _ => CellResponse::at_anchor(anchor_gap),
-        }
-    }
-
-    #[inline(always)]
-    fn add<S>(&self, sums: &mut ForceMoments, spread_energy: &mut Real, sub: &SubContact<S>, cell: &CellResponse) {
-        sums.add_joint(&sub.force, sub.plane);
-        if let Some(e) = self {
-            let normal = sub.force.normal;
-            if normal > 0.0 {
-                sums.per_x.x += normal * cell.offset.x;
-                sums.per_y.x += normal * cell.offset.y;
-                *spread_energy += e.normal_stiffness * cell.excess_energy;
-            }
-        }
-    }
 }
 
 /// The first tangent of `previous` turned into the plane normal to `normal` by the smallest

@@ -131,8 +131,9 @@ pub(crate) struct LaneSums {
     pub(crate) force: [F4; 3],
     pub(crate) per_x: [F4; 3],
     pub(crate) per_y: [F4; 3],
-    /// Energy dissipated by the law, in sub-contact order.
+    /// Energy dissipated by the law, in sub-contact order: fracture work apart.
     dissipated: Real,
+    fracture: Real,
 }
 
 impl LaneSums {
@@ -146,8 +147,8 @@ impl LaneSums {
         }
     }
 
-    /// The lane sums added in lane order, and the dissipated energy.
-    pub fn total(self) -> (ForceMoments, Real) {
+    /// The lane sums added in lane order, the dissipated energy and the fracture work.
+    pub fn total(self) -> (ForceMoments, Real, Real) {
         let v = |s: [F4; 3]| Vector::new(s[0].sum(), s[1].sum(), s[2].sum());
         (
             ForceMoments {
@@ -156,6 +157,7 @@ impl LaneSums {
                 per_y: v(self.per_y),
             },
             self.dissipated,
+            self.fracture,
         )
     }
 }
@@ -184,7 +186,9 @@ pub(crate) fn update_group<L: ConstitutiveLaw>(
             continue;
         }
         let du_s = Vector2::new(du_1.0[l], du_2.0[l]);
-        sums.dissipated += update_with_law(law, sub, gap, du_n.0[l], du_s, frame.axes, frame.dt).1;
+        let (_, lost, fracture) = update_with_law(law, sub, gap, du_n.0[l], du_s, frame.axes, frame.dt);
+        sums.dissipated += lost;
+        sums.fracture += fracture;
     }
     // The forces as the law left them (zero where skipped), read back lane by lane.
     let f = [

@@ -15,9 +15,10 @@ mod view;
 use serde::{Deserialize, Serialize};
 
 pub(crate) use closed_lanes::LaneBuild;
-pub(crate) use kernel::{face_gap_coefficients, tension_free, update_contact, KernelContext};
+pub(crate) use kernel::{face_gap_coefficients, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
 pub(crate) use nodes::{node_frame, stored_node_frame, update_nodes};
+pub(crate) use spread::tension_free;
 pub(crate) use view::{CellGeometry, NodeGeometry, TensionFree};
 pub use view::{Contact, ContactView, SubContactSample, SubContactView};
 

@@ -155,8 +155,9 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
             continue;
         }
         let before = axes.force(&sub.force);
-        let (status, lost) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
+        let (status, lost, fracture) = update_with_law(law, sub, gap, du_n, du_s, axes, dt);
         step.dissipated += lost;
+        step.fracture += fracture;
         let spring = axes.force(&sub.force);
         spring_sum += (before + spring).dot(du);
         normal_force += sub.force.normal;

@@ -18,6 +18,9 @@
 //! cell's area: the same region for the rectangular cells of rectangular faces, the same
 //! area, centroid and principal moments otherwise. The integrals over it are exact.
 
+use super::moments::ForceMoments;
+use super::SubContact;
+use crate::law::ConstitutiveLaw;
 use crate::math::{Real, Vector2};
 
 /// A cell's elastic normal response for the gap `ḡ` at its anchor and the slope `s`.
@@ -160,6 +163,82 @@ fn straddling(gap: Real, slope: Vector2, half: Vector2, area: Real) -> CellRespo
         law_gap: -0.25 * i0,
         offset: offset.clamp(-half, half),
         excess_energy: (0.125 * area * (i2 - 0.25 * i0 * i0)).max(0.0),
+    }
+}
+
+/// How a face-face contact integrates its cells' normal springs (`contact/spread.rs`): exactly
+/// over each cell where the law's normal spring is linear ([`ConstitutiveLaw::elastic_regime`])
+/// and carries no tension in the cell's state ([`ConstitutiveLaw::stays_open`] at the smallest
+/// opening), with the gap geometric (large displacements); at the anchor otherwise.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ExactCells {
+    /// `k_n` (Pa/m).
+    pub(super) normal_stiffness: Real,
+    /// The gap's slope on the anchor plane, `∂g/∂x`, `∂g/∂y`.
+    pub(super) slope: Vector2,
+    /// Whether a virgin sub-contact carries no tension.
+    pub(super) virgin_without_tension: bool,
+}
+
+impl ExactCells {
+    /// For a contact whose face gap has the coefficients `face` (`None`: not geometric).
+    #[inline(always)]
+    pub(crate) fn of<L: ConstitutiveLaw>(law: &L, face: Option<(Real, Real, Real)>) -> Option<Self> {
+        let (_, gx, gy) = face?;
+        let regime = law.elastic_regime()?;
+        (regime.normal_stiffness > 0.0).then(|| Self {
+            normal_stiffness: regime.normal_stiffness,
+            slope: Vector2::new(-gx, -gy),
+            virgin_without_tension: tension_free(law, &L::State::default()),
+        })
+    }
+}
+
+/// Whether a sub-contact in `state` carries no tension: the law keeps it open at the smallest
+/// opening ([`ConstitutiveLaw::stays_open`]); its cell's normal spring is then integrated
+/// exactly ([`ExactCells`]).
+#[inline]
+pub(crate) fn tension_free<L: ConstitutiveLaw>(law: &L, state: &L::State) -> bool {
+    law.stays_open(1.0, Real::MIN_POSITIVE, state)
+}
+
+/// [`ExactCells`] of a contact, or none.
+pub(crate) trait CellRule {
+    /// The response of `sub`'s cell to the gap `anchor_gap` at its anchor.
+    fn cell<L: ConstitutiveLaw>(&self, law: &L, sub: &SubContact<L::State>, anchor_gap: Real) -> CellResponse;
+    /// Adds `sub`'s spring forces to `sums` (joint axes), its normal force where `cell` puts
+    /// it, and the cell's spread energy to `spread_energy`.
+    fn add<S>(&self, sums: &mut ForceMoments, spread_energy: &mut Real, sub: &SubContact<S>, cell: &CellResponse);
+}
+
+impl CellRule for Option<ExactCells> {
+    #[inline(always)]
+    fn cell<L: ConstitutiveLaw>(&self, law: &L, sub: &SubContact<L::State>, anchor_gap: Real) -> CellResponse {
+        match self {
+            Some(e)
+                if if sub.state == L::State::default() {
+                    e.virgin_without_tension
+                } else {
+                    tension_free(law, &sub.state)
+                } =>
+            {
+                cell_response(anchor_gap, e.slope, sub.half(), sub.area)
+            }
+            _ => CellResponse::at_anchor(anchor_gap),
+        }
+    }
+
+    #[inline(always)]
+    fn add<S>(&self, sums: &mut ForceMoments, spread_energy: &mut Real, sub: &SubContact<S>, cell: &CellResponse) {
+        sums.add_joint(&sub.force, sub.plane);
+        if let Some(e) = self {
+            let normal = sub.force.normal;
+            if normal > 0.0 {
+                sums.per_x.x += normal * cell.offset.x;
+                sums.per_y.x += normal * cell.offset.y;
+                *spread_energy += e.normal_stiffness * cell.excess_energy;
+            }
+        }
     }
 }
 

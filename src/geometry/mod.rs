@@ -12,7 +12,9 @@ pub(crate) use narrow_phase::contact_polygon;
 pub(crate) use narrow_phase::nodes::{deepest_two, NodeId};
 pub use narrow_phase::{
     detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact,
-    SubKey, SubcontactDensity, SubcontactSeed, MAX_SUBCONTACTS_PER_EDGE,
+    SubContactDensity, SubContactSeed, SubKey, DEFAULT_SUBCONTACTS_PER_EDGE, MAX_SUBCONTACTS_PER_EDGE,
 };
 pub(crate) use narrow_phase::{face_frame, PARALLEL_ANGLE};
+#[allow(deprecated)]
+pub use narrow_phase::{SubcontactDensity, SubcontactSeed};
 pub use polyhedron::{Face, MassProperties, PlacedPolyhedron, Polyhedron, MAX_HULL_VERTICES};

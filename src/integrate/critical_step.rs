@@ -23,9 +23,12 @@ pub enum TimeStep {
     Fixed(Real),
 }
 
+/// The default safety factor of [`TimeStep::Auto`] ([`TimeStep::default`]).
+pub const DEFAULT_SAFETY: Real = 0.5;
+
 impl Default for TimeStep {
     fn default() -> Self {
-        TimeStep::Auto { safety: 0.5 }
+        TimeStep::Auto { safety: DEFAULT_SAFETY }
     }
 }
 

@@ -3,13 +3,13 @@
 #![doc = include_str!("README.md")]
 
 mod central_difference;
+mod critical_step;
 mod damping;
 mod stability;
-mod critical_step;
 
 pub use central_difference::CentralDifference;
+pub use critical_step::{critical_time_step, CriticalStep, Stiffness6, StiffnessBound, TimeStep, DEFAULT_SAFETY};
 pub use damping::Damping;
-pub use critical_step::{critical_time_step, CriticalStep, Stiffness6, StiffnessBound, TimeStep};
 
 pub(crate) use stability::{block_bound, contact_eigenvalues, AreaMoments, ContactStiffness};
 

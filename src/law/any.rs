@@ -5,14 +5,14 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     ConstitutiveLaw, CoulombSlip, CoulombState, ElasticRegime, JointForce, JointStatus, JointStep, JointStiffness,
-    LinearElastic,
+    LinearElastic, MortarJoint, MortarState,
 };
 use crate::error::Result;
 use crate::math::Real;
 
 /// Any of the laws voussoir ships, so that one model can give different kinds of law to
-/// different pairs of materials: `Model<AnyLaw>`, with [`CoulombSlip`] between stones and
-/// [`LinearElastic`] for an elastic pad, say.
+/// different pairs of materials: `Model<AnyLaw>`, with [`CoulombSlip`] between stones,
+/// [`MortarJoint`] for the mortared joints and [`LinearElastic`] for an elastic pad, say.
 ///
 /// Every method of [`ConstitutiveLaw`] is forwarded to the inner law, the two shortcuts of the
 /// contact kernel included: [`ConstitutiveLaw::elastic_regime`] and
@@ -24,8 +24,8 @@ use crate::math::Real;
 /// The state is [`AnyState`], which holds each law's state side by side.
 ///
 /// In JSON (scenes, checkpoints) a law is written with its variant's name,
-/// `{"Coulomb": {...}}` or `{"Elastic": {...}}`, and the inner law as on its own; a
-/// [`CoulombSlip`] is validated as it is read.
+/// `{"Coulomb": {...}}`, `{"Mortar": {...}}` or `{"Elastic": {...}}`, and the inner law as on
+/// its own; a [`CoulombSlip`] or a [`MortarJoint`] is validated as it is read.
 ///
 /// ```
 /// use voussoir::law::{conformance, AnyLaw};
@@ -65,6 +65,8 @@ use crate::math::Real;
 pub enum AnyLaw {
     /// Coulomb slip with tension cut-off, cohesion and residual friction.
     Coulomb(CoulombSlip),
+    /// A mortared joint whose tension and cohesion soften by their fracture energies.
+    Mortar(MortarJoint),
     /// Linear springs with no strength limit.
     Elastic(LinearElastic),
 }
@@ -78,7 +80,8 @@ pub enum AnyLaw {
 /// law's variant, and a sub-contact of another law would either never be virgin (no fast path) or
 /// have to read a foreign variant as its own. Here there is nothing to map: a sub-contact that
 /// changes law (its pair of materials given another law) keeps a state the new law reads as
-/// it would its own. The struct is `Copy` and as small as the states it holds (one byte today).
+/// it would its own. The struct is `Copy` and as small as the states it holds side by side
+/// (32 bytes: [`MortarState`]'s two lengths and flag, and [`CoulombState`]'s flag).
 ///
 /// ```
 /// use voussoir::law::{AnyLaw, AnyState, ConstitutiveLaw, CoulombSlip};
@@ -96,11 +99,19 @@ pub enum AnyLaw {
 pub struct AnyState {
     /// The state of [`AnyLaw::Coulomb`].
     pub coulomb: CoulombState,
+    /// The state of [`AnyLaw::Mortar`].
+    pub mortar: MortarState,
 }
 
 impl From<CoulombSlip> for AnyLaw {
     fn from(law: CoulombSlip) -> Self {
         AnyLaw::Coulomb(law)
+    }
+}
+
+impl From<MortarJoint> for AnyLaw {
+    fn from(law: MortarJoint) -> Self {
+        AnyLaw::Mortar(law)
     }
 }
 
@@ -117,6 +128,7 @@ impl ConstitutiveLaw for AnyLaw {
     fn stiffness(&self) -> JointStiffness {
         match self {
             AnyLaw::Coulomb(law) => law.stiffness(),
+            AnyLaw::Mortar(law) => law.stiffness(),
             AnyLaw::Elastic(law) => law.stiffness(),
         }
     }
@@ -125,6 +137,7 @@ impl ConstitutiveLaw for AnyLaw {
     fn update(&self, step: &JointStep, force: &mut JointForce, state: &mut AnyState) -> JointStatus {
         match self {
             AnyLaw::Coulomb(law) => law.update(step, force, &mut state.coulomb),
+            AnyLaw::Mortar(law) => law.update(step, force, &mut state.mortar),
             AnyLaw::Elastic(law) => law.update(step, force, &mut ()),
         }
     }
@@ -133,6 +146,7 @@ impl ConstitutiveLaw for AnyLaw {
     fn stays_open(&self, area: Real, normal_displacement: Real, state: &AnyState) -> bool {
         match self {
             AnyLaw::Coulomb(law) => law.stays_open(area, normal_displacement, &state.coulomb),
+            AnyLaw::Mortar(law) => law.stays_open(area, normal_displacement, &state.mortar),
             AnyLaw::Elastic(law) => law.stays_open(area, normal_displacement, &()),
         }
     }
@@ -141,6 +155,7 @@ impl ConstitutiveLaw for AnyLaw {
     fn elastic_regime(&self) -> Option<ElasticRegime> {
         match self {
             AnyLaw::Coulomb(law) => law.elastic_regime(),
+            AnyLaw::Mortar(law) => law.elastic_regime(),
             AnyLaw::Elastic(law) => law.elastic_regime(),
         }
     }
@@ -148,13 +163,24 @@ impl ConstitutiveLaw for AnyLaw {
     fn elastic_energy(&self, area: Real, force: &JointForce, state: &AnyState) -> Real {
         match self {
             AnyLaw::Coulomb(law) => law.elastic_energy(area, force, &state.coulomb),
+            AnyLaw::Mortar(law) => law.elastic_energy(area, force, &state.mortar),
             AnyLaw::Elastic(law) => law.elastic_energy(area, force, &()),
+        }
+    }
+
+    #[inline]
+    fn fracture_work(&self, area: Real, before: &AnyState, after: &AnyState) -> Real {
+        match self {
+            AnyLaw::Coulomb(law) => law.fracture_work(area, &before.coulomb, &after.coulomb),
+            AnyLaw::Mortar(law) => law.fracture_work(area, &before.mortar, &after.mortar),
+            AnyLaw::Elastic(law) => law.fracture_work(area, &(), &()),
         }
     }
 
     fn is_failed(&self, state: &AnyState) -> bool {
         match self {
             AnyLaw::Coulomb(law) => law.is_failed(&state.coulomb),
+            AnyLaw::Mortar(law) => law.is_failed(&state.mortar),
             AnyLaw::Elastic(law) => law.is_failed(&()),
         }
     }
@@ -162,6 +188,7 @@ impl ConstitutiveLaw for AnyLaw {
     fn validate(&self) -> Result<()> {
         match self {
             AnyLaw::Coulomb(law) => law.validate(),
+            AnyLaw::Mortar(law) => law.validate(),
             AnyLaw::Elastic(law) => law.validate(),
         }
     }
@@ -205,7 +232,10 @@ mod tests {
             assert!(any.validate().is_ok());
             for failed in [false, true] {
                 let state = CoulombState { failed };
-                let any_state = AnyState { coulomb: state };
+                let any_state = AnyState {
+                    coulomb: state,
+                    ..AnyState::default()
+                };
                 assert_eq!(any.is_failed(&any_state), inner.is_failed(&state));
                 for &gap in &gaps {
                     assert_eq!(any.stays_open(0.3, gap, &any_state), inner.stays_open(0.3, gap, &state));
@@ -226,7 +256,13 @@ mod tests {
                         let (mut g, mut t) = (start, any_state);
                         assert_eq!(any.update(&step, &mut g, &mut t), inner.update(&step, &mut f, &mut s));
                         assert_eq!(bits(&g), bits(&f));
-                        assert_eq!(t, AnyState { coulomb: s });
+                        assert_eq!(
+                            t,
+                            AnyState {
+                                coulomb: s,
+                                ..AnyState::default()
+                            }
+                        );
                         assert_eq!(
                             any.elastic_energy(0.3, &g, &t).to_bits(),
                             inner.elastic_energy(0.3, &f, &s).to_bits()
@@ -289,6 +325,11 @@ mod tests {
         assert_eq!(back, laws);
         let state = AnyState {
             coulomb: CoulombState { failed: true },
+            mortar: MortarState {
+                crack_opening: 1.25e-4,
+                plastic_slip: 3e-5,
+                overstressed: true,
+            },
         };
         let back: AnyState = serde_json::from_str(&serde_json::to_string(&state).unwrap()).unwrap();
         assert_eq!(back, state);
@@ -316,9 +357,116 @@ mod tests {
         );
     }
 
-    /// The state adds nothing to a sub-contact: it is as large as `CoulombSlip`'s state.
+    /// The state is the laws' states side by side and no larger: `MortarState` (two lengths
+    /// and a flag, 24 bytes) and `CoulombState`'s flag, 32 bytes with the alignment.
     #[test]
-    fn state_is_as_small_as_coulombs() {
-        assert_eq!(std::mem::size_of::<AnyState>(), std::mem::size_of::<CoulombState>());
+    fn state_is_the_laws_states_side_by_side() {
+        assert_eq!(std::mem::size_of::<MortarState>(), 24);
+        assert_eq!(std::mem::size_of::<CoulombState>(), 1);
+        assert_eq!(std::mem::size_of::<AnyState>(), 32);
+        // A sub-contact of a `Model<AnyLaw>`: 112 bytes (80 with `CoulombSlip`'s state alone).
+        assert_eq!(std::mem::size_of::<crate::contact::SubContact<AnyState>>(), 112);
+    }
+
+    fn mortar_laws() -> [MortarJoint; 2] {
+        [
+            MortarJoint::builder(1e10, 4e9, 35.0)
+                .residual_friction(28.0)
+                .tension(1e5, 8.0)
+                .cohesion(1.5e5, 40.0)
+                .build()
+                .unwrap(),
+            MortarJoint::builder(1e10, 4e9, 30.0)
+                .tension(1e5, 0.0)
+                .cohesion(2e5, 0.0)
+                .softening(crate::law::Softening::Linear)
+                .build()
+                .unwrap(),
+        ]
+    }
+
+    /// `AnyLaw::Mortar` forwards every method to the `MortarJoint` it holds, on its field of
+    /// the state, bit for bit, `fracture_work` included, over opening, closing and sliding
+    /// histories; the other laws' fields stay at their default.
+    #[test]
+    fn mortar_is_forwarded() {
+        let bits = |f: &JointForce| [f.normal.to_bits(), f.shear.x.to_bits(), f.shear.y.to_bits()];
+        let mut fracture = 0.0;
+        for inner in mortar_laws() {
+            let any = AnyLaw::from(inner);
+            assert_eq!(any.stiffness(), inner.stiffness());
+            assert_eq!(any.elastic_regime(), inner.elastic_regime());
+            assert!(any.validate().is_ok());
+            let (mut f, mut s) = (JointForce::default(), MortarState::default());
+            let (mut g, mut t) = (JointForce::default(), AnyState::default());
+            for k in 0..400 {
+                let x = k as Real;
+                let step = JointStep {
+                    area: 0.3,
+                    normal_displacement: 2e-5 * (0.05 * x).sin() - 2e-6,
+                    normal_increment: 0.0,
+                    shear_increment: Vector2::new(1e-6 * (0.03 * x).cos(), 2e-7),
+                    axes: JointAxes::from_normal(Vector::Z),
+                    dt: 1e-5,
+                };
+                let (s0, t0) = (s, t);
+                assert_eq!(any.update(&step, &mut g, &mut t), inner.update(&step, &mut f, &mut s));
+                assert_eq!(bits(&g), bits(&f));
+                assert_eq!(
+                    t,
+                    AnyState {
+                        mortar: s,
+                        ..AnyState::default()
+                    }
+                );
+                let (a, b) = (any.fracture_work(0.3, &t0, &t), inner.fracture_work(0.3, &s0, &s));
+                assert_eq!(a.to_bits(), b.to_bits());
+                fracture += a;
+                assert_eq!(
+                    any.elastic_energy(0.3, &g, &t).to_bits(),
+                    inner.elastic_energy(0.3, &f, &s).to_bits()
+                );
+                assert_eq!(any.is_failed(&t), inner.is_failed(&s));
+                for gap in [-1e-6, 0.0, 1e-6, 1e-3] {
+                    assert_eq!(any.stays_open(0.3, gap, &t), inner.stays_open(0.3, gap, &s));
+                }
+            }
+            assert!(inner.is_failed(&s));
+        }
+        // The softening joint cracked and consumed fracture energy; the brittle one none.
+        assert!(fracture > 0.0);
+        // The other laws book none.
+        let coulomb = AnyLaw::from(coulomb_laws()[2]);
+        let failed = AnyState {
+            coulomb: CoulombState { failed: true },
+            ..AnyState::default()
+        };
+        assert_eq!(coulomb.fracture_work(1.0, &AnyState::default(), &failed), 0.0);
+    }
+
+    /// A `MortarJoint` in JSON as `{"Mortar": {...}}`, round-tripping bit for bit, validated as
+    /// it is read, and a strength given without its fracture energy refused by name.
+    #[test]
+    #[cfg(feature = "io")]
+    fn mortar_serde_round_trip() {
+        let laws = mortar_laws().map(AnyLaw::from);
+        let text = serde_json::to_string(&laws).unwrap();
+        assert!(text.contains("\"Mortar\""), "{text}");
+        let back: Vec<AnyLaw> = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, laws);
+        let bad = text.replacen("\"cohesion\":150000.0", "\"cohesion\":-1.0", 1);
+        assert_ne!(bad, text);
+        let e = serde_json::from_str::<Vec<AnyLaw>>(&bad).unwrap_err();
+        assert!(e.to_string().contains("cohesion"), "{e}");
+        let missing = r#"{"Mortar": {"normal_stiffness": 1e10, "shear_stiffness": 4e9, "friction_deg": 30,
+            "tensile_strength": 1e5}}"#;
+        let e = serde_json::from_str::<AnyLaw>(missing).unwrap_err();
+        assert!(e.to_string().contains("mode_i_fracture_energy"), "{e}");
+        // A dry mortar joint needs nothing but its stiffnesses and friction.
+        let dry = r#"{"Mortar": {"normal_stiffness": 1e10, "shear_stiffness": 4e9, "friction_deg": 30}}"#;
+        assert_eq!(
+            serde_json::from_str::<AnyLaw>(dry).unwrap(),
+            AnyLaw::from(MortarJoint::builder(1e10, 4e9, 30.0).build().unwrap())
+        );
     }
 }

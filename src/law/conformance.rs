@@ -33,6 +33,8 @@
 //!   constant normal displacement. (Reversals are not checked: an explicit return mapping of a
 //!   softening law books a little negative work on the step after a reversal, made up by the
 //!   steps before.)
+//! * **Fracture work** ([`Clause::FractureWork`]): [`ConstitutiveLaw::fracture_work`] finite
+//!   and not negative for every update, and zero for one that leaves the state as it was.
 //!
 //! The histories, from the virgin state, for each of four areas (`1e-4` to 4 m²) and two sets
 //! of axes and time steps: closing from 0.1 m open to 0.1 m of interpenetration and opening
@@ -106,6 +108,9 @@ pub enum Clause {
     /// A step of monotonic loading dissipated a negative energy.
     #[error("negative dissipation on monotonic loading")]
     Dissipation,
+    /// `fracture_work` is negative or not finite, or not zero for an unchanged state.
+    #[error("`fracture_work` is negative, not finite, or not zero for an unchanged state")]
+    FractureWork,
     /// `update` does not do what [`ConstitutiveLaw::elastic_regime`] promises.
     #[error("`elastic_regime` promises what `update` does not do")]
     ElasticRegime,
@@ -300,6 +305,13 @@ impl<L: ConstitutiveLaw> Checker<'_, L> {
             return fail(
                 Clause::ElasticEnergy,
                 format!("{}: {status:?} {f:?} {s:?}, elastic energy {energy}", context()),
+            );
+        }
+        let fracture = self.law.fracture_work(step.area, state, &s);
+        if !(fracture >= 0.0 && fracture.is_finite()) || (s == *state && fracture != 0.0) {
+            return fail(
+                Clause::FractureWork,
+                format!("{}: {status:?} {f:?} {s:?}, fracture work {fracture}", context()),
             );
         }
         Ok((status, f, s))
@@ -696,6 +708,8 @@ mod tests {
         ActiveSlipInRegime,
         /// Returns a different force every other call.
         Flaky,
+        /// Reports fracture work of the wrong sign at a failure.
+        NegativeFracture,
     }
 
     impl ConstitutiveLaw for Broken {
@@ -752,6 +766,13 @@ mod tests {
                 _ => regime,
             })
         }
+        fn fracture_work(&self, _area: Real, before: &CoulombState, after: &CoulombState) -> Real {
+            if self.flaw == Flaw::NegativeFracture && before != after {
+                -1.0
+            } else {
+                0.0
+            }
+        }
         fn elastic_energy(&self, area: Real, force: &JointForce, state: &CoulombState) -> Real {
             let e = self.law.elastic_energy(area, force, state);
             if self.flaw == Flaw::NegativeEnergy {
@@ -777,6 +798,7 @@ mod tests {
             (dry, Flaw::ActiveSlip, Clause::Dissipation),
             (dry, Flaw::ActiveSlipInRegime, Clause::ElasticRegime),
             (dry, Flaw::Flaky, Clause::Determinism),
+            (bonded, Flaw::NegativeFracture, Clause::FractureWork),
         ] {
             let error = check(&Broken { law, flaw }).expect_err(&format!("{flaw:?} passed"));
             assert_eq!(error.clause, clause, "{flaw:?}: {error}");

@@ -10,6 +10,7 @@ mod any;
 pub mod conformance;
 mod coulomb;
 mod elastic;
+mod mortar;
 mod table;
 
 #[cfg(feature = "serde")]
@@ -18,6 +19,7 @@ use serde::{Deserialize, Serialize};
 pub use any::{AnyLaw, AnyState};
 pub use coulomb::{CoulombSlip, CoulombState};
 pub use elastic::LinearElastic;
+pub use mortar::{MortarJoint, MortarJointBuilder, MortarState, MortarStrengths, Softening};
 pub use table::LawTable;
 
 pub use crate::ids::MaterialId;
@@ -326,6 +328,22 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
             e += 0.5 * force.shear.length_squared() / (k.shear * area);
         }
         e
+    }
+
+    /// The fracture energy a step consumed at a sub-contact of area `area` whose state went
+    /// from `before` to `after` (J): the part of the step's dissipation that is the work
+    /// against softening strengths (a tensile strength or a cohesion falling with the crack's
+    /// opening or slip), which voussoir books as [`crate::model::Energies::fracture`] instead of
+    /// [`crate::model::Energies::friction`]. Asked only for steps that change the state; never
+    /// negative. The default, for laws that do not soften, is 0.
+    ///
+    /// The contact kernel books the step's dissipation (see `docs/custom-law.md`,
+    /// "Dissipation") and takes this part of it for `fracture`, never more than the step
+    /// dissipated in all (a sub-contact that comes into being beyond its strength cracks
+    /// without work and books none); the rest stays with `friction`.
+    #[inline]
+    fn fracture_work(&self, _area: Real, _before: &Self::State, _after: &Self::State) -> Real {
+        0.0
     }
 
     /// Whether the sub-contact has failed (lost cohesion or tensile strength), for output.

@@ -93,8 +93,10 @@ pub(super) struct PairSums {
     /// Σ |resultant| (N), for the unbalanced-force ratio.
     pub force_magnitude: Real,
     pub work: Real,
-    /// Energy dissipated by the joint laws (J).
+    /// Energy dissipated by the joint laws (J), their fracture work apart.
     pub dissipated: Real,
+    /// The joint laws' fracture work (J).
+    pub fracture: Real,
     pub dashpot_work: Real,
     /// The largest squared frequency bound of the blocks of an impacting contact (0: none).
     pub impact: Real,
@@ -192,6 +194,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             sums.force_magnitude += step.wrench.force.length();
             sums.work += step.work;
             sums.dissipated += step.dissipated;
+            sums.fracture += step.fracture;
             sums.dashpot_work += step.dashpot_work;
             if step.impact {
                 let w2 = self.bounds[p.a as usize]

@@ -8,16 +8,19 @@ use crate::math::Real;
 
 /// Energies and works since the start of the run (J).
 ///
-/// Balance: `kinetic + elastic + friction + damping = initial_kinetic + gravity_work + load_work +
-/// boundary_work`. `kinetic` is evaluated at integer time levels as `½·m·v⁻·v⁺` (the product of
+/// Balance: `kinetic + elastic + friction + fracture + damping = initial_kinetic + gravity_work +
+/// load_work + boundary_work`. `kinetic` is evaluated at integer time levels as `½·m·v⁻·v⁺` (the product of
 /// the half-step velocities either side, the quantity central difference conserves; it differs
 /// from `½·m·v̄²` by `⅛·m·|v⁺ − v⁻|²`); works are each force times the displacement of the step,
 /// by the trapezoidal rule, so that the balance is exact for translation; `elastic` is the energy stored
-/// in the joint springs; `friction` is what the joint laws dissipated: at every sub-contact
-/// step that slid or changed the law's state (failure), the work done on its springs less the
-/// change of their elastic energy. Elastic and open steps dissipate nothing, so with a
-/// frictionless law `friction` stays zero, and `balance_error` measures what the time
-/// integration and the discretisation of the joints did not conserve.
+/// in the joint springs; `friction` and `fracture` are what the joint laws dissipated: at every
+/// sub-contact step that slid or changed the law's state (failure, softening), the work done on
+/// its springs less the change of their elastic energy, of which the law's fracture work
+/// ([`crate::law::ConstitutiveLaw::fracture_work`]: the work against softening strengths, such
+/// as [`crate::law::MortarJoint`]'s) goes to `fracture` and the rest to `friction`. Elastic and
+/// open steps dissipate nothing, so with a frictionless law `friction` stays zero, and
+/// `balance_error` measures what the time integration and the discretisation of the joints did
+/// not conserve.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Energies {
@@ -34,12 +37,20 @@ pub struct Energies {
     /// Work of the supports and prescribed velocities (J).
     pub boundary_work: Real,
     /// Energy dissipated by slip and joint failure (J): accumulated from the laws' inelastic
-    /// steps, never from a balance.
+    /// steps, never from a balance; their fracture work apart.
     pub friction: Real,
+    /// Fracture energy the joints consumed as they cracked and softened (J): the laws'
+    /// [`fracture_work`](crate::law::ConstitutiveLaw::fracture_work) at their inelastic steps
+    /// (`G_f·A` for a [`MortarJoint`](crate::law::MortarJoint) cracked through over an area
+    /// `A`). Zero for laws that do not soften. Absent from checkpoints written before it
+    /// existed, which load with 0.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub fracture: Real,
     /// Energy dissipated by damping: local, Rayleigh mass part and contact dashpots (J).
     pub damping: Real,
-    /// Total work done on the joint springs (J): the elastic energy plus `friction` plus what
-    /// the time integration and the joints' discretisation did not conserve.
+    /// Total work done on the joint springs (J): the elastic energy plus `friction` and
+    /// `fracture` plus what the time integration and the joints' discretisation did not
+    /// conserve.
     pub joint_work: Real,
 }
 
@@ -49,9 +60,9 @@ impl Energies {
         self.initial_kinetic + self.gravity_work + self.load_work + self.boundary_work
     }
 
-    /// Energy accounted for: kinetic, elastic, friction and damping (J).
+    /// Energy accounted for: kinetic, elastic, friction, fracture and damping (J).
     pub fn accounted(&self) -> Real {
-        self.kinetic + self.elastic + self.friction + self.damping
+        self.kinetic + self.elastic + self.friction + self.damping + self.fracture
     }
 
     /// `accounted − input` (J); zero for a perfect integrator.

@@ -55,7 +55,8 @@ use crate::law::{ConstitutiveLaw, CoulombSlip, LawTable};
 use crate::math::{is_finite_vector, Pose, Real};
 
 use changes::Changes;
-use pipeline::Pipeline;
+/// The model's pipeline: the stages' scratch with the detection's.
+type Pipeline<S> = pipeline::PipelineOf<detection::DetectionScratch<S>>;
 
 /// A discrete element model of rigid blocks with joint law type `L`.
 ///

@@ -11,7 +11,7 @@
 use rayon::prelude::*;
 
 use super::detection::prepare_chunk;
-use super::pipeline::Pipeline;
+use super::Pipeline;
 use super::{diverged, BlockSums, ModelState, BLOCK_CHUNK};
 use crate::block::{Block, Dof, RigidBlock, Wrench};
 use crate::contact::{ContactWrench, DisplacementMode};
@@ -267,6 +267,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         for s in &pipeline.pair_sums {
             e.joint_work += s.work;
             e.friction += s.dissipated;
+            e.fracture += s.fracture;
             e.damping += s.dashpot_work;
         }
         let force_magnitudes: Real = pipeline.pair_sums.iter().map(|s| s.force_magnitude).sum();

@@ -3,15 +3,16 @@
 //! store it, and a restored model rebuilds it.
 
 use super::contact_pass::PairSums;
-use super::detection::DetectionScratch;
 use super::{BlockSums, Timings};
 use crate::block::Wrench;
 use crate::integrate::StiffnessBound;
 use crate::math::{Matrix, Real};
 
-/// Scratch of the step's stages.
+/// Scratch of the step's stages. `D` is the detection's scratch
+/// (`detection::DetectionScratch`), a parameter so that the pipeline, which the detection stage
+/// takes, does not depend on that stage (`super::Pipeline` names the model's pipeline).
 #[derive(Debug, Clone)]
-pub(super) struct Pipeline<S> {
+pub(super) struct PipelineOf<D> {
     /// Block → contact index (CSR with `block_offsets`): `2 × contact + side`, side 1 when the
     /// block is the contact's `b`. Rebuilt at detection and on checkpoint load.
     pub block_contacts: Vec<u32>,
@@ -30,7 +31,7 @@ pub(super) struct Pipeline<S> {
     pub refresh_blocks: Vec<u32>,
     pub refresh_bounds: Vec<StiffnessBound>,
     /// Detection's buffers, and what the block pass prepared for the next step.
-    pub detection: DetectionScratch<S>,
+    pub detection: D,
     /// The largest speed of a point of a block at the end of the last step
     /// ([`super::motion::speed_bound`], m/s), for the next step's length; `None` after a setter
     /// touched a block or a load: the next step takes it in a pass of its own.
@@ -48,7 +49,7 @@ pub(super) struct Pipeline<S> {
 /// end's signal check; a clock reading costs tens of nanoseconds).
 pub const INTERRUPT_INTERVAL: std::time::Duration = std::time::Duration::from_millis(20);
 
-impl<S> Pipeline<S> {
+impl<D> PipelineOf<D> {
     /// Whether the interrupt check, asked now if [`INTERRUPT_INTERVAL`] has passed since it was
     /// last asked before a step, says to stop.
     pub fn interrupt_due(&mut self) -> bool {
@@ -67,7 +68,7 @@ impl<S> Pipeline<S> {
     }
 }
 
-impl<S> Default for Pipeline<S> {
+impl<D: Default> Default for PipelineOf<D> {
     fn default() -> Self {
         Self {
             block_contacts: Vec::new(),
@@ -79,7 +80,7 @@ impl<S> Default for Pipeline<S> {
             bounds: Vec::new(),
             refresh_blocks: Vec::new(),
             refresh_bounds: Vec::new(),
-            detection: DetectionScratch::default(),
+            detection: D::default(),
             max_speed: None,
             timings: Timings::default(),
             interrupt: None,

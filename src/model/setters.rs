@@ -3,7 +3,7 @@
 //! each of which records what it changed for the next step.
 
 use super::changes::Changes;
-use super::pipeline::Pipeline;
+use super::Pipeline;
 use super::{Energies, InterruptCheck, Model, ModelParameters, ModelState};
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::error::{Error, Result};

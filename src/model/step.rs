@@ -3,7 +3,7 @@
 
 use super::changes::Changes;
 use super::contact_pass::{ContactPass, ContactSlices, PairSums, CONTACT_CHUNK};
-use super::pipeline::Pipeline;
+use super::Pipeline;
 use super::{is_finite_state, ModelState};
 use crate::block::{Block, BlockId};
 use crate::contact::{DisplacementMode, KernelContext};

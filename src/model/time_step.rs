@@ -1,8 +1,8 @@
 //! The model's time step: the contacts' stiffness handed to the integrator's stability limit
 //! ([`crate::integrate::Integrator::critical_step`]), then the step the parameters ask for.
 
-use super::pipeline::Pipeline;
 use super::ModelState;
+use super::Pipeline;
 use crate::error::{Error, Result};
 use rayon::prelude::*;
 

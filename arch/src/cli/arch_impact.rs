@@ -25,8 +25,7 @@
 use std::ops::Bound::{Excluded, Included};
 
 use clap::builder::PossibleValuesParser;
-use clap::{ArgAction, Args, ValueEnum};
-use serde::Serialize;
+use clap::{ArgAction, Args};
 
 use super::args::{self, Interval};
 use super::{BoxError, Outputs, Run};
@@ -34,6 +33,7 @@ use crate::plot::{Curve, LegendPosition, LinePlot, Reference};
 use crate::scenarios::arch_impact::{
     run, setups, ImpactCase, ImpactResult, ImpactSetup, ImpactorBase, ImpactorGuide, Release,
 };
+use crate::scenarios::impact_summary::ImpactSummary;
 
 /// The six tests, as `--setup` takes them.
 pub const SETUP_NAMES: [&str; 6] = ["M60H20", "M60H25", "M60H30", "M75H20", "M75H45", "M80H45"];
@@ -112,14 +112,14 @@ pub struct ImpactOptions {
     #[arg(long, value_name = "S", value_parser = DURATION_RANGE.parser(), allow_hyphen_values = true)]
     pub duration: Option<f64>,
     /// How the impactor is guided
-    #[arg(long, value_enum, default_value_t = Guide::Frame)]
-    pub guide: Guide,
+    #[arg(long, value_enum, default_value_t = ImpactorGuide::Frame)]
+    pub guide: ImpactorGuide,
     /// The impactor's striking face
-    #[arg(long, value_enum, default_value_t = Base::Sloped)]
-    pub base: Base,
+    #[arg(long, value_enum, default_value_t = ImpactorBase::Sloped)]
+    pub base: ImpactorBase,
     /// Where the impactor is released
-    #[arg(long, value_enum, default_value_t = ReleaseAt::Above)]
-    pub release: ReleaseAt,
+    #[arg(long, value_enum, default_value_t = Release::JustAbove)]
+    pub release: Release,
     /// Drop-height perturbations (mm), each at most once; every setup runs at each, the
     /// smallest reported. Each in [-100, 100] (the lowest drop is 200 mm)
     #[arg(
@@ -149,60 +149,6 @@ pub struct ImpactOptions {
     /// Add the other release (full height or just above) for each setup's central run
     #[arg(long)]
     pub compare_release: bool,
-}
-
-/// `--guide`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Guide {
-    /// A free impactor between fixed frame blocks (contacts only)
-    Frame,
-    /// A steel seat on voussoir 5, the impactor guided by constrained DOFs
-    Seat,
-}
-
-/// `--base`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Base {
-    /// Parallel to the extrados of voussoir 5 (20.7°)
-    Sloped,
-    /// Horizontal
-    Flat,
-}
-
-/// `--release`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ReleaseAt {
-    /// Just above the arch, at the speed of the fall
-    Above,
-    /// At the full drop height, at rest
-    Full,
-}
-
-impl From<Guide> for ImpactorGuide {
-    fn from(g: Guide) -> Self {
-        match g {
-            Guide::Frame => ImpactorGuide::Frame,
-            Guide::Seat => ImpactorGuide::SeatConstrained,
-        }
-    }
-}
-
-impl From<Base> for ImpactorBase {
-    fn from(b: Base) -> Self {
-        match b {
-            Base::Sloped => ImpactorBase::Sloped,
-            Base::Flat => ImpactorBase::Flat,
-        }
-    }
-}
-
-impl From<ReleaseAt> for Release {
-    fn from(r: ReleaseAt) -> Self {
-        match r {
-            ReleaseAt::Above => Release::JustAbove,
-            ReleaseAt::Full => Release::FullHeight,
-        }
-    }
 }
 
 impl Run for ImpactOptions {
@@ -274,9 +220,9 @@ fn groups(o: &ImpactOptions) -> Result<Vec<Group>, String> {
     };
     let configure = |s: &ImpactSetup| {
         let mut c = ImpactCase::baseline(s.clone());
-        c.guide = o.guide.into();
-        c.base = o.base.into();
-        c.release = o.release.into();
+        c.guide = o.guide;
+        c.base = o.base;
+        c.release = o.release;
         if let Some(kn) = o.kn {
             c.ks = kn * c.ks / c.kn;
             c.kn = kn;
@@ -336,7 +282,7 @@ fn groups(o: &ImpactOptions) -> Result<Vec<Group>, String> {
         }
     }
     if o.compare_release {
-        let other = match Release::from(o.release) {
+        let other = match o.release {
             Release::JustAbove => Release::FullHeight,
             Release::FullHeight => Release::JustAbove,
         };
@@ -371,79 +317,6 @@ fn guide_name(g: ImpactorGuide) -> &'static str {
     }
 }
 
-#[derive(Serialize)]
-struct Experiment {
-    collapsed: bool,
-    max_disp_m: Option<f64>,
-    max_velocity_m_per_s: f64,
-    max_accel_m_per_s2: f64,
-}
-
-#[derive(Serialize)]
-struct RunSummary {
-    height_offset_m: f64,
-    first_peak_disp_m: f64,
-    max_disp_m: f64,
-    max_velocity_m_per_s: f64,
-    collapsed: bool,
-    max_energy_excess_j: f64,
-    max_energy_error_j: f64,
-    wall_s: f64,
-}
-
-#[derive(Serialize)]
-struct EnergySummary {
-    /// At the end of the run, changes since release (J).
-    input_j: f64,
-    kinetic_j: f64,
-    elastic_j: f64,
-    friction_j: f64,
-    damping_j: f64,
-    gravity_work_j: f64,
-    final_excess_j: f64,
-    max_excess_j: f64,
-    max_abs_error_j: f64,
-}
-
-#[derive(Serialize)]
-struct GroupSummary {
-    name: String,
-    label: String,
-    kind: &'static str,
-    guide: ImpactorGuide,
-    base: ImpactorBase,
-    release: Release,
-    mass_kg: f64,
-    height_m: f64,
-    v0_m_per_s: f64,
-    contact_speed_m_per_s: f64,
-    impact_energy_j: f64,
-    kn_pa_per_m: f64,
-    damping_ratio: f64,
-    width_m: f64,
-    first_peak_disp_m: f64,
-    max_disp_m: f64,
-    spread_max_disp_m: [f64; 2],
-    spread_first_peak_disp_m: [f64; 2],
-    max_rise_m: f64,
-    max_rise_time_s: f64,
-    max_velocity_m_per_s: f64,
-    max_accel_m_per_s2: f64,
-    max_impact_force_n: f64,
-    max_impactor_drift_m: [f64; 2],
-    max_impactor_rotation_rad: f64,
-    collapsed: bool,
-    collapsed_runs: usize,
-    runs_count: usize,
-    collapse_time_s: Option<f64>,
-    energy: EnergySummary,
-    steps: u64,
-    dt_s: f64,
-    wall_s: f64,
-    runs: Vec<RunSummary>,
-    experiment: Experiment,
-}
-
 /// The results of one group, central run first.
 struct Outcome<'a> {
     group: &'a Group,
@@ -452,89 +325,8 @@ struct Outcome<'a> {
 }
 
 impl Outcome<'_> {
-    fn spread(&self, f: impl Fn(&ImpactResult) -> f64) -> [f64; 2] {
-        let v: Vec<f64> = self.runs.iter().map(|r| f(r)).collect();
-        [
-            v.iter().copied().fold(f64::INFINITY, f64::min),
-            v.iter().copied().fold(f64::NEG_INFINITY, f64::max),
-        ]
-    }
-
-    fn collapsed_runs(&self) -> usize {
-        self.runs.iter().filter(|r| r.collapsed).count()
-    }
-
-    fn summary(&self) -> GroupSummary {
-        let r = self.central;
-        let c = &r.case;
-        let s = &c.setup;
-        let last = r.samples.last().copied();
-        let e = |f: fn(&crate::scenarios::arch_impact::ImpactSample) -> f64| last.map_or(0.0, |x| f(&x));
-        GroupSummary {
-            name: s.name.clone(),
-            label: self.group.label.clone(),
-            kind: self.group.kind,
-            guide: c.guide,
-            base: c.base,
-            release: c.release,
-            mass_kg: s.mass,
-            height_m: c.drop_height(),
-            v0_m_per_s: r.v0,
-            contact_speed_m_per_s: r.contact_speed,
-            impact_energy_j: r.kinetic_energy,
-            kn_pa_per_m: c.kn,
-            damping_ratio: c.damping_ratio,
-            width_m: c.width,
-            first_peak_disp_m: r.first_peak_disp,
-            max_disp_m: r.max_disp,
-            spread_max_disp_m: self.spread(|r| r.max_disp),
-            spread_first_peak_disp_m: self.spread(|r| r.first_peak_disp),
-            max_rise_m: r.max_rise,
-            max_rise_time_s: r.max_rise_time,
-            max_velocity_m_per_s: r.max_velocity,
-            max_accel_m_per_s2: r.max_accel,
-            max_impact_force_n: r.max_impact_force,
-            max_impactor_drift_m: r.max_impactor_drift,
-            max_impactor_rotation_rad: r.max_impactor_rotation,
-            collapsed: r.collapsed,
-            collapsed_runs: self.collapsed_runs(),
-            runs_count: self.runs.len(),
-            collapse_time_s: r.collapse_time,
-            energy: EnergySummary {
-                input_j: e(|x| x.input),
-                kinetic_j: e(|x| x.kinetic),
-                elastic_j: e(|x| x.elastic),
-                friction_j: e(|x| x.friction),
-                damping_j: e(|x| x.damping),
-                gravity_work_j: e(|x| x.gravity_work),
-                final_excess_j: r.final_energy_excess,
-                max_excess_j: r.max_energy_excess,
-                max_abs_error_j: r.max_energy_error,
-            },
-            steps: r.steps,
-            dt_s: r.dt,
-            wall_s: r.wall_s,
-            runs: self
-                .runs
-                .iter()
-                .map(|x| RunSummary {
-                    height_offset_m: x.case.height_offset,
-                    first_peak_disp_m: x.first_peak_disp,
-                    max_disp_m: x.max_disp,
-                    max_velocity_m_per_s: x.max_velocity,
-                    collapsed: x.collapsed,
-                    max_energy_excess_j: x.max_energy_excess,
-                    max_energy_error_j: x.max_energy_error,
-                    wall_s: x.wall_s,
-                })
-                .collect(),
-            experiment: Experiment {
-                collapsed: s.collapsed,
-                max_disp_m: s.max_disp,
-                max_velocity_m_per_s: s.max_velocity,
-                max_accel_m_per_s2: s.max_accel,
-            },
-        }
+    fn summary(&self) -> ImpactSummary {
+        ImpactSummary::of(&self.group.label, self.group.kind, self.central, &self.runs)
     }
 }
 
@@ -582,15 +374,15 @@ fn markdown(outcomes: &[Outcome], agree: usize, main_count: usize) -> String {
     for x in outcomes {
         let r = x.central;
         let s = &r.case.setup;
-        let sp = x.spread(|r| r.max_disp);
-        let sp1 = x.spread(|r| r.first_peak_disp);
+        let sp = x.summary().spread_max_disp_m;
+        let sp1 = x.summary().spread_first_peak_disp_m;
         md.push_str(&format!(
             "| {} | {:.1} | {} | {} | {}/{} | {} ({}–{}) | {} | {}–{} | {} | {} | {:.2} | {:.2} | {:.0} | {:.0} | {} at {:.3} |\n",
             x.group.label,
             r.kinetic_energy,
             verdict(r.collapsed),
             verdict(s.collapsed),
-            x.collapsed_runs(),
+            x.summary().collapsed_runs,
             x.runs.len(),
             mm(r.first_peak_disp),
             mm(sp1[0]),
@@ -749,7 +541,7 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
         let s = &r.case.setup;
         let verdict = |c: bool| if c { "collapse" } else { "stands" };
         let exp_disp = s.max_disp.map_or("—".to_owned(), |d| format!("{:.0}", d * 1e3));
-        let sp = x.spread(|r| r.max_disp);
+        let sp = x.summary().spread_max_disp_m;
         println!(
             "{:<26} {:>6.1} {:>8.1} {:>8.1} {:>6.1}–{:<6.1} {:>6} {:>6.1} {:>6.2} {:>7.2} {:>6.2} {:>8.2} {:>4}/{:<2} {} / test {}",
             x.group.label,
@@ -764,7 +556,7 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
             s.max_velocity,
             r.max_accel / 1e3,
             r.max_energy_error,
-            x.collapsed_runs(),
+            x.summary().collapsed_runs,
             x.runs.len(),
             verdict(r.collapsed),
             verdict(s.collapsed)
@@ -842,8 +634,10 @@ fn run_impact(o: &ImpactOptions, out: &Outputs) -> Result<(), BoxError> {
         y_label: "max displacement [mm]".into(),
         curves: vec![
             curve("model (M60 setups)", &|x| x.central.max_disp),
-            curve("model, lowest of ±0.5 mm drops", &|x| x.spread(|r| r.max_disp)[0]),
-            curve("model, highest of ±0.5 mm drops", &|x| x.spread(|r| r.max_disp)[1]),
+            curve("model, lowest of ±0.5 mm drops", &|x| x.summary().spread_max_disp_m[0]),
+            curve("model, highest of ±0.5 mm drops", &|x| {
+                x.summary().spread_max_disp_m[1]
+            }),
         ],
         references: refs,
         legend: LegendPosition::Auto,

@@ -289,9 +289,10 @@ impl Outputs {
 
 #[cfg(test)]
 mod tests {
-    use super::arch_impact::{Base, Guide, ImpactOptions, ReleaseAt};
+    use super::arch_impact::ImpactOptions;
     use super::arch_static::StaticOptions;
     use super::*;
+    use crate::scenarios::arch_impact::{ImpactorBase, ImpactorGuide, Release};
 
     fn impact(args: &[&str]) -> (CommonOptions, ImpactOptions) {
         parse::<ImpactOptions>(std::iter::once("arch_impact").chain(args.iter().copied())).expect("parses")
@@ -311,7 +312,7 @@ mod tests {
         assert_eq!((o.kn, o.damping, o.width, o.duration), (None, None, None, None));
         assert_eq!(
             (o.guide, o.base, o.release),
-            (Guide::Frame, Base::Sloped, ReleaseAt::Above)
+            (ImpactorGuide::Frame, ImpactorBase::Sloped, Release::JustAbove)
         );
         assert_eq!(o.offsets_mm, [-0.5, -0.25, 0.0, 0.25, 0.5]);
         assert!(!o.study && !o.compare_release);
@@ -355,7 +356,10 @@ mod tests {
             (o.kn, o.damping, o.width, o.duration),
             (Some(8e9), Some(0.02), Some(0.2), Some(0.5))
         );
-        assert_eq!((o.guide, o.base, o.release), (Guide::Seat, Base::Flat, ReleaseAt::Full));
+        assert_eq!(
+            (o.guide, o.base, o.release),
+            (ImpactorGuide::SeatConstrained, ImpactorBase::Flat, Release::FullHeight)
+        );
         assert_eq!(o.offsets_mm, [-0.5, 0.0]);
         assert!(o.study && o.compare_release);
         // A repeated option keeps its last value, as the old parsers did.

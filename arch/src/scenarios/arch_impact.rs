@@ -84,6 +84,7 @@ pub fn setups() -> Vec<ImpactSetup> {
 }
 
 /// How the impactor is guided.
+/// On the command line (`--guide`): `frame`, `seat`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum ImpactorGuide {
     /// A free block between fixed frame blocks, guided only through contacts, striking the
@@ -96,6 +97,7 @@ pub enum ImpactorGuide {
 }
 
 /// The shape of the impactor's bottom face ([`ImpactorGuide::Frame`] only).
+/// On the command line (`--base`): `sloped`, `flat`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum ImpactorBase {
     /// Parallel to the extrados of voussoir 5 (20.7° to the horizontal): the whole footprint
@@ -107,6 +109,7 @@ pub enum ImpactorBase {
 }
 
 /// Where the impactor starts.
+/// On the command line (`--release`): `above`, `full`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum Release {
     /// [`ImpactCase::release_gap`] above the point of contact, moving down at the speed of the
@@ -116,6 +119,52 @@ pub enum Release {
     /// At rest, the drop height `H` above the point of contact.
     FullHeight,
 }
+
+/// The names of a setting's choices, in one place: the command line (`clap::ValueEnum`, feature
+/// `cli`) and the Python bindings (`FromStr`) read them from here.
+macro_rules! named_choices {
+    ($ty:ident, $what:literal, [$($variant:ident => $name:literal),+ $(,)?]) => {
+        impl $ty {
+            /// Every choice, in order.
+            pub const ALL: &'static [$ty] = &[$($ty::$variant),+];
+
+            /// The choice's name on the command line and in Python.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $($ty::$variant => $name),+
+                }
+            }
+        }
+
+        impl std::str::FromStr for $ty {
+            type Err = String;
+
+            /// A choice from its name (any case); the error lists the names.
+            fn from_str(s: &str) -> std::result::Result<Self, String> {
+                let lower = s.to_ascii_lowercase();
+                Self::ALL.iter().copied().find(|c| c.name() == lower).ok_or_else(|| {
+                    let names: Vec<String> = Self::ALL.iter().map(|c| format!("{:?}", c.name())).collect();
+                    format!("{} {s:?}: expected {}", $what, names.join(" or "))
+                })
+            }
+        }
+
+        #[cfg(feature = "cli")]
+        impl clap::ValueEnum for $ty {
+            fn value_variants<'a>() -> &'a [Self] {
+                Self::ALL
+            }
+
+            fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+                Some(clap::builder::PossibleValue::new(self.name()))
+            }
+        }
+    };
+}
+
+named_choices!(ImpactorGuide, "guide", [Frame => "frame", SeatConstrained => "seat"]);
+named_choices!(ImpactorBase, "base", [Sloped => "sloped", Flat => "flat"]);
+named_choices!(Release, "release", [JustAbove => "above", FullHeight => "full"]);
 
 /// One analysis: a setup and the model parameters.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -5,11 +5,12 @@
 pub mod arch_impact;
 pub mod arch_limit;
 pub mod arch_static;
+pub mod impact_summary;
 
 use voussoir::build::arch::{Arch, ArchSpec};
 use voussoir::contact::DisplacementMode;
 use voussoir::error::Result;
-use voussoir::geometry::{ContactParameters, SubcontactDensity};
+use voussoir::geometry::{ContactParameters, SubContactDensity};
 use voussoir::integrate::TimeStep;
 use voussoir::law::{CoulombSlip, MaterialId};
 use voussoir::math::{Real, Vector};
@@ -41,7 +42,7 @@ pub(crate) fn reference_arch_model(j: ArchJoints) -> Result<(Model, Arch)> {
     let params = ModelParameters {
         gravity: Vector::new(0.0, -9.81, 0.0),
         contact: ContactParameters {
-            density: SubcontactDensity::PerEdge(j.per_edge),
+            density: SubContactDensity::PerEdge(j.per_edge),
             ..ContactParameters::default()
         },
         mode: j.mode,

@@ -219,8 +219,8 @@ def to_voussoir(
     kn: Optional[float] = None,
     ks: Optional[float] = None,
     interfaces: Optional[Dict[tuple, dict]] = None,
-    subcontacts_per_edge: int = 15,
-    contact_tolerance: float = 1e-3,
+    subcontacts_per_edge: Optional[int] = None,
+    contact_tolerance: Optional[float] = None,
     **model_options,
 ) -> Conversion:
     """Builds the ``voussoir.Model`` of a problem (its model's blocks, supports and joints);
@@ -243,10 +243,11 @@ def to_voussoir(
         )
     law, params = joint_law(problem, kn, ks)
     g = _gravity(problem)
+    # None: voussoir's own default (``voussoir.Model.defaults()``), not restated here.
+    given = {"subcontacts_per_edge": subcontacts_per_edge, "contact_tolerance": contact_tolerance}
     m = vs.Model(
         gravity=(0.0, 0.0, -g),
-        subcontacts_per_edge=subcontacts_per_edge,
-        contact_tolerance=contact_tolerance,
+        **{k: v for k, v in given.items() if v is not None},
         **model_options,
     )
     m.set_joint_law(0, 0, law)

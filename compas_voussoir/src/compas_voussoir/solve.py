@@ -105,8 +105,8 @@ def run(
     kn: Optional[float] = None,
     ks: Optional[float] = None,
     interfaces: Optional[Dict[tuple, dict]] = None,
-    subcontacts_per_edge: int = 15,
-    contact_tolerance: float = 1e-3,
+    subcontacts_per_edge: Optional[int] = None,
+    contact_tolerance: Optional[float] = None,
     ramp_time: float = 0.5,
     ratio: float = 1e-5,
     max_steps: int = 2_000_000,
@@ -169,16 +169,24 @@ def run(
       or the centre the hinged joints face: :func:`compas_voussoir.results.hinges`); ``fixity``
       overrides per graph node (e.g. a loading plate's out-of-plane motions fixed). A dead load
       that is not carried is an answer, not an error: ``carries_dead_load`` False,
-      ``multiplier`` None, ``status`` ``"infeasible"`` and ``reason`` (the solver's), Results
-      without forces. ``live=[]`` (or live loads of zero force) asks only whether the dead load
-      is carried (``multiplier`` None).
+      ``multiplier`` None, ``status`` ``"infeasible"`` and ``reason`` (voussoir's
+      ``LimitInfeasibleError``), Results without forces. ``live=[]`` (or live loads of zero
+      force) asks only whether the dead load is carried (``voussoir.limit`` with no live load;
+      ``multiplier`` None, ``dead_load_only`` True, ``status`` the solver's): when it is, the
+      Results hold the contact forces of an admissible state that carries it (they balance the
+      weight and the dead loads; the supports' reactions with them) and no mechanism; when it
+      is not, ``status`` ``"PrimalInfeasible"``, ``reason`` naming the blocks that fall,
+      ``mechanism`` the solver's certificate (a motion on which the dead load does work: which
+      blocks fall and which way, not a collapse mechanism to read hinges from) and Results
+      without forces.
 
     Model options: ``density`` (kg/m³, for blocks without a material) and ``densities`` per
     graph node; ``kn``, ``ks`` (**Pa/m, stiffness per unit joint area**; compas_dem's
     ``set_joint_model`` docstring says N/m: a value outside 1e8–1e14 Pa/m is warned about,
     :class:`compas_voussoir.StiffnessUnitsWarning`) over the problem's joint model;
     ``interfaces`` ``{(u, v): {"phi", "c", "t_c", "kn", "kt"}}`` per pair of graph nodes;
-    ``subcontacts_per_edge``, ``contact_tolerance``; the ``voussoir.Model`` keywords of
+    ``subcontacts_per_edge``, ``contact_tolerance`` (None: voussoir's defaults,
+    ``voussoir.Model.defaults()``); the ``voussoir.Model`` keywords of
     ``compas_voussoir.convert.MODEL_OPTIONS``. Any other keyword is refused (``TypeError``
     naming it).
     """
@@ -393,58 +401,6 @@ def _settle(m, ramp_time, ratio, max_steps, every, progress):
     }
 
 
-def _dead_wrench_probe(m):
-    """The dead load reversed, as ``voussoir.limit`` live loads: per block, minus its weight and
-    constant load (force at the centroid, a moment as a couple). Scaled by 1 it
-    cancels every block's dead load, so the multiplier's programme is always feasible; its
-    dead-load check then answers whether the dead load alone is carried."""
-    g = np.asarray(m.gravity, dtype=float)
-    centroids = m.positions()
-    size = max(float(np.ptp(centroids, axis=0).max()) if len(centroids) > 1 else 1.0, 1e-3)
-    probe = []
-    for i in range(len(m)):
-        b = m.block(i)
-        load = m.load(i)
-        f = -(b.mass * g + np.asarray(load["force"], dtype=float))
-        c = np.asarray(centroids[i], dtype=float)
-        if np.any(f != 0.0):
-            probe.append({"block": i, "point": c.tolist(), "force": f.tolist()})
-        mo = -np.asarray(load["moment"], dtype=float)
-        if np.any(mo != 0.0):
-            # A couple: +q at c + d/2, −q at c − d/2 with d ⊥ M, d × q = M.
-            u = np.cross(mo, [1.0, 0.0, 0.0] if abs(mo[0]) < 0.9 * np.linalg.norm(mo) else [0.0, 1.0, 0.0])
-            d = 0.1 * size * u / np.linalg.norm(u)
-            q = np.cross(mo, d) / float(d @ d)
-            probe.append({"block": i, "point": (c + d / 2).tolist(), "force": q.tolist()})
-            probe.append({"block": i, "point": (c - d / 2).tolist(), "force": (-q).tolist()})
-    return probe
-
-
-def _has_free_dof(spec):
-    """Whether a fixity spec (as ``voussoir.Model.set_fixity`` takes it) leaves a degree of
-    freedom free."""
-    if spec is None or spec is False or spec == "free":
-        return True
-    if spec is True or spec == "fixed":
-        return False
-    if isinstance(spec, dict):
-        return any(d == "free" for key in ("translation", "rotation") for d in spec.get(key, ["free"] * 3))
-    return True
-
-
-def _limit_failure(error):
-    """What a ``voussoir.limit`` error means: ``"infeasible"`` (the dead load is not carried,
-    voussoir's ``LimitInfeasible``: "the structure cannot carry its own weight"),
-    ``"unbounded"`` (``LimitUnbounded``) or None (another error). By the message: voussoir
-    raises one ``VoussoirError`` class for all."""
-    text = str(error)
-    if "cannot carry its own weight" in text:
-        return "infeasible"
-    if "multiplier is unbounded" in text:
-        return "unbounded"
-    return None
-
-
 def _limit(problem, model, conv, meta, *, live, fixity, friction, facets, check_dead_load, max_iterations, mechanism_scale, centre):
     m = conv.model
     if live is None:
@@ -480,64 +436,27 @@ def _limit(problem, model, conv, meta, *, live, fixity, friction, facets, check_
     meta.update({"live": names, "mechanism_scale": mechanism_scale, "check_dead_load": bool(check_dead_load)})
 
     if not loads:
-        # Only the dead load: is it carried? (voussoir.limit refuses a zero live load.)
-        probe = _dead_wrench_probe(m)
-        free = any(_has_free_dof(overrides.get(i, m.block(i).fixity)) for i in range(len(m)))
-        if not probe or not free:
-            meta.update(
-                {
-                    "multiplier": None,
-                    "status": "no dead load" if free else "no free block",
-                    "carries_dead_load": True,
-                    "mechanism": None,
-                    "hinges": [],
-                    "dead_load_only": True,
-                }
-            )
-            return without_forces(problem, model, conv, meta)
-        try:
-            vs.limit(m, probe, check_dead_load=True, **options)
-            carried, status, reason = True, "Solved", None
-        except vs.VoussoirError as e:
-            kind = _limit_failure(e)
-            if kind == "infeasible":
-                # (The library's message speaks of the probe's "live load": not the user's.)
-                carried, status, reason = (
-                    False,
-                    "infeasible",
-                    "the dead load alone is not carried: no contact forces within the joints' strength hold every "
-                    "block in equilibrium under its weight and the dead loads (voussoir's dead-load check)",
-                )
-            elif kind == "unbounded":
-                # The reversed dead load is carried whatever its size (blocks wedged under a
-                # fixed block): the check cannot tell.
-                carried, status, reason = (
-                    None,
-                    "undetermined",
-                    "the dead-load check could not tell: the reversed dead load is carried whatever its size "
-                    f"(blocks wedged under fixed ones). voussoir: {e}",
-                )
-            else:
-                raise
+        # Only the dead load: is it carried? voussoir.limit answers that with no live load:
+        # the forces of an admissible state when it is, the blocks that fall when not.
+        r = vs.limit(m, [], **options)
         meta.update(
             {
                 "multiplier": None,
-                "status": status,
-                "carries_dead_load": carried,
-                "mechanism": None,
-                "hinges": [],
+                "status": r["status"],
+                "iterations": r["iterations"],
+                "carries_dead_load": r["carries_dead_load"],
                 "dead_load_only": True,
             }
         )
-        if reason is not None:
-            meta["reason"] = reason
+        if r["carries_dead_load"]:
+            meta["mechanism"] = None
+            return from_limit(problem, model, conv, r, meta, centre=centre)
+        meta.update({"reason": r["reason"], "mechanism": _mechanism(conv, r), "hinges": []})
         return without_forces(problem, model, conv, meta)
 
     try:
         r = vs.limit(m, loads, check_dead_load=bool(check_dead_load), **options)
-    except vs.VoussoirError as e:
-        if _limit_failure(e) != "infeasible":
-            raise
+    except vs.LimitInfeasibleError as e:
         meta.update(
             {
                 "multiplier": None,
@@ -555,16 +474,22 @@ def _limit(problem, model, conv, meta, *, live, fixity, friction, facets, check_
             "status": r["status"],
             "iterations": r["iterations"],
             "carries_dead_load": r["carries_dead_load"],
-            "mechanism": {
-                conv.node[i]: {
-                    "velocity": r["blocks"]["velocity"][i].tolist(),
-                    "angular_velocity": r["blocks"]["angular_velocity"][i].tolist(),
-                }
-                for i in conv.node
-            },
+            "mechanism": _mechanism(conv, r),
         }
     )
     return from_limit(problem, model, conv, r, meta, centre=centre)
+
+
+def _mechanism(conv, r):
+    """Per graph node, the block's ``velocity`` and ``angular_velocity`` in a
+    ``voussoir.limit`` answer's mechanism."""
+    return {
+        conv.node[i]: {
+            "velocity": r["blocks"]["velocity"][i].tolist(),
+            "angular_velocity": r["blocks"]["angular_velocity"][i].tolist(),
+        }
+        for i in conv.node
+    }
 
 
 def _ground_motion(ground_motion):
@@ -669,12 +594,14 @@ def _check_run_arguments(**values):
 
     for name in ("duration", "ratio", "ramp_time", "contact_tolerance", "mechanism_scale"):
         v = values[name]
+        if v is None and name == "contact_tolerance":
+            continue  # voussoir's default
         if not number(v) or v <= 0:
             raise ValueError(f"{name} = {v!r}: a positive, finite number expected")
     for name in ("max_steps", "subcontacts_per_edge", "max_iterations", "history_every"):
         v = values[name]
-        if v is None and name == "history_every":
-            continue
+        if v is None and name in ("history_every", "subcontacts_per_edge"):
+            continue  # every step / voussoir's default
         if not integer(v) or v <= 0:
             raise ValueError(f"{name} = {v!r}: a positive integer expected")
     v = values["facets"]

@@ -17,7 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use voussoir::block::{Block, BlockId, Wrench};
 use voussoir::contact::DisplacementMode;
-use voussoir::geometry::SubcontactDensity;
+use voussoir::geometry::SubContactDensity;
 use voussoir::integrate::{Damping, TimeStep};
 use voussoir::law::{AnyLaw, MaterialId};
 use voussoir::model::{InterruptCheck, Model, ModelParameters};
@@ -139,8 +139,10 @@ fn material(k: &Int, what: &str) -> PyResult<MaterialId> {
 #[pymethods]
 impl PyModel {
     #[new]
-    #[pyo3(signature = (*, gravity=None, contact_tolerance=1e-3, subcontacts_per_edge=15, subcontact_spacing=None,
-        time_step=None, safety=0.5, mode="large", max_speed=1000.0, impact_step=Some(0.1)))]
+    #[pyo3(signature = (*, gravity=None, contact_tolerance=ModelParameters::default().contact.tolerance,
+        subcontacts_per_edge=i64::from(voussoir::geometry::DEFAULT_SUBCONTACTS_PER_EDGE), subcontact_spacing=None,
+        time_step=None, safety=voussoir::integrate::DEFAULT_SAFETY, mode="large",
+        max_speed=ModelParameters::default().max_speed, impact_step=ModelParameters::default().impact_step))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         gravity: Option<&Bound<'_, PyAny>>,
@@ -161,8 +163,8 @@ impl PyModel {
         }
         params.contact.tolerance = contact_tolerance;
         params.contact.density = match subcontact_spacing {
-            Some(h) => SubcontactDensity::Spacing(h),
-            None => SubcontactDensity::PerEdge(subcontacts_per_edge),
+            Some(h) => SubContactDensity::Spacing(h),
+            None => SubContactDensity::PerEdge(subcontacts_per_edge),
         };
         params.time_step = match time_step {
             Some(dt) => TimeStep::Fixed(dt),
@@ -176,6 +178,39 @@ impl PyModel {
         params.max_speed = max_speed;
         params.impact_step = impact_step;
         Ok(Self::wrap(Model::new(params).py()?))
+    }
+
+    /// The constructor's defaults, from the Rust library's ``ModelParameters::default()`` (the
+    /// one place they are written): ``gravity``, ``contact_tolerance``,
+    /// ``subcontacts_per_edge``, ``safety``, ``mode``, ``max_speed``, ``impact_step``.
+    ///
+    /// >>> import voussoir as vs
+    /// >>> vs.Model.defaults()["subcontacts_per_edge"]
+    /// 15
+    #[staticmethod]
+    fn defaults(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
+        let p = ModelParameters::default();
+        let d = pyo3::types::PyDict::new(py);
+        d.set_item("gravity", (p.gravity.x, p.gravity.y, p.gravity.z))?;
+        d.set_item("contact_tolerance", p.contact.tolerance)?;
+        d.set_item("subcontacts_per_edge", voussoir::geometry::DEFAULT_SUBCONTACTS_PER_EDGE)?;
+        d.set_item(
+            "safety",
+            match p.time_step {
+                TimeStep::Auto { safety } => safety,
+                TimeStep::Fixed(_) => voussoir::integrate::DEFAULT_SAFETY,
+            },
+        )?;
+        d.set_item(
+            "mode",
+            match p.mode {
+                DisplacementMode::Large => "large",
+                DisplacementMode::Small => "small",
+            },
+        )?;
+        d.set_item("max_speed", p.max_speed)?;
+        d.set_item("impact_step", p.impact_step)?;
+        Ok(d)
     }
 
     // ---- building -------------------------------------------------------------------------

@@ -286,8 +286,9 @@ impl PyModel {
     }
 
     /// The energy terms (J) as a dict: ``kinetic``, ``initial_kinetic``, ``elastic``,
-    /// ``gravity_work``, ``load_work``, ``boundary_work``, ``friction``, ``damping``,
-    /// ``joint_work``, and ``input``, ``accounted``, ``balance_error``.
+    /// ``gravity_work``, ``load_work``, ``boundary_work``, ``friction``, ``fracture`` (the
+    /// fracture energy softening joints consumed), ``damping``, ``joint_work``, and ``input``,
+    /// ``accounted``, ``balance_error``.
     fn energies<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let this = self.lock(py);
         let e = this.model.energies();
@@ -300,6 +301,7 @@ impl PyModel {
             ("load_work", e.load_work),
             ("boundary_work", e.boundary_work),
             ("friction", e.friction),
+            ("fracture", e.fracture),
             ("damping", e.damping),
             ("joint_work", e.joint_work),
             ("input", e.input()),

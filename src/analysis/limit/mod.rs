@@ -14,6 +14,12 @@
 //! [`LimitResult::classify`] reads as hinges and sliding joints in the terms of
 //! [`classify_joints`](super::classify_joints).
 //!
+//! Without a live load the programme answers the dead-load question alone
+//! ([`LimitProblem::dead_load`], or [`LimitProblem::analyse`] with no live load or live loads of
+//! zero force): whether the blocks carry their own weight, with the contact forces of an
+//! admissible state (e.g. to draw the thrust line) when they do, and the blocks that fall (a
+//! mechanism of the dead loads) when they do not ([`DeadLoadResult`]; no multiplier).
+//!
 //! The flow rule of this (associative) formulation is dilatant: a sliding corner opens at
 //! `μ` times its slip rate. The DEM's Coulomb joints slide without dilatancy; by Radenković's
 //! theorem the associative limit load bounds the non-associative one from above.
@@ -56,7 +62,7 @@ use crate::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, LinearElastic};
 use crate::math::{Real, Vector};
 use crate::model::Model;
 use programme::{Corner, Programme, Scales, Solution, Triplets};
-pub use result::{BlockMotion, JointMotion, LimitContact, LimitResult, LimitVertex};
+pub use result::{BlockMotion, DeadLoadResult, JointMotion, LimitAnswer, LimitContact, LimitResult, LimitVertex};
 
 /// The strength of a joint in limit analysis: the Coulomb cone `‖t‖ ≤ μ n + c A` over its area
 /// `A`, with no tension.
@@ -135,6 +141,7 @@ impl LimitStrength for AnyLaw {
     fn limit_strength(&self) -> Option<JointStrength> {
         match self {
             AnyLaw::Coulomb(law) => law.limit_strength(),
+            AnyLaw::Mortar(law) => law.limit_strength(),
             AnyLaw::Elastic(law) => law.limit_strength(),
         }
     }
@@ -356,13 +363,16 @@ impl LimitProblem {
     ///
     /// # Errors
     /// [`Error::UnknownBlock`] or [`Error::NonFinite`] for a bad live load,
-    /// [`Error::InvalidParameter`] for a zero live load or a pyramid of fewer than 3 facets;
+    /// [`Error::InvalidParameter`] for no live load or a zero one (ask the dead-load question
+    /// with [`LimitProblem::dead_load`] or [`LimitProblem::analyse`]) or a pyramid of fewer
+    /// than 3 facets;
     /// [`Error::LimitInfeasible`] when the dead loads are not carried (no admissible `λ`, or
     /// only negative ones, or — with [`LimitOptions::check_dead_load`] — only positive ones);
     /// [`Error::LimitUnbounded`] when `λ` has no bound; [`Error::LimitSolver`] when Clarabel
     /// stops without an answer.
     pub fn solve(&self, live: &[LiveLoad], options: &LimitOptions) -> Result<LimitResult> {
-        self.check_live(live)?;
+        let total = self.check_live(live)?;
+        self.check_live_size(live, total)?;
         let scales = self.scales(live);
         let programme = self.assemble(Some(live), options.friction, &scales)?;
         let (solution, status, iterations) = programme.run(options.max_iterations)?;
@@ -414,35 +424,126 @@ impl LimitProblem {
         Ok(self.result(&programme, &solution, &scales, multiplier, status, iterations))
     }
 
-    /// Whether the dead loads alone are carried: whether contact forces within the joints'
-    /// strength equilibrate every free block under gravity and the blocks' constant loads.
-    /// (The structure "can carry its own weight".)
+    /// The collapse multiplier of `live` ([`LimitProblem::solve`]) or, when there is no live
+    /// load (an empty slice, or live loads whose forces are all zero), the dead-load question
+    /// alone ([`LimitProblem::dead_load`]): one entry point for a caller whose live load may be
+    /// empty. The dead-load answer is an answer, not an error, whether carried or not.
+    ///
+    /// ```
+    /// use voussoir::analysis::limit::{LimitAnswer, LimitOptions, LimitProblem};
+    /// use voussoir::prelude::*;
+    ///
+    /// let mut model: Model = Model::new(ModelParameters::default())?;
+    /// model.set_joint_law(MaterialId(0), MaterialId(0), CoulombSlip::dry(1e9, 4e8, 30.0)?)?;
+    /// model.add_block(
+    ///     RigidBlock::cuboid("base", Vector::new(-1.0, -1.0, -0.2), Vector::new(1.0, 1.0, 0.0), 2500.0)?
+    ///         .with_fixity(Fixity::FIXED),
+    /// )?;
+    /// model.add_block(RigidBlock::cuboid("cube", Vector::ZERO, Vector::splat(0.2), 2500.0)?)?;
+    /// model.step()?;
+    /// let answer = LimitProblem::from_model(&model)?.analyse(&[], &LimitOptions::default())?;
+    /// assert_eq!(answer.multiplier(), None);
+    /// let LimitAnswer::DeadLoad(dead) = answer else { unreachable!() };
+    /// assert!(dead.carried);
+    /// // The base holds the cube up with its weight.
+    /// let weight = 2500.0 * 0.008 * 9.81;
+    /// assert!((dead.contacts[0].resultant().z - weight).abs() < 1e-6 * weight);
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    ///
+    /// # Errors
+    /// [`Error::UnknownBlock`] or [`Error::NonFinite`] for a bad live load; otherwise as
+    /// [`LimitProblem::solve`] with a live load and [`LimitProblem::dead_load`] without.
+    pub fn analyse(&self, live: &[LiveLoad], options: &LimitOptions) -> Result<LimitAnswer> {
+        if self.check_live(live)? > 0.0 {
+            self.solve(live, options).map(LimitAnswer::Collapse)
+        } else {
+            self.dead_load(options).map(LimitAnswer::DeadLoad)
+        }
+    }
+
+    /// Whether the dead loads alone (gravity and the blocks' constant loads) are carried:
+    /// whether contact forces within the joints' strength equilibrate every free block (the
+    /// structure "can carry its own weight"). When they are, the contact forces of one such
+    /// state; when not, the solver's certificate, a mechanism of the dead loads
+    /// ([`DeadLoadResult`]). A structure that does not stand is an answer (`carried` false),
+    /// not an error.
     ///
     /// # Errors
     /// [`Error::InvalidParameter`] for a pyramid of fewer than 3 facets; [`Error::LimitSolver`]
     /// when Clarabel stops without an answer or a certificate.
-    pub fn carries_dead_load(&self, options: &LimitOptions) -> Result<bool> {
+    pub fn dead_load(&self, options: &LimitOptions) -> Result<DeadLoadResult> {
         let scales = self.scales(&[]);
         let programme = self.assemble(None, options.friction, &scales)?;
-        let (_, status, iterations) = programme.run(options.max_iterations)?;
-        match status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(true),
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => Ok(false),
-            other => Err(Error::LimitSolver {
-                status: format!("{other:?}"),
+        let (solution, status, iterations) = programme.run(options.max_iterations)?;
+        let carried = match status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => true,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => false,
+            other => {
+                return Err(Error::LimitSolver {
+                    status: format!("{other:?}"),
+                    iterations,
+                })
+            }
+        };
+        let status = format!("{status:?}");
+        if carried {
+            let (contacts, blocks) = self.state(&programme, Some(&solution.x), None, &scales);
+            return Ok(DeadLoadResult {
+                carried,
+                contacts,
+                blocks,
+                status,
                 iterations,
-            }),
-        }
-    }
-
-    fn check_live(&self, live: &[LiveLoad]) -> Result<()> {
-        if live.is_empty() {
-            return Err(Error::InvalidParameter {
-                name: "live loads (count)".into(),
-                value: 0.0,
-                expected: "at least one live load",
+                reason: None,
             });
         }
+        // The certificate of infeasibility: velocities on which the dead loads do more work
+        // than the joints can dissipate. Scaled so that the dead loads' power is the
+        // reference force (the free blocks' weight).
+        let power: Real = self
+            .blocks
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                let dual = |d: usize| programme.row_of[6 * k + d].map_or(0.0, |r| solution.z[r]);
+                b.dead_force.dot(Vector::new(dual(0), dual(1), dual(2)))
+                    + b.dead_moment.dot(Vector::new(dual(3), dual(4), dual(5))) / scales.length
+            })
+            .sum();
+        let factor = scales.force / power;
+        let z: Vec<Real> = if factor.is_finite() && factor > 0.0 {
+            solution.z.iter().map(|v| v * factor).collect()
+        } else {
+            vec![0.0; solution.z.len()]
+        };
+        let (contacts, blocks) = self.state(&programme, None, Some(&z), &scales);
+        let reason = format!(
+            "no contact forces within the joints' strength hold every free block in equilibrium under the dead \
+             loads (gravity and the blocks' constant loads); in the solver's certificate, a mechanism of them, {}",
+            describe_motion(&blocks, &self.blocks)
+        );
+        Ok(DeadLoadResult {
+            carried,
+            contacts,
+            blocks,
+            status,
+            iterations,
+            reason: Some(reason),
+        })
+    }
+
+    /// Whether the dead loads alone are carried: [`LimitProblem::dead_load`]'s
+    /// [`carried`](DeadLoadResult::carried).
+    ///
+    /// # Errors
+    /// As [`LimitProblem::dead_load`].
+    pub fn carries_dead_load(&self, options: &LimitOptions) -> Result<bool> {
+        Ok(self.dead_load(options)?.carried)
+    }
+
+    /// Checks the live loads' blocks and numbers; returns the sum of their magnitudes (N).
+    fn check_live(&self, live: &[LiveLoad]) -> Result<Real> {
         for (k, l) in live.iter().enumerate() {
             if l.block.index() >= self.blocks.len() {
                 return Err(Error::UnknownBlock {
@@ -456,12 +557,25 @@ impl LimitProblem {
                 });
             }
         }
-        let total: Real = live.iter().map(|l| norm(l.force)).sum();
+        Ok(live.iter().map(|l| norm(l.force)).sum())
+    }
+
+    /// Checks that the live loads (of magnitudes summing to `total`) make a multiplier.
+    fn check_live_size(&self, live: &[LiveLoad], total: Real) -> Result<()> {
+        if live.is_empty() {
+            return Err(Error::InvalidParameter {
+                name: "live loads (count)".into(),
+                value: 0.0,
+                expected: "at least one live load (without one, LimitProblem::dead_load or LimitProblem::analyse \
+                           answers whether the dead loads are carried)",
+            });
+        }
         if total <= 0.0 {
             return Err(Error::InvalidParameter {
                 name: "live load force".into(),
                 value: total,
-                expected: "must not be zero",
+                expected: "must not be zero (without a live load, LimitProblem::dead_load or \
+                           LimitProblem::analyse answers whether the dead loads are carried)",
             });
         }
         // λ is in units of the live load: the reference force over it must be a number.
@@ -658,12 +772,35 @@ impl LimitProblem {
         status: SolverStatus,
         iterations: u32,
     ) -> LimitResult {
+        let (contacts, blocks) = self.state(programme, Some(&solution.x), Some(&solution.z), sc);
+        LimitResult {
+            multiplier,
+            contacts,
+            blocks,
+            status: format!("{status:?}"),
+            iterations,
+        }
+    }
+
+    /// The contacts' corner forces from the primal variables `x` (zero without) and the
+    /// blocks' motion from the equilibrium rows' duals `z` (zero without), with each corner's
+    /// relative motion.
+    fn state(
+        &self,
+        programme: &Programme,
+        x: Option<&[Real]>,
+        z: Option<&[Real]>,
+        sc: &Scales,
+    ) -> (Vec<LimitContact>, Vec<BlockMotion>) {
         let blocks: Vec<BlockMotion> = self
             .blocks
             .iter()
             .enumerate()
             .map(|(k, b)| {
-                let dual = |d: usize| programme.row_of[6 * k + d].map_or(0.0, |r| solution.z[r]);
+                let dual = |d: usize| match (programme.row_of[6 * k + d], z) {
+                    (Some(r), Some(z)) => z[r],
+                    _ => 0.0,
+                };
                 BlockMotion {
                     centroid: b.centroid,
                     velocity: Vector::new(dual(0), dual(1), dual(2)),
@@ -684,26 +821,21 @@ impl LimitProblem {
                 vertices: Vec::with_capacity(c.vertices.len()),
             })
             .collect();
+        let value = |i: usize| x.map_or(0.0, |x| x[i]);
         for corner in &programme.corners {
             let c = &self.contacts[corner.contact];
-            let (t1, t2) = corner.t.map_or((0.0, 0.0), |(i, j)| (solution.x[i], solution.x[j]));
+            let (t1, t2) = corner.t.map_or((0.0, 0.0), |(i, j)| (value(i), value(j)));
             let rel = velocity_at(c.b, corner.point) - velocity_at(c.a, corner.point);
             let opening = c.normal.dot(rel);
             contacts[corner.contact].vertices.push(LimitVertex {
                 point: corner.point,
-                normal_force: solution.x[corner.n] * sc.force,
+                normal_force: value(corner.n) * sc.force,
                 shear_force: (c.t1 * t1 + c.t2 * t2) * sc.force,
                 opening,
                 sliding: (rel - c.normal * opening).length(),
             });
         }
-        LimitResult {
-            multiplier,
-            contacts,
-            blocks,
-            status: format!("{status:?}"),
-            iterations,
-        }
+        (contacts, blocks)
     }
 }
 
@@ -759,4 +891,36 @@ fn describe_live(live: &[LiveLoad], blocks: &[BlockData]) -> String {
         })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// The blocks that move most in a mechanism (speed of the centroid plus the angular speed
+/// times the block's radius, beyond 1e-3 of the fastest), fastest first, at most eight.
+fn describe_motion(motion: &[BlockMotion], blocks: &[BlockData]) -> String {
+    let mut speeds: Vec<(usize, Real)> = motion
+        .iter()
+        .zip(blocks)
+        .enumerate()
+        .map(|(k, (m, b))| (k, m.velocity.length() + m.angular_velocity.length() * b.radius))
+        .collect();
+    let fastest = speeds.iter().map(|s| s.1).fold(0.0, Real::max);
+    if !(fastest > 0.0 && fastest.is_finite()) {
+        return "no block moves (the solver's certificate is empty)".into();
+    }
+    speeds.retain(|s| s.1 > 1e-3 * fastest);
+    speeds.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    let count = speeds.len();
+    let mut text = speeds
+        .iter()
+        .take(8)
+        .map(|&(k, _)| format!("{} ({:?})", BlockId(k as u32), blocks[k].name))
+        .collect::<Vec<_>>()
+        .join(", ");
+    if count > 8 {
+        text.push_str(&format!(" and {} more", count - 8));
+    }
+    format!(
+        "block{} {text} move{}",
+        if count == 1 { "" } else { "s" },
+        if count == 1 { "s" } else { "" }
+    )
 }

@@ -77,14 +77,16 @@ impl Programme {
                 (true, true) => SolverStatus::DualInfeasible,
                 (true, false) => SolverStatus::Solved,
             };
-            return Ok((
-                Solution {
-                    x: vec![0.0; n],
-                    z: vec![0.0; self.b.len()],
-                },
-                status,
-                0,
-            ));
+            // Infeasible: the unbalanced loads themselves are the certificate (`z = −b` on the
+            // equilibrium rows; `Aᵀz = 0` with no variable, `bᵀz < 0`), the free blocks moving
+            // along their dead loads.
+            let mut z = vec![0.0; self.b.len()];
+            if !carried {
+                for (z, b) in z.iter_mut().zip(&self.b[..self.equations]) {
+                    *z = -b;
+                }
+            }
+            return Ok((Solution { x: vec![0.0; n], z }, status, 0));
         }
         let p = CscMatrix::zeros((n, n));
         let settings = DefaultSettings {

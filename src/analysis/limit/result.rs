@@ -1,5 +1,6 @@
 //! The answer of a limit analysis: the multiplier, the contact forces at collapse and the
-//! mechanism (the blocks' virtual velocities), read as hinges and sliding joints.
+//! mechanism (the blocks' virtual velocities), read as hinges and sliding joints; or, with no
+//! live load, whether the dead loads are carried.
 
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
@@ -102,32 +103,24 @@ pub struct LimitResult {
 impl LimitResult {
     /// Velocity and angular velocity of `block` in the mechanism, `None` for an unknown id.
     pub fn block_velocity(&self, block: BlockId) -> Option<(Vector, Vector)> {
-        self.blocks.get(block.index()).map(|m| (m.velocity, m.angular_velocity))
+        block_velocity(&self.blocks, block)
     }
 
     /// Velocity of the material point of `block` at `point` (world) in the mechanism.
     pub fn point_velocity(&self, block: BlockId, point: Vector) -> Option<Vector> {
-        self.blocks
-            .get(block.index())
-            .map(|m| m.velocity + m.angular_velocity.cross(point - m.centroid))
+        point_velocity(&self.blocks, block, point)
     }
 
     /// The rigid motion of `block` after advancing the mechanism by `t`: a turn by `ω t` about
     /// its centroid and a translation by `v t`, to put on top of the block's pose (a frame of
     /// the mechanism for ParaView). The identity for an unknown id.
     pub fn displacement(&self, block: BlockId, t: Real) -> Pose {
-        let Some(m) = self.blocks.get(block.index()) else {
-            return Pose::IDENTITY;
-        };
-        let rotation = Rotation::from_scaled_axis(m.angular_velocity * t);
-        // x ↦ c + v t + R (x − c)
-        Pose::from_parts(m.centroid + m.velocity * t - rotation * m.centroid, rotation)
+        displacement(&self.blocks, block, t)
     }
 
     /// The contact between `a` and `b` (either order).
     pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<&LimitContact> {
-        let key = (a.min(b), a.max(b));
-        self.contacts.iter().find(|c| c.blocks == key)
+        contact_between(&self.contacts, a, b)
     }
 
     /// Names the mechanism's hinges and sliding joints at `joints`, as
@@ -217,4 +210,145 @@ impl LimitResult {
         }
         (motions, mechanism)
     }
+}
+
+/// The answer of [`LimitProblem::dead_load`](super::LimitProblem::dead_load): whether the dead
+/// loads alone (gravity and the blocks' constant loads, no live load) are carried, with the
+/// contact forces of a statically admissible state when they are, and a collapse mechanism
+/// when they are not.
+///
+/// Nothing in it is NaN: a state that does not exist is zeros (the forces of a structure that
+/// falls, the motion of one that stands).
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub struct DeadLoadResult {
+    /// Whether contact forces within the joints' strength hold every free block in
+    /// equilibrium under the dead loads.
+    pub carried: bool,
+    /// The contacts. Carried: the corner forces of one statically admissible state (the
+    /// interior-point solver's, towards the middle of the admissible set; not unique where the
+    /// structure is hyperstatic), with zero opening and sliding rates; they balance the dead
+    /// loads to round-off (1e-14 of the weight measured). Not carried: zero forces and the
+    /// certificate's opening and sliding rates at the corners.
+    pub contacts: Vec<LimitContact>,
+    /// Per block of the model, in order. Not carried: its motion in the solver's certificate
+    /// that no admissible state exists, a mechanism of the dead loads (kinematically
+    /// admissible: at every corner the joint opens by at least `μ` times its slip; the dead
+    /// loads do positive work on it, more than the joints' cohesion can dissipate), scaled so
+    /// that the dead loads' power is the free blocks' weight (`Σ W`: under gravity alone the
+    /// centroids sink at unit speed, weighted by weight). Which blocks fall and which way, but
+    /// not a collapse mechanism to read hinges from: where several mechanisms exist (an arch
+    /// too thin has many) the interior-point certificate is a blend of them. Carried: zero
+    /// motion.
+    pub blocks: Vec<BlockMotion>,
+    /// Clarabel's status: `Solved` or `AlmostSolved` when carried, `PrimalInfeasible` or
+    /// `AlmostPrimalInfeasible` when not.
+    pub status: String,
+    /// Interior-point iterations.
+    pub iterations: u32,
+    /// Why the dead loads are not carried (naming the blocks that move most in the
+    /// certificate); `None` when they are.
+    pub reason: Option<String>,
+}
+
+impl DeadLoadResult {
+    /// Velocity and angular velocity of `block` in the mechanism (zero when carried), `None`
+    /// for an unknown id.
+    pub fn block_velocity(&self, block: BlockId) -> Option<(Vector, Vector)> {
+        block_velocity(&self.blocks, block)
+    }
+
+    /// Velocity of the material point of `block` at `point` (world) in the mechanism.
+    pub fn point_velocity(&self, block: BlockId, point: Vector) -> Option<Vector> {
+        point_velocity(&self.blocks, block, point)
+    }
+
+    /// The rigid motion of `block` after advancing the mechanism by `t`, as
+    /// [`LimitResult::displacement`].
+    pub fn displacement(&self, block: BlockId, t: Real) -> Pose {
+        displacement(&self.blocks, block, t)
+    }
+
+    /// The contact between `a` and `b` (either order).
+    pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<&LimitContact> {
+        contact_between(&self.contacts, a, b)
+    }
+}
+
+/// The answer of [`LimitProblem::analyse`](super::LimitProblem::analyse): the collapse
+/// multiplier of a live load, or, with no live load (none, or all of zero force), the answer
+/// to the dead-load question alone.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub enum LimitAnswer {
+    /// The live load's collapse multiplier, forces at collapse and mechanism.
+    Collapse(LimitResult),
+    /// No live load: whether the dead loads are carried.
+    DeadLoad(DeadLoadResult),
+}
+
+impl LimitAnswer {
+    /// The collapse multiplier; `None` for the dead-load question.
+    pub fn multiplier(&self) -> Option<Real> {
+        match self {
+            Self::Collapse(r) => Some(r.multiplier),
+            Self::DeadLoad(_) => None,
+        }
+    }
+
+    /// The contacts with their corner forces and the mechanism's rates.
+    pub fn contacts(&self) -> &[LimitContact] {
+        match self {
+            Self::Collapse(r) => &r.contacts,
+            Self::DeadLoad(r) => &r.contacts,
+        }
+    }
+
+    /// Per block, its motion in the mechanism.
+    pub fn blocks(&self) -> &[BlockMotion] {
+        match self {
+            Self::Collapse(r) => &r.blocks,
+            Self::DeadLoad(r) => &r.blocks,
+        }
+    }
+
+    /// Clarabel's status.
+    pub fn status(&self) -> &str {
+        match self {
+            Self::Collapse(r) => &r.status,
+            Self::DeadLoad(r) => &r.status,
+        }
+    }
+
+    /// Interior-point iterations.
+    pub fn iterations(&self) -> u32 {
+        match self {
+            Self::Collapse(r) => r.iterations,
+            Self::DeadLoad(r) => r.iterations,
+        }
+    }
+}
+
+fn block_velocity(blocks: &[BlockMotion], block: BlockId) -> Option<(Vector, Vector)> {
+    blocks.get(block.index()).map(|m| (m.velocity, m.angular_velocity))
+}
+
+fn point_velocity(blocks: &[BlockMotion], block: BlockId, point: Vector) -> Option<Vector> {
+    blocks
+        .get(block.index())
+        .map(|m| m.velocity + m.angular_velocity.cross(point - m.centroid))
+}
+
+fn displacement(blocks: &[BlockMotion], block: BlockId, t: Real) -> Pose {
+    let Some(m) = blocks.get(block.index()) else {
+        return Pose::IDENTITY;
+    };
+    let rotation = Rotation::from_scaled_axis(m.angular_velocity * t);
+    // x ↦ c + v t + R (x − c)
+    Pose::from_parts(m.centroid + m.velocity * t - rotation * m.centroid, rotation)
+}
+
+fn contact_between(contacts: &[LimitContact], a: BlockId, b: BlockId) -> Option<&LimitContact> {
+    let key = (a.min(b), a.max(b));
+    contacts.iter().find(|c| c.blocks == key)
 }

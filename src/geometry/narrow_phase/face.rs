@@ -33,7 +33,7 @@ pub(super) fn face_face(
     kept_host: Option<bool>,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
-    seeds: &mut Vec<SubcontactSeed>,
+    seeds: &mut Vec<SubContactSeed>,
 ) -> Option<DetectedContact> {
     let smaller_is_a = a.shape.faces()[fa].area <= b.shape.faces()[fb].area;
     if let Some(host_is_a) = kept_host {
@@ -76,7 +76,7 @@ pub(super) fn face_face_hosted(
     cover: Real,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
-    seeds: &mut Vec<SubcontactSeed>,
+    seeds: &mut Vec<SubContactSeed>,
 ) -> Hosted {
     let (host, fh, other, fo) = if host_is_a { (a, fa, b, fb) } else { (b, fb, a, fa) };
     let face = &host.shape.faces()[fh];
@@ -157,8 +157,8 @@ pub(super) fn face_face_hosted(
     // the outer nodes on its boundary (trapezoidal rule), so that a joint opening about an edge
     // hinges on that edge. Each node carries the overlap within its tributary cell.
     let (nu, nv) = match params.density {
-        SubcontactDensity::PerEdge(k) => (k as u32, k as u32),
-        SubcontactDensity::Spacing(h) => (
+        SubContactDensity::PerEdge(k) => (k as u32, k as u32),
+        SubContactDensity::Spacing(h) => (
             ((size.x / h).ceil() as u32).max(1) + 1,
             ((size.y / h).ceil() as u32).max(1) + 1,
         ),
@@ -206,7 +206,7 @@ pub(super) fn face_face_hosted(
                 let (jx, jy) = second_moments(&scratch.cell, centroid);
                 let half = DVec2::new((3.0 * jx / area).max(0.0).sqrt(), (3.0 * jy / area).max(0.0).sqrt());
                 let at = centroid;
-                seeds.push(SubcontactSeed {
+                seeds.push(SubContactSeed {
                     key,
                     anchor: origin + u * at.x + v * at.y,
                     area,

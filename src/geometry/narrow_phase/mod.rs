@@ -22,10 +22,24 @@ pub(crate) use face::{face_frame, PARALLEL_ANGLE};
 use hull::hull2d;
 use nodes::node_contact;
 
+/// The former name of [`SubContactDensity`] (sub-contact types are spelt `SubContact…`).
+///
+/// ```
+/// #[allow(deprecated)]
+/// let d: voussoir::geometry::SubcontactDensity = voussoir::geometry::SubContactDensity::PerEdge(5);
+/// # let _ = d;
+/// ```
+#[deprecated(since = "0.1.0", note = "renamed SubContactDensity")]
+pub type SubcontactDensity = SubContactDensity;
+
+/// The former name of [`SubContactSeed`].
+#[deprecated(since = "0.1.0", note = "renamed SubContactSeed")]
+pub type SubcontactSeed = SubContactSeed;
+
 /// How densely joint faces are covered with sub-contacts.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub enum SubcontactDensity {
+pub enum SubContactDensity {
     /// `n` sub-contacts along each edge of the host face's bounding rectangle (`n × n` cells);
     /// the reference paper uses 15.
     PerEdge(u16),
@@ -34,23 +48,23 @@ pub enum SubcontactDensity {
     Spacing(Real),
 }
 
-impl SubcontactDensity {
+impl SubContactDensity {
     /// The grid with its cells halved along each edge: `2n − 1` nodes for `n` (3 for a single
     /// node), at most [`MAX_SUBCONTACTS_PER_EDGE`]; half the spacing.
     ///
     /// ```
-    /// use voussoir::geometry::SubcontactDensity;
-    /// assert_eq!(SubcontactDensity::PerEdge(15).refined(), SubcontactDensity::PerEdge(29));
-    /// assert_eq!(SubcontactDensity::Spacing(0.02).refined(), SubcontactDensity::Spacing(0.01));
+    /// use voussoir::geometry::SubContactDensity;
+    /// assert_eq!(SubContactDensity::PerEdge(15).refined(), SubContactDensity::PerEdge(29));
+    /// assert_eq!(SubContactDensity::Spacing(0.02).refined(), SubContactDensity::Spacing(0.01));
     /// ```
     pub fn refined(&self) -> Self {
         match *self {
-            SubcontactDensity::PerEdge(n) => SubcontactDensity::PerEdge(if n < 2 {
+            SubContactDensity::PerEdge(n) => SubContactDensity::PerEdge(if n < 2 {
                 3
             } else {
                 (2 * n - 1).min(MAX_SUBCONTACTS_PER_EDGE)
             }),
-            SubcontactDensity::Spacing(h) => SubcontactDensity::Spacing(0.5 * h),
+            SubContactDensity::Spacing(h) => SubContactDensity::Spacing(0.5 * h),
         }
     }
 
@@ -70,19 +84,19 @@ impl SubcontactDensity {
     ///
     /// # Example
     /// ```
-    /// use voussoir::geometry::SubcontactDensity;
+    /// use voussoir::geometry::SubContactDensity;
     /// // A stand-in for an analysis whose answer drifts with the cell size.
-    /// let load = |d: SubcontactDensity| match d {
-    ///     SubcontactDensity::PerEdge(n) => Ok::<_, voussoir::Error>(1000.0 * (1.0 + 0.1 / n as f64)),
-    ///     SubcontactDensity::Spacing(_) => unreachable!(),
+    /// let load = |d: SubContactDensity| match d {
+    ///     SubContactDensity::PerEdge(n) => Ok::<_, voussoir::Error>(1000.0 * (1.0 + 0.1 / n as f64)),
+    ///     SubContactDensity::Spacing(_) => unreachable!(),
     /// };
-    /// let c = SubcontactDensity::PerEdge(15).check_convergence(load)?;
+    /// let c = SubContactDensity::PerEdge(15).check_convergence(load)?;
     /// assert!(c.converged(0.005) && !c.converged(0.002));
     /// # Ok::<(), voussoir::Error>(())
     /// ```
     pub fn check_convergence<F>(&self, run: F) -> Result<crate::math::Convergence>
     where
-        F: Fn(SubcontactDensity) -> Result<Real> + Sync,
+        F: Fn(SubContactDensity) -> Result<Real> + Sync,
     {
         let (value, refined) = rayon::join(|| run(*self), || run(self.refined()));
         Ok(crate::math::Convergence {
@@ -132,8 +146,11 @@ pub struct ContactParameters {
     /// `docs/theory.md` §2.2).
     pub face_angle_tolerance: Real,
     /// Sub-contact density on joint faces. Default `PerEdge(15)` (the paper's value).
-    pub density: SubcontactDensity,
+    pub density: SubContactDensity,
 }
+
+/// The default sub-contacts per face edge ([`ContactParameters::default`]).
+pub const DEFAULT_SUBCONTACTS_PER_EDGE: u16 = 15;
 
 impl Default for ContactParameters {
     fn default() -> Self {
@@ -141,20 +158,20 @@ impl Default for ContactParameters {
             tolerance: 1e-3,
             redetect_fraction: 0.25,
             face_angle_tolerance: 15f64.to_radians(),
-            density: SubcontactDensity::PerEdge(15),
+            density: SubContactDensity::PerEdge(DEFAULT_SUBCONTACTS_PER_EDGE),
         }
     }
 }
 
 impl ContactParameters {
-    /// Checks that a [`SubcontactDensity::Spacing`] leaves at most
+    /// Checks that a [`SubContactDensity::Spacing`] leaves at most
     /// [`MAX_SUBCONTACTS_PER_EDGE`] sub-contacts along the faces of a block of circumradius
     /// `radius` (m), named `block` in the error.
     ///
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming the block.
     pub fn check_block(&self, radius: Real, block: &str) -> Result<()> {
-        if let SubcontactDensity::Spacing(h) = self.density {
+        if let SubContactDensity::Spacing(h) = self.density {
             let nodes = (2.0 * radius / h).ceil() + 1.0;
             if nodes.is_nan() || nodes > MAX_SUBCONTACTS_PER_EDGE as Real {
                 return Err(crate::Error::InvalidParameter {
@@ -191,7 +208,7 @@ impl ContactParameters {
             "must lie in [0, 5 pi/12) rad (75 degrees)",
         )?;
         match self.density {
-            SubcontactDensity::PerEdge(n) => {
+            SubContactDensity::PerEdge(n) => {
                 in_range(
                     "contact.density.per_edge",
                     n as Real,
@@ -200,7 +217,7 @@ impl ContactParameters {
                     "must lie in 1..=1000 (MAX_SUBCONTACTS_PER_EDGE)",
                 )?;
             }
-            SubcontactDensity::Spacing(h) => {
+            SubContactDensity::Spacing(h) => {
                 positive("contact.density.spacing", h)?;
             }
         }
@@ -265,7 +282,7 @@ pub struct PreviousContact {
 
 /// A sub-contact as created by detection.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SubcontactSeed {
+pub struct SubContactSeed {
     /// Identity within the pair.
     pub key: SubKey,
     /// Material point in the host block's body frame (m).
@@ -337,7 +354,7 @@ pub fn detect(
     previous: Option<PreviousContact>,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
-    seeds: &mut Vec<SubcontactSeed>,
+    seeds: &mut Vec<SubContactSeed>,
 ) -> Option<DetectedContact> {
     let axis = separating_axis(a, b, scratch);
     scratch.separation = axis.separation;
@@ -433,7 +450,7 @@ pub fn detect(
 /// comes down; its corner went 4.6 cm into the slab while the joint on the first face carried
 /// its weight with 0.05 mm overlaps (a sharp-block drop). Node contacts see every vertex and
 /// edge and are not asked.
-fn sees_the_overlap(seeds: &[SubcontactSeed], separation: Real, size: Real) -> bool {
+fn sees_the_overlap(seeds: &[SubContactSeed], separation: Real, size: Real) -> bool {
     if separation >= 0.0 {
         return true;
     }
@@ -503,7 +520,7 @@ fn near_coplanar_neighbour(
     fb: usize,
     params: &ContactParameters,
     scratch: &mut NarrowPhaseScratch,
-    seeds: &mut Vec<SubcontactSeed>,
+    seeds: &mut Vec<SubContactSeed>,
 ) -> bool {
     fn neighbours(shape: &Polyhedron, f: usize) -> impl Iterator<Item = usize> + '_ {
         let n = shape.faces()[f].normal;
@@ -601,9 +618,9 @@ fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut Nar
 }
 
 /// Characteristic sub-contact spacing for a pair (m), used for node contacts.
-fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubcontactDensity) -> Real {
+fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubContactDensity) -> Real {
     match density {
-        SubcontactDensity::Spacing(h) => h,
-        SubcontactDensity::PerEdge(n) => a.volume().cbrt().min(b.volume().cbrt()) / n as Real,
+        SubContactDensity::Spacing(h) => h,
+        SubContactDensity::PerEdge(n) => a.volume().cbrt().min(b.volume().cbrt()) / n as Real,
     }
 }

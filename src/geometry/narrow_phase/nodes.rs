@@ -412,7 +412,7 @@ fn push_nodes(
     on_b: bool,
     h: Real,
     tolerance: Real,
-    seeds: &mut Vec<SubcontactSeed>,
+    seeds: &mut Vec<SubContactSeed>,
 ) {
     let to_other = other.pose.inverse() * *host.pose;
     // Nodes farther than this from the other block's centroid cannot be within the tolerance.
@@ -421,7 +421,7 @@ fn push_nodes(
     let vertices = host.shape.vertices();
     let start = seeds.len();
     let mut areas = None;
-    let mut try_node = |place: NodePlace, seeds: &mut Vec<SubcontactSeed>| {
+    let mut try_node = |place: NodePlace, seeds: &mut Vec<SubContactSeed>| {
         let id = NodeId { on_b, place };
         let anchor = id.point(host.shape);
         let q = to_other.transform_point(anchor);
@@ -431,7 +431,7 @@ fn push_nodes(
         let (_, gap) = deepest_face(other.shape, q);
         if gap < tolerance {
             let areas = areas.get_or_insert_with(|| NodeAreas::of(host.shape, h));
-            seeds.push(SubcontactSeed {
+            seeds.push(SubContactSeed {
                 key: id.key(),
                 anchor,
                 area: areas.area(host.shape, place, h),
@@ -497,7 +497,7 @@ pub(super) fn node_contact(
     b: BlockGeometry<'_>,
     n: Vector,
     params: &ContactParameters,
-    seeds: &mut Vec<SubcontactSeed>,
+    seeds: &mut Vec<SubContactSeed>,
 ) -> Option<DetectedContact> {
     let h = spacing(a.shape, b.shape, params.density);
     let start = seeds.len();

@@ -5,7 +5,7 @@ use parry3d_f64::shape::Shape;
 use rayon::prelude::*;
 
 use super::changes::Changes;
-use super::pipeline::Pipeline;
+use super::Pipeline;
 use super::{ModelState, BLOCK_CHUNK};
 use crate::block::{Block, BlockId, RigidBlock};
 use crate::contact::DisplacementMode;
@@ -14,11 +14,11 @@ use crate::geometry::BroadPhase;
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Pose, Real};
 
+#[cfg(test)]
+mod detection_tests;
 mod pairs;
 mod splice;
 mod staging;
-#[cfg(test)]
-mod detection_tests;
 
 pub(crate) use pairs::TestedPair;
 use pairs::*;

@@ -4,7 +4,7 @@
 use crate::block::{Block, RigidBlock};
 use crate::contact::ContactPair;
 use crate::geometry::{
-    detect, BlockGeometry, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact, SubcontactSeed,
+    detect, BlockGeometry, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact, SubContactSeed,
 };
 use crate::math::{Pose, Real};
 
@@ -91,7 +91,7 @@ impl Default for Outcome {
 #[derive(Debug, Clone, Default)]
 pub(super) struct ChunkScratch {
     pub(super) narrow: NarrowPhaseScratch,
-    pub(super) seeds: Vec<SubcontactSeed>,
+    pub(super) seeds: Vec<SubContactSeed>,
     /// The index of its first staged contact and of that contact's first sub-contact in the
     /// staging lists (those of the next one when it stages none).
     pub(super) place: (u32, u32),

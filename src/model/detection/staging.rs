@@ -10,7 +10,7 @@ use crate::contact::{
     node_frame, AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
 };
 use crate::error::Result;
-use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubKey, SubcontactSeed, PARALLEL_ANGLE};
+use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubContactSeed, SubKey, PARALLEL_ANGLE};
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Real, Vector, Vector2};
 
@@ -188,7 +188,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
         dc: &DetectedContact,
         (law, joint_law): (u32, &L),
         large: bool,
-        seeds: &[SubcontactSeed],
+        seeds: &[SubContactSeed],
     ) where
         L: ConstitutiveLaw<State = S>,
     {
