@@ -9,6 +9,7 @@ mod law_update;
 mod moments;
 mod nodes;
 mod spread;
+mod store;
 mod view;
 
 #[cfg(feature = "serde")]
@@ -19,6 +20,7 @@ pub(crate) use kernel::{face_gap_coefficients, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
 pub(crate) use nodes::{node_frame, stored_node_frame, update_nodes};
 pub(crate) use spread::tension_free;
+pub(crate) use store::{ContactLists, ContactSlices, ContactStore, OldContacts};
 pub(crate) use view::{CellGeometry, NodeGeometry, TensionFree};
 pub use view::{Contact, ContactView, SubContactSample, SubContactView};
 

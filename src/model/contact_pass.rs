@@ -9,13 +9,11 @@
 //! needed. Sums are kept per chunk of [`CONTACT_CHUNK`] contacts and added in chunk order
 //! afterwards, so that they do not depend on the number of threads.
 
+use super::{ModelState, Pipeline};
 use crate::block::{Block, RigidBlock};
-use crate::contact::{
-    update_contact, update_nodes, ContactPair, ContactReference, ContactWrench, KernelContext, LaneBuild, SubContact,
-    SubContactRecord,
-};
+use crate::contact::{update_contact, update_nodes, ContactReference, KernelContext, LaneBuild};
 use crate::geometry::ContactKind;
-use crate::integrate::StiffnessBound;
+use crate::integrate::{StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real};
 
@@ -41,51 +39,8 @@ pub(super) struct ContactPass<'a, L: ConstitutiveLaw> {
     pub ctx: KernelContext,
 }
 
-/// What the contact pass writes: the contacts, their wrenches and per-chunk sums, and the
-/// sub-contacts with their records, all starting at the same contact.
-pub(super) struct ContactSlices<'a, S> {
-    /// Index of the first contact.
-    pub first: usize,
-    pub pairs: &'a mut [ContactPair],
-    pub wrenches: &'a mut [ContactWrench],
-    /// One per chunk of [`CONTACT_CHUNK`] contacts.
-    pub sums: &'a mut [PairSums],
-    /// The sub-contacts of `pairs`, from the first contact's first one.
-    pub subs: &'a mut [SubContact<S>],
-    pub records: &'a mut [SubContactRecord],
-}
-
-impl<'a, S> ContactSlices<'a, S> {
-    /// Splits after `chunks` chunks of contacts (at least one contact must follow).
-    fn split(self, chunks: usize) -> (Self, Self) {
-        let at = chunks * CONTACT_CHUNK;
-        let base = self.pairs[0].first as usize;
-        let sub_at = self.pairs[at].first as usize - base;
-        let (pairs, pairs_right) = self.pairs.split_at_mut(at);
-        let (wrenches, wrenches_right) = self.wrenches.split_at_mut(at);
-        let (sums, sums_right) = self.sums.split_at_mut(chunks);
-        let (subs, subs_right) = self.subs.split_at_mut(sub_at);
-        let (records, records_right) = self.records.split_at_mut(sub_at);
-        (
-            Self {
-                first: self.first,
-                pairs,
-                wrenches,
-                sums,
-                subs,
-                records,
-            },
-            Self {
-                first: self.first + at,
-                pairs: pairs_right,
-                wrenches: wrenches_right,
-                sums: sums_right,
-                subs: subs_right,
-                records: records_right,
-            },
-        )
-    }
-}
+/// The contact pass's view of the contacts, with its per-chunk sums.
+type Slices<'a, S> = crate::contact::ContactSlices<'a, S, PairSums>;
 
 /// Per-chunk sums of the contact pass.
 #[derive(Debug, Clone, Copy, Default)]
@@ -113,16 +68,16 @@ pub(super) struct PairSums {
 impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     /// Runs the pass over `slices`: split in halves at chunk boundaries on rayon's pool down to
     /// [`CHUNKS_PER_TASK`] chunks, which run in order.
-    pub fn run_all(&self, slices: ContactSlices<'_, L::State>, avx2: bool) {
+    pub fn run_all(&self, slices: Slices<'_, L::State>, avx2: bool) {
         let chunks = slices.pairs.len().div_ceil(CONTACT_CHUNK);
         if chunks > CHUNKS_PER_TASK {
-            let (left, right) = slices.split(chunks / 2);
+            let (left, right) = slices.split(chunks / 2, CONTACT_CHUNK);
             rayon::join(|| self.run_all(left, avx2), || self.run_all(right, avx2));
             return;
         }
         let mut rest = slices;
         while rest.pairs.len() > CONTACT_CHUNK {
-            let (chunk, tail) = rest.split(1);
+            let (chunk, tail) = rest.split(1, CONTACT_CHUNK);
             self.run_chunk(chunk, avx2);
             rest = tail;
         }
@@ -133,7 +88,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
 
     /// One chunk, compiled for AVX2 where the processor has it.
     #[inline(always)]
-    fn run_chunk(&self, chunk: ContactSlices<'_, L::State>, avx2: bool) {
+    fn run_chunk(&self, chunk: Slices<'_, L::State>, avx2: bool) {
         #[cfg(target_arch = "x86_64")]
         if avx2 {
             // SAFETY: the processor has AVX2 (checked by `dispatch::has_avx2`).
@@ -147,9 +102,9 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     /// Updates one chunk of contacts and their sub-contacts, writes their wrenches and adds
     /// their totals to the chunk's sums.
     #[inline(always)]
-    fn run(&self, chunk: ContactSlices<'_, L::State>, lanes: LaneBuild) {
+    fn run(&self, chunk: Slices<'_, L::State>, lanes: LaneBuild) {
         let ctx = KernelContext { lanes, ..self.ctx };
-        let ContactSlices {
+        let Slices {
             first,
             pairs,
             wrenches,
@@ -220,7 +175,63 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     /// The processor must support AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn run_avx2(&self, chunk: ContactSlices<'_, L::State>) {
+    unsafe fn run_avx2(&self, chunk: Slices<'_, L::State>) {
         self.run(chunk, LaneBuild::Avx2);
+    }
+}
+
+impl<L: ConstitutiveLaw> ModelState<L> {
+    /// The contact pass; returns the largest squared frequency bound of the blocks of the
+    /// contacts the impact probe marked (0: none), and whether a loaded contact it marked
+    /// since the refinement began moves fast.
+    pub(super) fn contact_pass(&mut self, pipeline: &mut Pipeline<L::State>) -> (Real, bool) {
+        // The probe: normal speeds beyond that of a fall through the contact tolerance,
+        // `√(2 g tol)` (a block settling on its joints moves much slower), crossing the kink
+        // within two steps.
+        let probe = matches!(self.params.time_step, TimeStep::Auto { .. }) && self.params.impact_step.is_some();
+        let impact_speed = if probe {
+            (2.0 * self.params.gravity.length() * self.params.contact.tolerance).sqrt()
+        } else {
+            Real::INFINITY
+        };
+        let ctx = KernelContext {
+            dt: self.clock.drift,
+            impact_speed,
+            impact_horizon: 2.0 * self.clock.dt,
+            stiffness_damping: self.integrator.damping().stiffness_coefficient(),
+            mode: self.params.mode,
+            lanes: crate::contact::LaneBuild::Portable,
+        };
+        // The records run index for index with the sub-contacts (kept so by detection and
+        // checkpoint load).
+        assert!(self.contacts.in_step(), "contact lists out of step");
+        assert_eq!(
+            pipeline.rotations.len(),
+            self.blocks.len(),
+            "rotation matrices out of step"
+        );
+        // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed
+        // per fixed chunk of contacts, so that the totals do not depend on the thread count.
+        pipeline.pair_sums.clear();
+        pipeline
+            .pair_sums
+            .resize(self.contacts.pairs.len().div_ceil(CONTACT_CHUNK), PairSums::default());
+        if !self.contacts.pairs.is_empty() {
+            let (references, slices) = self.contacts.pass_view(&mut pipeline.pair_sums);
+            let pass = ContactPass {
+                blocks: &self.blocks,
+                rotations: &pipeline.rotations,
+                references,
+                laws: self.laws.laws(),
+                bounds: &pipeline.bounds,
+                refining: &self.clock.refining,
+                ctx,
+            };
+            pass.run_all(slices, crate::dispatch::has_avx2());
+        }
+        (
+            pipeline.pair_sums.iter().map(|s| s.impact).fold(0.0, Real::max),
+            pipeline.pair_sums.iter().any(|s| s.busy),
+        )
     }
 }

@@ -42,14 +42,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// difference to `½(F_{n−1} + F_n)·v_{n−½}·Δt_{n−½}` is added here (`F_{n−1}` the load
     /// the block had; nothing on the first step, where the gather books `½ F_0`).
     pub(super) fn apply_load_histories(&mut self) {
-        for h in &self.load_histories {
+        for h in &self.excitations.load_histories {
             let block = &mut self.blocks[h.block as usize];
-            let new = h.load.at(self.time - h.start);
+            let new = h.load.at(self.clock.time - h.start);
             let old: Wrench = block.load;
-            if self.step > 0 {
+            if self.clock.step > 0 {
                 let (v, om) = (block.state.velocity, block.state.angular_velocity);
                 self.energy.load_work +=
-                    0.5 * ((old.force - new.force).dot(v) + (old.moment - new.moment).dot(om)) * self.drift;
+                    0.5 * ((old.force - new.force).dot(v) + (old.moment - new.moment).dot(om)) * self.clock.drift;
             }
             block.load = new;
         }
@@ -59,8 +59,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// current time: the mean velocity of the motion over the step, so that the block's
     /// displacement at the end of the step is the motion's exactly.
     pub(super) fn apply_base_motions(&mut self, drift: Real) {
-        for m in &self.motions {
-            let t = self.time - m.start;
+        for m in &self.excitations.motions {
+            let t = self.clock.time - m.start;
             let v = m.motion.mean_velocity(t, drift);
             let block = &mut self.blocks[m.block as usize];
             let mut fixity = *block.fixity();
@@ -113,10 +113,10 @@ impl<L: ConstitutiveLaw> Model<L> {
     pub fn set_base_motion(&mut self, id: BlockId, motion: Option<BaseMotion>) -> Result<()> {
         let mut fixity = *self.block(id)?.fixity();
         let Some(motion) = motion else {
-            let Some(k) = self.state.motions.iter().position(|m| m.block == id.0) else {
+            let Some(k) = self.state.excitations.motions.iter().position(|m| m.block == id.0) else {
                 return Ok(());
             };
-            let removed = self.state.motions.remove(k);
+            let removed = self.state.excitations.motions.remove(k);
             for (axis, driven) in removed.motion.driven_axes().into_iter().enumerate() {
                 if driven {
                     fixity.translation[axis] = Dof::Fixed;
@@ -133,20 +133,20 @@ impl<L: ConstitutiveLaw> Model<L> {
                 });
             }
         }
-        self.state.motions.retain(|m| m.block != id.0);
-        self.state.motions.push(AppliedMotion {
+        self.state.excitations.motions.retain(|m| m.block != id.0);
+        self.state.excitations.motions.push(AppliedMotion {
             block: id.0,
             motion,
-            start: self.state.time,
+            start: self.state.clock.time,
         });
-        self.state.motions.sort_by_key(|m| m.block);
+        self.state.excitations.motions.sort_by_key(|m| m.block);
         Ok(())
     }
 
     /// [`Error::DrivenAxisFreed`] when `fixity` frees a translation of block `id` that its base
     /// motion drives.
     pub(super) fn check_driven_axes(&self, id: BlockId, fixity: &Fixity) -> Result<()> {
-        let Some(m) = self.state.motions.iter().find(|m| m.block == id.0) else {
+        let Some(m) = self.state.excitations.motions.iter().find(|m| m.block == id.0) else {
             return Ok(());
         };
         let driven = m.motion.driven_axes();
@@ -200,14 +200,14 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// [`Error::UnknownBlock`].
     pub fn set_load_history(&mut self, id: BlockId, load: Option<LoadHistory>) -> Result<()> {
         self.block(id)?;
-        self.state.load_histories.retain(|h| h.block != id.0);
+        self.state.excitations.load_histories.retain(|h| h.block != id.0);
         if let Some(load) = load {
-            self.state.load_histories.push(AppliedLoad {
+            self.state.excitations.load_histories.push(AppliedLoad {
                 block: id.0,
                 load,
-                start: self.state.time,
+                start: self.state.clock.time,
             });
-            self.state.load_histories.sort_by_key(|h| h.block);
+            self.state.excitations.load_histories.sort_by_key(|h| h.block);
         }
         Ok(())
     }
@@ -215,6 +215,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The load histories applied, with their blocks and the model time each started at.
     pub fn load_histories(&self) -> impl Iterator<Item = (BlockId, &LoadHistory, Real)> {
         self.state
+            .excitations
             .load_histories
             .iter()
             .map(|h| (BlockId(h.block), &h.load, h.start))
@@ -223,6 +224,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// The base motions applied, with their blocks and the model time each history started at.
     pub fn base_motions(&self) -> impl Iterator<Item = (BlockId, &BaseMotion, Real)> {
         self.state
+            .excitations
             .motions
             .iter()
             .map(|m| (BlockId(m.block), &m.motion, m.start))

@@ -1,5 +1,6 @@
 //! The model: blocks, joint laws, gravity and loads; stepping and runs.
 
+mod block_pass;
 mod changes;
 #[cfg(feature = "serde")]
 mod checkpoint;
@@ -7,7 +8,6 @@ mod contact_pass;
 mod detection;
 mod energy;
 mod excitation;
-mod motion;
 mod observe;
 mod parameters;
 mod pipeline;
@@ -15,6 +15,7 @@ mod queries;
 mod run;
 mod setters;
 mod step;
+mod step_length;
 mod time_step;
 
 #[cfg(feature = "serde")]
@@ -49,7 +50,7 @@ pub use observe::Observer;
 pub use parameters::ModelParameters;
 
 use crate::block::RigidBlock;
-use crate::contact::{ContactPair, ContactReference, ContactWrench, SubContact, SubContactRecord};
+use crate::contact::ContactStore;
 use crate::integrate::{CriticalStep, Integrator, StepRecord};
 use crate::law::{ConstitutiveLaw, CoulombSlip, LawTable};
 use crate::math::{is_finite_vector, Pose, Real};
@@ -89,31 +90,56 @@ pub struct Model<L: ConstitutiveLaw = CoulombSlip> {
 pub(super) struct ModelState<L: ConstitutiveLaw> {
     pub params: ModelParameters,
     pub blocks: Vec<RigidBlock>,
+    /// Each block's step record (reaction, damping force, ...), index for index with `blocks`.
+    pub records: Vec<StepRecord>,
     pub laws: LawTable<L>,
     pub integrator: Box<dyn Integrator>,
-    pub pairs: Vec<ContactPair>,
-    /// The contacts' reference geometry and areas, index for index with `pairs`.
-    pub references: Vec<ContactReference>,
-    pub subs: Vec<SubContact<L::State>>,
-    /// The sub-contacts' records (key, slip, dashpot force), index for index with `subs`.
-    pub sub_records: Vec<SubContactRecord>,
-    pub records: Vec<StepRecord>,
-    /// The contacts' resultants and moments, index for index with `pairs`: written by the
-    /// contact pass, read by the per-block gather and the accessors (kept out of `ContactPair`,
-    /// whose stream they would lengthen by 72 bytes per contact). Detection carries a kept
-    /// contact's wrench and starts a new one at zero; checkpointed.
-    pub wrenches: Vec<ContactWrench>,
+    /// The contacts with their sub-contacts and history.
+    pub contacts: ContactStore<L::State>,
+    /// What detection keeps between detections.
+    pub found: Found,
+    /// The step's clock: count, time, lengths, the impact refinement.
+    pub clock: StepClock,
+    pub energy: Energies,
+    /// What the setters changed since the last step (read first by [`Model::step`]).
+    pub changes: Changes,
+    /// Blocks whose fixity changed since the last detection ([`Model::set_fixity`]): the next
+    /// detection looks at their pairs as if they had moved.
+    pub refixed: Vec<u32>,
+    pub unbalanced_ratio: Real,
+    /// Base motions and load histories, by block.
+    pub excitations: Excitations,
+}
+
+/// What detection keeps from one detection to the next.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Found {
     /// Each block's pose at the last detection: the next one runs once a block has moved the
     /// re-detection trigger from it.
     pub ref_poses: Vec<Pose>,
     /// The pairs the narrow phase tested and the relative poses it tested them at, sorted by
     /// pair (every contact has one): a pair keeps its verdict until it moves relatively.
     pub tested: Vec<detection::TestedPair>,
+    /// Detections run.
+    pub detections: u64,
+}
+
+/// The step's clock.
+#[derive(Debug, Clone, Default)]
+pub(super) struct StepClock {
+    /// Steps taken.
+    pub step: u64,
+    /// Simulated time (s).
+    pub time: Real,
+    /// Whether the first step has been taken.
+    pub started: bool,
     /// The step: `safety × critical` (or the fixed one), as set at the last evaluation.
     pub dt: Real,
     /// The step that brought the blocks to their poses (`Δt_{n−½}`): `dt`, or shorter around
     /// impacts (see [`ModelParameters::impact_step`]).
     pub drift: Real,
+    /// The critical step of the last evaluation and the block that sets it.
+    pub critical: Option<CriticalStep>,
     /// Impact refinement: the time until which it holds, and the largest squared frequency
     /// bound of the blocks that asked for it (0 when not refining).
     pub refine_until: Real,
@@ -126,18 +152,11 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     /// The contacts (as sorted block pairs) the impact probe marked since the refinement began:
     /// the step is not relaxed while one of them is loaded and moving fast.
     pub refining: Vec<(u32, u32)>,
-    pub critical: Option<CriticalStep>,
-    pub step: u64,
-    pub time: Real,
-    pub energy: Energies,
-    pub started: bool,
-    /// What the setters changed since the last step (read first by [`Model::step`]).
-    pub changes: Changes,
-    /// Blocks whose fixity changed since the last detection ([`Model::set_fixity`]): the next
-    /// detection looks at their pairs as if they had moved.
-    pub refixed: Vec<u32>,
-    pub unbalanced_ratio: Real,
-    pub detections: u64,
+}
+
+/// The blocks' excitations.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Excitations {
     /// Base motions, by block ([`Model::set_base_motion`]).
     pub motions: Vec<excitation::AppliedMotion>,
     /// Time-varying loads, by block ([`Model::set_load_history`]).
@@ -172,11 +191,11 @@ impl<L: ConstitutiveLaw> std::fmt::Debug for Model<L> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Model")
             .field("blocks", &self.state.blocks.len())
-            .field("contacts", &self.state.pairs.len())
+            .field("contacts", &self.state.contacts.pairs.len())
             .field("subcontacts", &self.subcontact_count())
-            .field("step", &self.state.step)
-            .field("time", &self.state.time)
-            .field("dt", &self.state.dt)
+            .field("step", &self.state.clock.step)
+            .field("time", &self.state.clock.time)
+            .field("dt", &self.state.clock.dt)
             .finish()
     }
 }
@@ -197,7 +216,7 @@ struct BlockSums {
     /// First block of the chunk that diverged.
     diverged: Option<usize>,
     /// The largest squared speeds of translation and of rotation at the radius of the
-    /// chunk's blocks after the move (m²/s², see [`motion::move_speeds2`]).
+    /// chunk's blocks after the move (m²/s², see [`block_pass::move_speeds2`]).
     max_v2: Real,
     max_w2: Real,
     /// First block of the chunk that the step moved further than the contact tolerance, and

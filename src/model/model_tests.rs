@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::block::{Block, Wrench};
-use crate::contact::{update_contact, DisplacementMode, KernelContext};
+use crate::contact::{update_contact, ContactWrench, DisplacementMode, KernelContext};
 use crate::error::Error;
 use crate::integrate::{CentralDifference, Damping};
 use crate::law::{JointStatus, MaterialId};
@@ -74,26 +74,33 @@ pub(crate) fn toppling_column(params: ModelParameters) -> Model {
 /// compared, sliding, open, and of nodes of node contacts (not compared: one loop).
 fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &Model, law: &L) -> [usize; 4] {
     let ctx = KernelContext {
-        dt: model.state.dt,
+        dt: model.state.clock.dt,
         impact_speed: Real::INFINITY,
         impact_horizon: 0.0,
         stiffness_damping: 0.0,
         mode: model.state.params.mode,
         lanes: crate::contact::LaneBuild::Portable,
     };
-    let (mut grouped_subs, mut single_subs) = (model.state.subs.clone(), model.state.subs.clone());
-    let (mut grouped_records, mut single_records) = (model.state.sub_records.clone(), model.state.sub_records.clone());
-    let (mut grouped_pairs, mut single_pairs) = (model.state.pairs.clone(), model.state.pairs.clone());
+    let (mut grouped_subs, mut single_subs) = (model.state.contacts.subs.clone(), model.state.contacts.subs.clone());
+    let (mut grouped_records, mut single_records) = (
+        model.state.contacts.sub_records.clone(),
+        model.state.contacts.sub_records.clone(),
+    );
+    let (mut grouped_pairs, mut single_pairs) =
+        (model.state.contacts.pairs.clone(), model.state.contacts.pairs.clone());
     let mut counts = [0; 4];
-    for k in 0..model.state.pairs.len() {
-        let r = model.state.pairs[k].range();
-        let (a, b) = (model.state.pairs[k].a as usize, model.state.pairs[k].b as usize);
+    for k in 0..model.state.contacts.pairs.len() {
+        let r = model.state.contacts.pairs[k].range();
+        let (a, b) = (
+            model.state.contacts.pairs[k].a as usize,
+            model.state.contacts.pairs[k].b as usize,
+        );
         let (ra, rb) = (
             crate::math::Matrix::from_quat(model.state.blocks[a].state.pose.rotation),
             crate::math::Matrix::from_quat(model.state.blocks[b].state.pose.rotation),
         );
         let (sa, sb) = ((&model.state.blocks[a].state, &ra), (&model.state.blocks[b].state, &rb));
-        if matches!(model.state.pairs[k].kind, crate::geometry::ContactKind::Nodes) {
+        if matches!(model.state.contacts.pairs[k].kind, crate::geometry::ContactKind::Nodes) {
             // Node contacts have one loop (`contact/nodes.rs`).
             counts[3] += r.len();
             continue;
@@ -120,7 +127,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
             pairs[k].dashpots = dashpots;
             *wrench = update_contact(
                 &mut pairs[k],
-                &model.state.references[k],
+                &model.state.contacts.references[k],
                 &mut subs[r.clone()],
                 &mut records[r.clone()],
                 sa,
@@ -254,22 +261,25 @@ fn redetection_carries_shear_forces_in_turned_axes() {
     let b = cube("b", 0.2).with_fixity(crate::block::Fixity::velocity(Vector::ZERO));
     model.add_block(b).expect("b");
     model.run_steps(1).expect("detection");
-    assert_eq!(model.state.pairs.len(), 1, "one joint");
-    let (normal, range) = (model.state.pairs[0].normal, model.state.pairs[0].range());
+    assert_eq!(model.state.contacts.pairs.len(), 1, "one joint");
+    let (normal, range) = (
+        model.state.contacts.pairs[0].normal,
+        model.state.contacts.pairs[0].range(),
+    );
     assert!(normal.z.abs() < 0.6, "a steep joint: {normal}");
     // Turn the tangents 40° about the normal and load the springs elastically.
     let fresh = JointAxes::from_normal(normal);
     let turned = crate::math::Rotation::from_axis_angle(normal, 40f64.to_radians()) * fresh.tangent;
-    model.state.pairs[0].tangent = turned;
-    for (i, sub) in model.state.subs[range].iter_mut().enumerate() {
+    model.state.contacts.pairs[0].tangent = turned;
+    for (i, sub) in model.state.contacts.subs[range].iter_mut().enumerate() {
         sub.force.normal = 100.0 + i as Real;
         sub.force.shear = crate::math::Vector2::new(30.0 - i as Real, 5.0 + 2.0 * i as Real);
         sub.status = JointStatus::Elastic;
     }
-    let mut subs = model.state.subs[model.state.pairs[0].range()].to_vec();
+    let mut subs = model.state.contacts.subs[model.state.contacts.pairs[0].range()].to_vec();
     let law = model.state.laws.laws()[0];
     let poses = (model.state.blocks[0].state.pose, model.state.blocks[1].state.pose);
-    model.state.pairs[0].refresh_springs(&mut subs, &law, Some((&poses.0, &poses.1)));
+    model.state.contacts.pairs[0].refresh_springs(&mut subs, &law, Some((&poses.0, &poses.1)));
     let world_shears = |m: &Model| -> Vec<(SubKey, Vector)> {
         let view = m.contacts().next().expect("the joint");
         view.subcontacts().map(|s| (s.key(), s.shear_force())).collect()
@@ -287,7 +297,9 @@ fn redetection_carries_shear_forces_in_turned_axes() {
     assert!(worst < 1e-14, "shear forces changed by {worst} (relative)");
     // What fresh axes would have given: the test can tell.
     let misread = before[0].1.length() * 2.0 * (20f64.to_radians()).sin();
-    let first = model.state.subs[model.state.pairs[0].range()][0].force.shear;
+    let first = model.state.contacts.subs[model.state.contacts.pairs[0].range()][0]
+        .force
+        .shear;
     assert!((fresh.shear(first) - before[0].1).length() > 0.5 * misread);
 }
 

@@ -83,7 +83,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 what: format!("end time {t} of run_until_time_observed"),
             });
         }
-        while self.state.time < t {
+        while self.state.clock.time < t {
             self.step()?;
             if observer.after_step(self)?.is_break() {
                 return Ok(true);

@@ -33,7 +33,7 @@ pub(super) struct PipelineOf<D> {
     /// Detection's buffers, and what the block pass prepared for the next step.
     pub detection: D,
     /// The largest speed of a point of a block at the end of the last step
-    /// ([`super::motion::speed_bound`], m/s), for the next step's length; `None` after a setter
+    /// ([`super::block_pass::speed_bound`], m/s), for the next step's length; `None` after a setter
     /// touched a block or a load: the next step takes it in a pass of its own.
     pub max_speed: Option<Real>,
     /// Wall-clock time per stage.

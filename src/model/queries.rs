@@ -3,7 +3,7 @@
 
 use rayon::prelude::*;
 
-use super::{motion, Energies, Model, ModelParameters, Timings};
+use super::{block_pass, Energies, Model, ModelParameters, Timings};
 use crate::block::{Block, BlockId, RigidBlock, Wrench};
 use crate::contact::{ContactView, DisplacementMode};
 use crate::error::{Error, Result};
@@ -40,13 +40,14 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// The current contacts, each with its sub-contacts.
     pub fn contacts(&self) -> impl ExactSizeIterator<Item = ContactView<'_, L::State>> + '_ {
-        (0..self.state.pairs.len()).map(move |k| self.view(k))
+        (0..self.state.contacts.pairs.len()).map(move |k| self.view(k))
     }
 
     /// The contact between two blocks, if any.
     pub fn contact_between(&self, a: BlockId, b: BlockId) -> Option<ContactView<'_, L::State>> {
         let key = (a.0.min(b.0), a.0.max(b.0));
         self.state
+            .contacts
             .pairs
             .binary_search_by_key(&key, |p| (p.a, p.b))
             .ok()
@@ -96,7 +97,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     pub(super) fn view(&self, k: usize) -> ContactView<'_, L::State> {
-        let p = &self.state.pairs[k];
+        let p = &self.state.contacts.pairs[k];
         let (sa, sb) = (
             &self.state.blocks[p.a as usize].state,
             &self.state.blocks[p.b as usize].state,
@@ -122,47 +123,52 @@ impl<L: ConstitutiveLaw> Model<L> {
         });
         ContactView::new(
             p,
-            &self.state.subs[p.range()],
-            &self.state.sub_records[p.range()],
-            p.frame(&self.state.references[k], &sa.pose, &sb.pose, self.state.params.mode),
-            self.state.wrenches[k],
+            &self.state.contacts.subs[p.range()],
+            &self.state.contacts.sub_records[p.range()],
+            p.frame(
+                &self.state.contacts.references[k],
+                &sa.pose,
+                &sb.pose,
+                self.state.params.mode,
+            ),
+            self.state.contacts.wrenches[k],
             (nodes, cells),
         )
     }
 
     /// Total number of sub-contacts.
     pub fn subcontact_count(&self) -> usize {
-        self.state.pairs.iter().map(|p| p.count as usize).sum()
+        self.state.contacts.pairs.iter().map(|p| p.count as usize).sum()
     }
 
     /// Steps taken.
     pub fn step_count(&self) -> u64 {
-        self.state.step
+        self.state.clock.step
     }
 
     /// Simulated time (s).
     pub fn time(&self) -> Real {
-        self.state.time
+        self.state.clock.time
     }
 
     /// The time step in use (s); zero before the first step.
     pub fn dt(&self) -> Real {
-        self.state.dt
+        self.state.clock.dt
     }
 
     /// The duration of the last step (s): [`dt`](Self::dt), or shorter while the step was refined
     /// around an impact (see [`ModelParameters::impact_step`]); `dt` before the first step.
     pub fn last_step(&self) -> Real {
-        if self.state.drift > 0.0 {
-            self.state.drift
+        if self.state.clock.drift > 0.0 {
+            self.state.clock.drift
         } else {
-            self.state.dt
+            self.state.clock.dt
         }
     }
 
     /// The critical time step and the block that limits it (after the first step).
     pub fn critical_step(&self) -> Option<CriticalStep> {
-        self.state.critical
+        self.state.clock.critical
     }
 
     /// Energies since the start.
@@ -181,6 +187,7 @@ impl<L: ConstitutiveLaw> Model<L> {
         let laws = self.state.laws.laws();
         let chunk_sums: Vec<Real> = self
             .state
+            .contacts
             .pairs
             .par_chunks(1024)
             .map(|chunk| {
@@ -188,7 +195,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                     .iter()
                     .map(|p| {
                         let law = &laws[p.law as usize];
-                        self.state.subs[p.range()]
+                        self.state.contacts.subs[p.range()]
                             .iter()
                             .map(|s| law.elastic_energy(s.area, &s.force, &s.state))
                             .sum::<Real>()
@@ -208,7 +215,7 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     /// Number of contact detections run so far.
     pub fn detection_count(&self) -> u64 {
-        self.state.detections
+        self.state.found.detections
     }
 
     /// Number of block pairs the narrow phase tested since the model was built or restored: at
@@ -251,7 +258,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             return Wrench::default();
         };
         let entries = &self.pipeline.block_contacts[start as usize..end as usize];
-        motion::add_contact_wrenches(Wrench::default(), entries, &self.state.wrenches)
+        block_pass::add_contact_wrenches(Wrench::default(), entries, &self.state.contacts.wrenches)
     }
 
     /// Time spent per stage (wall clock).

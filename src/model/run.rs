@@ -21,7 +21,9 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// run, servo wait or push-over honours it) and between the batches of a contact detection.
     pub fn step(&mut self) -> Result<()> {
         if self.pipeline.interrupt_due() {
-            return Err(Error::Interrupted { step: self.state.step });
+            return Err(Error::Interrupted {
+                step: self.state.clock.step,
+            });
         }
         self.state.step(&mut self.pipeline)
     }
@@ -47,7 +49,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 what: format!("end time {t} of run_until_time"),
             });
         }
-        while self.state.time < t {
+        while self.state.clock.time < t {
             self.step()?;
         }
         Ok(())

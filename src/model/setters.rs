@@ -4,8 +4,9 @@
 
 use super::changes::Changes;
 use super::Pipeline;
-use super::{Energies, InterruptCheck, Model, ModelParameters, ModelState};
+use super::{Energies, Excitations, Found, InterruptCheck, Model, ModelParameters, ModelState, StepClock};
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
+use crate::contact::ContactStore;
 use crate::error::{Error, Result};
 use crate::integrate::{CentralDifference, Damping, Integrator, StepRecord, StiffnessBound};
 use crate::law::{ConstitutiveLaw, LawTable, MaterialId};
@@ -22,33 +23,17 @@ impl<L: ConstitutiveLaw> Model<L> {
             state: ModelState {
                 params,
                 blocks: Vec::new(),
+                records: Vec::new(),
                 laws: LawTable::new(),
                 integrator: Box::new(CentralDifference::default()),
-                pairs: Vec::new(),
-                references: Vec::new(),
-                subs: Vec::new(),
-                sub_records: Vec::new(),
-                records: Vec::new(),
-                wrenches: Vec::new(),
-                ref_poses: Vec::new(),
-                tested: Vec::new(),
-                dt: 0.0,
-                drift: 0.0,
-                refine_until: 0.0,
-                refine_omega2: 0.0,
-                refine_travel: false,
-                refining: Vec::new(),
-                critical: None,
-                step: 0,
-                time: 0.0,
+                contacts: ContactStore::default(),
+                found: Found::default(),
+                clock: StepClock::default(),
                 energy: Energies::default(),
-                started: false,
                 changes: Changes::DETECTION,
                 refixed: Vec::new(),
                 unbalanced_ratio: Real::INFINITY,
-                detections: 0,
-                motions: Vec::new(),
-                load_histories: Vec::new(),
+                excitations: Excitations::default(),
             },
             pipeline: Pipeline::default(),
         })
@@ -71,11 +56,11 @@ impl<L: ConstitutiveLaw> Model<L> {
             .contact
             .check_block(block.shape().radius(), block.name())?;
         block.radius = block.shape().radius();
-        if self.state.started {
+        if self.state.clock.started {
             self.check_added_overlap(&block)?;
         }
         let id = BlockId(self.state.blocks.len() as u32);
-        self.state.ref_poses.push(block.state.pose);
+        self.state.found.ref_poses.push(block.state.pose);
         self.state.blocks.push(block);
         self.pipeline.forces.push(Wrench::default());
         self.state.records.push(StepRecord::default());
@@ -196,7 +181,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             params.contact.check_block(b.shape().radius(), b.name())?;
         }
         let old = std::mem::replace(&mut self.state.params, params);
-        if !self.state.started || params.contact != old.contact || params.mode != old.mode {
+        if !self.state.clock.started || params.contact != old.contact || params.mode != old.mode {
             // Contacts are detected and discretised afresh with the new contact parameters.
             self.state.changes.insert(Changes::PARAMETERS);
         } else if params != old {
@@ -223,7 +208,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             });
         }
         self.block_mut(id)?.load = load;
-        self.state.load_histories.retain(|h| h.block != id.0);
+        self.state.excitations.load_histories.retain(|h| h.block != id.0);
         Ok(())
     }
 
@@ -325,7 +310,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             });
         }
         // Kinetic energy given by the user counts as energy put in.
-        if self.state.started {
+        if self.state.clock.started {
             self.state.energy.initial_kinetic += after - before;
             self.state.energy.kinetic += after - before;
         }

@@ -22,17 +22,18 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         // Blocks added since the last detection (a setter may ask before the first step).
         let n = self.blocks.len();
-        if pipeline.block_offsets.len() != n + 1 || pipeline.block_offsets[n] as usize != 2 * self.pairs.len() {
+        if pipeline.block_offsets.len() != n + 1 || pipeline.block_offsets[n] as usize != 2 * self.contacts.pairs.len()
+        {
             self.rebuild_block_index(pipeline);
         }
-        for reference in &mut self.references {
+        for reference in &mut self.contacts.references {
             reference.bound_area = reference.area;
         }
         pipeline.bounds.resize(n, StiffnessBound::default());
         let mut sources = self.bound_sources(&pipeline.block_offsets, &pipeline.block_contacts);
         // Each contact's eigenvalues once (each block would otherwise take both of each of
         // its contacts: four per contact).
-        let eigenvalues: Vec<[Real; 2]> = (0..self.pairs.len())
+        let eigenvalues: Vec<[Real; 2]> = (0..self.contacts.pairs.len())
             .into_par_iter()
             .with_min_len(CONTACTS_PER_TASK)
             .map(|k| contact_eigenvalues(&self.blocks, &sources.contact(k)))
@@ -51,10 +52,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// Only a contact detected afresh can have grown: a caller may pass those alone.
     pub(super) fn take_grown(&mut self, contacts: impl Iterator<Item = usize>, blocks: &mut Vec<u32>) {
         for k in contacts {
-            let reference = &mut self.references[k];
+            let reference = &mut self.contacts.references[k];
             if reference.area > GROWTH * reference.bound_area {
                 reference.bound_area = reference.area;
-                blocks.extend([self.pairs[k].a, self.pairs[k].b]);
+                blocks.extend([self.contacts.pairs[k].a, self.contacts.pairs[k].b]);
             }
         }
     }
@@ -66,7 +67,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     pub(super) fn refresh_time_step_around(&mut self, pipeline: &mut Pipeline<L::State>, i: u32) -> Result<()> {
         let n = self.blocks.len();
         let offsets = &pipeline.block_offsets;
-        if offsets.len() != n + 1 || offsets[n] as usize != 2 * self.pairs.len() || pipeline.bounds.len() != n {
+        if offsets.len() != n + 1 || offsets[n] as usize != 2 * self.contacts.pairs.len() || pipeline.bounds.len() != n
+        {
             return self.refresh_time_step(pipeline);
         }
         let mut blocks = std::mem::take(&mut pipeline.refresh_blocks);
@@ -74,7 +76,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         blocks.push(i);
         let entries = &pipeline.block_contacts[offsets[i as usize] as usize..offsets[i as usize + 1] as usize];
         for &e in entries {
-            let p = &self.pairs[(e / 2) as usize];
+            let p = &self.contacts.pairs[(e / 2) as usize];
             blocks.extend([p.a, p.b]);
         }
         pipeline.refresh_blocks = blocks;
@@ -123,11 +125,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
 
     /// The critical step from the blocks' bounds, then `dt`.
     fn set_time_step(&mut self, pipeline: &Pipeline<L::State>) -> Result<()> {
-        self.critical = self.integrator.critical_step(&pipeline.bounds);
-        let Some(crit) = self.critical else {
+        self.clock.critical = self.integrator.critical_step(&pipeline.bounds);
+        let Some(crit) = self.clock.critical else {
             // No stiffness anywhere: free flight; keep a previous step or a small default.
-            if self.dt == 0.0 {
-                self.dt = match self.params.time_step {
+            if self.clock.dt == 0.0 {
+                self.clock.dt = match self.params.time_step {
                     TimeStep::Fixed(dt) => dt,
                     TimeStep::Auto { .. } => 1e-4,
                 };
@@ -137,7 +139,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if !(crit.dt.is_finite() && crit.dt > 0.0) {
             // Stiffnesses near f64's limit (a law of 1.7e308 Pa/m) overflow the bound: the step
             // would be NaN or zero. (Found by the fuzzer.)
-            self.critical = None;
+            self.clock.critical = None;
             return Err(Error::InvalidParameter {
                 name: format!("critical time step (set by block {})", crit.block),
                 value: crit.dt,
@@ -145,7 +147,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                            (lower the joint stiffness)",
             });
         }
-        self.dt = match self.params.time_step {
+        self.clock.dt = match self.params.time_step {
             TimeStep::Auto { safety } => safety * crit.dt,
             TimeStep::Fixed(dt) => {
                 if dt > crit.dt {
@@ -200,8 +202,8 @@ impl<L: ConstitutiveLaw> BoundSources<'_, L> {
     /// first one (for digits), its normal and stiffness.
     fn contact(&self, k: usize) -> ContactStiffness {
         let s = self.state;
-        let (p, reference) = (&s.pairs[k], &s.references[k]);
-        let subs = &s.subs[p.range()];
+        let (p, reference) = (&s.contacts.pairs[k], &s.contacts.references[k]);
+        let subs = &s.contacts.subs[p.range()];
         let (sa, sb) = (&s.blocks[p.a as usize].state, &s.blocks[p.b as usize].state);
         let mut stiffness = s.laws.laws()[p.law as usize].stiffness();
         let mut moments = AreaMoments::default();
@@ -211,7 +213,7 @@ impl<L: ConstitutiveLaw> BoundSources<'_, L> {
             // stiffer spring in every direction.
             let (ba, bb) = (&s.blocks[p.a as usize], &s.blocks[p.b as usize]);
             let (ra, rb) = (Matrix::from_quat(sa.pose.rotation), Matrix::from_quat(sb.pose.rotation));
-            let records = &s.sub_records[p.range()];
+            let records = &s.contacts.sub_records[p.range()];
             let point = |k: usize| {
                 stored_node_frame(
                     NodeId::from_key(records[k].key),

@@ -12,7 +12,7 @@ use super::{
     checksum_of, law_type_name, ContactEntry, Header, Snapshot, CHECKSUM, FORMAT, MAX_COUNT, MIN_STORED_BOUND, VERSION,
 };
 use crate::block::Block;
-use crate::contact::{ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord};
+use crate::contact::{ContactPair, ContactReference, ContactStore, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::integrate::{CentralDifference, CriticalStep, TimeStep};
@@ -21,18 +21,8 @@ use crate::math::is_unit_pose;
 use crate::math::{is_finite_vector, Real, Vector};
 use crate::model::{Model, ModelParameters};
 
-/// The contacts of a checkpoint as the step stores them: the pairs, their references and
-/// wrenches, the sub-contacts and their records (each contact's range in order).
-struct Storage<S> {
-    pairs: Vec<ContactPair>,
-    references: Vec<ContactReference>,
-    wrenches: Vec<ContactWrench>,
-    subs: Vec<SubContact<S>>,
-    sub_records: Vec<SubContactRecord>,
-}
-
 /// The step's storage rebuilt from checkpointed joints.
-fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Storage<S> {
+fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> ContactStore<S> {
     let total = entries.iter().map(|e| e.subcontacts.len()).sum();
     let (mut pairs, mut references, mut wrenches) = (
         Vec::with_capacity(entries.len()),
@@ -91,7 +81,7 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Storage<S> {
         });
         wrenches.push(e.wrench);
     }
-    Storage {
+    ContactStore {
         pairs,
         references,
         wrenches,
@@ -178,10 +168,10 @@ where
         let mut model = restore_blocks(snap.params, std::mem::take(&mut snap.blocks), snap.dt.max(snap.drift))?;
         restore_contacts(&mut model, std::mem::take(&mut snap.joints), snap.damping, storage)?;
         check_slacks(&model.state.blocks, &tested, &model.state.params.contact)?;
-        model.state.tested = tested;
+        model.state.found.tested = tested;
         restore_excitations(&mut model, &mut snap)?;
         restore_run(&mut model, &snap);
-        let redetect = !model.state.started || pending_detection;
+        let redetect = !model.state.clock.started || pending_detection;
         if redetect {
             model.state.changes.insert(crate::model::changes::Changes::DETECTION);
         }
@@ -191,8 +181,8 @@ where
             let from_bounds = model.state.integrator.critical_step(&model.pipeline.bounds);
             check_time_step(&snap.params, snap.dt, snap.critical, from_bounds)?;
         }
-        model.state.dt = snap.dt;
-        model.state.critical = snap.critical;
+        model.state.clock.dt = snap.dt;
+        model.state.clock.critical = snap.critical;
         Ok(model)
     }
 
@@ -316,10 +306,10 @@ fn check_snapshot<L: ConstitutiveLaw>(snap: &Snapshot<L>) -> Result<Vec<crate::m
 /// each contact's law the one detection gives its pair, areas not negative.
 fn check_contacts<L: ConstitutiveLaw>(
     snap: &Snapshot<L>,
-    storage: &Storage<L::State>,
+    storage: &ContactStore<L::State>,
     tested: &[crate::model::detection::TestedPair],
 ) -> Result<()> {
-    let Storage {
+    let ContactStore {
         pairs,
         wrenches,
         subs,
@@ -481,26 +471,22 @@ fn restore_contacts<L: ConstitutiveLaw>(
     model: &mut Model<L>,
     laws: crate::law::LawTable<L>,
     damping: crate::integrate::Damping,
-    storage: Storage<L::State>,
+    storage: ContactStore<L::State>,
 ) -> Result<()> {
     model.state.laws = laws;
     model.state.integrator = Box::new(CentralDifference::new(damping));
-    model.state.pairs = storage.pairs;
-    model.state.references = storage.references;
-    model.state.wrenches = storage.wrenches;
-    model.state.subs = storage.subs;
-    model.state.sub_records = storage.sub_records;
-    for (k, p) in model.state.pairs.iter_mut().enumerate() {
+    model.state.contacts = storage;
+    for (k, p) in model.state.contacts.pairs.iter_mut().enumerate() {
         let (a, b) = (&model.state.blocks[p.a as usize], &model.state.blocks[p.b as usize]);
         p.cache_local_faces(Block::shape(a), Block::shape(b));
-        p.cells = crate::contact::CellSummary::of(&model.state.subs[p.range()]);
+        p.cells = crate::contact::CellSummary::of(&model.state.contacts.subs[p.range()]);
         // Dashpot forces still held must be seen (and their work booked) by the next step.
-        p.dashpots |= model.state.sub_records[p.range()]
+        p.dashpots |= model.state.contacts.sub_records[p.range()]
             .iter()
             .any(|r| r.dashpot != Vector::ZERO);
         // A cell's half sizes are lengths: finite (a huge number read into an `f32` is
         // infinite, and would be saved as `null`) and not negative.
-        if let Some(j) = model.state.subs[p.range()]
+        if let Some(j) = model.state.contacts.subs[p.range()]
             .iter()
             .position(|s| !s.half.iter().all(|h| h.is_finite() && *h >= 0.0))
         {
@@ -513,7 +499,7 @@ fn restore_contacts<L: ConstitutiveLaw>(
         // with each normal force placed within its cell's rectangle (where the step put it,
         // `contact/spread.rs`, at the poses before the step's advance).
         let law = &model.state.laws.laws()[p.law as usize];
-        let subs = &model.state.subs[p.range()];
+        let subs = &model.state.contacts.subs[p.range()];
         let (anchored, _) = p.springs_of(subs, law, None);
         let reach = |k: usize| subs.iter().map(|s| s.force.normal.max(0.0) * s.half()[k]).sum::<Real>();
         let scale = 1e-9 * (anchored.force.length() + anchored.per_x.length() + anchored.per_y.length());
@@ -538,9 +524,9 @@ fn restore_contacts<L: ConstitutiveLaw>(
     }
     // The joints' elastic energy is saved with the model: it must be a number (a sub-contact
     // of a tiny area, or a huge force, would make it infinite and the saved file unreadable).
-    for (k, p) in model.state.pairs.iter().enumerate() {
+    for (k, p) in model.state.contacts.pairs.iter().enumerate() {
         let law = &model.state.laws.laws()[p.law as usize];
-        let subs = &model.state.subs[p.range()];
+        let subs = &model.state.contacts.subs[p.range()];
         if let Some(j) = subs
             .iter()
             .position(|s| !law.elastic_energy(s.area, &s.force, &s.state).is_finite())
@@ -573,7 +559,7 @@ fn restore_excitations<L: ConstitutiveLaw>(model: &mut Model<L>, snap: &mut Snap
         model
             .set_base_motion(block, Some(m.motion))
             .map_err(|e| corrupt(&format!("motions[{k}]"), &e.to_string()))?;
-        if let Some(last) = model.state.motions.iter_mut().find(|a| a.block == block.0) {
+        if let Some(last) = model.state.excitations.motions.iter_mut().find(|a| a.block == block.0) {
             last.start = start;
         }
     }
@@ -588,7 +574,13 @@ fn restore_excitations<L: ConstitutiveLaw>(model: &mut Model<L>, snap: &mut Snap
         model
             .set_load_history(block, Some(h.load))
             .map_err(|e| corrupt(&format!("load_histories[{k}]"), &e.to_string()))?;
-        if let Some(last) = model.state.load_histories.iter_mut().find(|a| a.block == block.0) {
+        if let Some(last) = model
+            .state
+            .excitations
+            .load_histories
+            .iter_mut()
+            .find(|a| a.block == block.0)
+        {
             last.start = start;
         }
     }
@@ -599,24 +591,24 @@ fn restore_excitations<L: ConstitutiveLaw>(model: &mut Model<L>, snap: &mut Snap
 /// clock, energies, the last reactions and damping forces; no change owed.
 fn restore_run<L: ConstitutiveLaw>(model: &mut Model<L>, snap: &Snapshot<L>) {
     let state = &mut model.state;
-    state.ref_poses.clone_from(&snap.ref_poses);
-    state.drift = if snap.drift > 0.0 && snap.started {
+    state.found.ref_poses.clone_from(&snap.ref_poses);
+    state.clock.drift = if snap.drift > 0.0 && snap.started {
         snap.drift
     } else {
         0.0
     };
-    state.refine_until = snap.refine_until;
-    state.refine_omega2 = snap.refine_omega2;
-    state.refine_travel = snap.refine_travel;
-    state.refining.clone_from(&snap.refining);
-    state.refining.sort_unstable();
-    state.refining.dedup();
-    state.step = snap.step;
-    state.time = snap.time;
+    state.clock.refine_until = snap.refine_until;
+    state.clock.refine_omega2 = snap.refine_omega2;
+    state.clock.refine_travel = snap.refine_travel;
+    state.clock.refining.clone_from(&snap.refining);
+    state.clock.refining.sort_unstable();
+    state.clock.refining.dedup();
+    state.clock.step = snap.step;
+    state.clock.time = snap.time;
     state.energy = snap.energy;
-    state.started = snap.started;
+    state.clock.started = snap.started;
     state.unbalanced_ratio = snap.unbalanced_ratio.unwrap_or(Real::INFINITY);
-    state.detections = snap.detections;
+    state.found.detections = snap.detections;
     for (r, &(reaction, damping)) in state.records.iter_mut().zip(&snap.last_forces) {
         r.reaction = reaction;
         r.damping = damping;
@@ -635,10 +627,10 @@ fn restore_bounds<L: ConstitutiveLaw>(model: &mut Model<L>, bounds: &[Real]) -> 
     if let Some(i) = bounds.iter().position(|w| !(w.is_finite() && *w >= 0.0)) {
         return Err(corrupt(&format!("bounds[{i}]"), "a finite value ≥ 0 expected"));
     }
-    let bound_areas: Vec<Real> = model.state.references.iter().map(|r| r.bound_area).collect();
+    let bound_areas: Vec<Real> = model.state.contacts.references.iter().map(|r| r.bound_area).collect();
     // An error here is a fixed step above the re-evaluated limit: checked by the caller.
     let _ = model.state.refresh_time_step(&mut model.pipeline);
-    for (r, area) in model.state.references.iter_mut().zip(bound_areas) {
+    for (r, area) in model.state.contacts.references.iter_mut().zip(bound_areas) {
         r.bound_area = area;
     }
     for (i, (stored, fresh)) in bounds.iter().zip(&model.pipeline.bounds).enumerate() {

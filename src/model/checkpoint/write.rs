@@ -15,7 +15,7 @@ use crate::model::Model;
 impl<L: ConstitutiveLaw> Model<L> {
     /// Contact `k` as a checkpoint stores it.
     fn contact_entry(&self, k: usize) -> ContactEntry<L::State> {
-        let (p, r) = (&self.state.pairs[k], &self.state.references[k]);
+        let (p, r) = (&self.state.contacts.pairs[k], &self.state.contacts.references[k]);
         let range = p.range();
         ContactEntry {
             blocks: (p.a, p.b),
@@ -33,10 +33,10 @@ impl<L: ConstitutiveLaw> Model<L> {
             reference_host_rotation: r.ref_host_rotation,
             area: r.area,
             bound_area: r.bound_area,
-            wrench: self.state.wrenches[k],
-            subcontacts: self.state.subs[range.clone()]
+            wrench: self.state.contacts.wrenches[k],
+            subcontacts: self.state.contacts.subs[range.clone()]
                 .iter()
-                .zip(&self.state.sub_records[range])
+                .zip(&self.state.contacts.sub_records[range])
                 .map(|(s, rec)| SubContactEntry {
                     key: rec.key,
                     plane: s.plane,
@@ -87,10 +87,13 @@ where
             damping,
             blocks: self.state.blocks.clone(),
             joints: self.state.laws.clone(),
-            contacts: (0..self.state.pairs.len()).map(|k| self.contact_entry(k)).collect(),
-            ref_poses: self.state.ref_poses.clone(),
+            contacts: (0..self.state.contacts.pairs.len())
+                .map(|k| self.contact_entry(k))
+                .collect(),
+            ref_poses: self.state.found.ref_poses.clone(),
             tested: self
                 .state
+                .found
                 .tested
                 .iter()
                 .map(|t| TestedEntry {
@@ -99,27 +102,27 @@ where
                     slack: t.slack,
                 })
                 .collect(),
-            dt: self.state.dt,
-            critical: self.state.critical,
+            dt: self.state.clock.dt,
+            critical: self.state.clock.critical,
             bounds: self.pipeline.bounds.iter().map(|b| b.omega_squared).collect(),
-            step: self.state.step,
-            time: self.state.time,
+            step: self.state.clock.step,
+            time: self.state.clock.time,
             energy: self.energies(),
-            started: self.state.started,
+            started: self.state.clock.started,
             unbalanced_ratio: self
                 .state
                 .unbalanced_ratio
                 .is_finite()
                 .then_some(self.state.unbalanced_ratio),
-            detections: self.state.detections,
+            detections: self.state.found.detections,
             last_forces: self.state.records.iter().map(|r| (r.reaction, r.damping)).collect(),
-            drift: self.state.drift,
-            refine_until: self.state.refine_until,
-            refine_omega2: self.state.refine_omega2,
-            refine_travel: self.state.refine_travel,
-            refining: self.state.refining.clone(),
-            motions: self.state.motions.clone(),
-            load_histories: self.state.load_histories.clone(),
+            drift: self.state.clock.drift,
+            refine_until: self.state.clock.refine_until,
+            refine_omega2: self.state.clock.refine_omega2,
+            refine_travel: self.state.clock.refine_travel,
+            refining: self.state.clock.refining.clone(),
+            motions: self.state.excitations.motions.clone(),
+            load_histories: self.state.excitations.load_histories.clone(),
             pending_detection: self.state.changes.need_full_detection() || !self.state.refixed.is_empty(),
         };
         let io = |e: serde_json::Error| Error::Io {

@@ -10,16 +10,16 @@ use crate::scenes::{shaking_wall, BENCHMARK_SPACING};
 /// which stay within the room the last fresh layout allowed.
 fn check_layout<L: ConstitutiveLaw>(state: &ModelState<L>, room_limit: usize) {
     let mut end = 0;
-    for (k, p) in state.pairs.iter().enumerate() {
+    for (k, p) in state.contacts.pairs.iter().enumerate() {
         assert!(p.first >= end, "contact {k} starts at {} before {end}", p.first);
         end = p.first + p.count;
     }
-    assert!(end as usize <= state.subs.len(), "sub-contacts past the lists");
-    assert_eq!(state.subs.len(), state.sub_records.len());
+    assert!(end as usize <= state.contacts.subs.len(), "sub-contacts past the lists");
+    assert_eq!(state.contacts.subs.len(), state.contacts.sub_records.len());
     assert!(
-        state.subs.len() <= room_limit,
+        state.contacts.subs.len() <= room_limit,
         "{} sub-contacts' room past {room_limit}",
-        state.subs.len()
+        state.contacts.subs.len()
     );
 }
 
@@ -89,11 +89,16 @@ fn run<L: ConstitutiveLaw>(
     let states = model.blocks().iter().map(|b| *b.state()).collect();
     let s = &model.state;
     let contacts = s
+        .contacts
         .pairs
         .iter()
         .map(|p| {
             let pair = ContactPair { first: 0, ..p.clone() };
-            (pair, s.subs[p.range()].to_vec(), s.sub_records[p.range()].to_vec())
+            (
+                pair,
+                s.contacts.subs[p.range()].to_vec(),
+                s.contacts.sub_records[p.range()].to_vec(),
+            )
         })
         .collect();
     (states, model.energies(), model.pipeline.detection.splices, contacts)
@@ -152,36 +157,45 @@ fn spreading_segments_keeps_every_contacts_subcontacts() {
     let mut model = shaking_wall(300, BENCHMARK_SPACING).expect("wall");
     model.step().expect("first detection");
     let state = &mut model.state;
-    let contacts = state.pairs.len();
+    let contacts = state.contacts.pairs.len();
     assert!(contacts > 4 * SEGMENT, "{contacts} contacts");
     let each: Vec<_> = state
+        .contacts
         .pairs
         .iter()
-        .map(|p| (state.subs[p.range()].to_vec(), state.sub_records[p.range()].to_vec()))
+        .map(|p| {
+            (
+                state.contacts.subs[p.range()].to_vec(),
+                state.contacts.sub_records[p.range()].to_vec(),
+            )
+        })
         .collect();
     // Packed again, as a full detection stages them.
     let (mut subs, mut records) = (Vec::new(), Vec::new());
-    for (p, (s, r)) in state.pairs.iter_mut().zip(&each) {
+    for (p, (s, r)) in state.contacts.pairs.iter_mut().zip(&each) {
         p.first = subs.len() as u32;
         subs.extend_from_slice(s);
         records.extend_from_slice(r);
     }
     let live = subs.len();
-    (state.subs, state.sub_records) = (subs, records);
+    (state.contacts.subs, state.contacts.sub_records) = (subs, records);
     state.spread_segments();
     check_layout(state, room_limit(live));
-    for (k, (p, (s, r))) in state.pairs.iter().zip(&each).enumerate() {
-        assert!(state.subs[p.range()] == s[..], "contact {k}'s sub-contacts");
-        assert!(state.sub_records[p.range()] == r[..], "contact {k}'s records");
+    for (k, (p, (s, r))) in state.contacts.pairs.iter().zip(&each).enumerate() {
+        assert!(state.contacts.subs[p.range()] == s[..], "contact {k}'s sub-contacts");
+        assert!(state.contacts.sub_records[p.range()] == r[..], "contact {k}'s records");
     }
     let gaps = contacts.div_ceil(SEGMENT) - 1;
     assert!(
-        state.subs.len() >= live + 4 * gaps,
+        state.contacts.subs.len() >= live + 4 * gaps,
         "{} for {live} live",
-        state.subs.len()
+        state.contacts.subs.len()
     );
     for k in 1..=gaps {
-        let (before, after) = (&state.pairs[k * SEGMENT - 1], &state.pairs[k * SEGMENT]);
+        let (before, after) = (
+            &state.contacts.pairs[k * SEGMENT - 1],
+            &state.contacts.pairs[k * SEGMENT],
+        );
         assert!(
             after.first >= before.first + before.count + 4,
             "no slack before segment {k}"

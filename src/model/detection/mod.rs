@@ -57,7 +57,7 @@ fn plan_chunk(pairs: usize) -> usize {
 /// Buffers reused from one detection to the next.
 #[derive(Debug, Clone)]
 pub(crate) struct DetectionScratch<S> {
-    /// Set by the fused block pass ([`Model::advance_blocks`]) after it moved the blocks and
+    /// Set by the fused block pass ([`ModelState::block_pass`](super::ModelState::block_pass)) after it moved the blocks and
     /// took their rotation matrices and movement check for the next step: whether any block
     /// moved beyond the re-detection trigger. Taken (reset) by the next step.
     pub prepared: Option<bool>,
@@ -144,7 +144,10 @@ impl<S> DetectionScratch<S> {
     /// `staged` and `first_sub`, each task's `place`. In a fresh layout (`staging_spread`)
     /// [`segment_slack`] follows every [`SEGMENT`] contacts.
     fn place_staged(&mut self, batch: std::ops::Range<usize>, chunk: usize) {
-        let (mut contacts, mut cursor) = (self.staging.pairs.len() as u32, self.staging.subs.len() as u32);
+        let (mut contacts, mut cursor) = (
+            self.staging.store.pairs.len() as u32,
+            self.staging.store.subs.len() as u32,
+        );
         for (k, outcomes) in self.outcomes[batch].chunks_mut(chunk).enumerate() {
             self.chunks[k].place = (contacts, cursor);
             for o in outcomes {
@@ -273,7 +276,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(pipeline.detection.moved.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.blocks.par_chunks(BLOCK_CHUNK))
-            .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
+            .zip(self.found.ref_poses.par_chunks(BLOCK_CHUNK))
             .map(|(((rotations, moved), blocks), refs)| {
                 prepare_chunk(rotations, moved, blocks, refs, check.then_some(trigger))
             })
@@ -309,11 +312,12 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             sc.boxes.extend(
                 self.blocks
                     .iter()
-                    .zip(&self.ref_poses)
+                    .zip(&self.found.ref_poses)
                     .map(|(b, r)| reference_box(b, r, reach)),
             );
         }
-        self.ref_poses
+        self.found
+            .ref_poses
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(sc.boxes.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.blocks.par_chunks(BLOCK_CHUNK))
@@ -338,17 +342,17 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             for i in (0..n).filter(|&i| sc.moved[i]) {
                 sc.fixed[i] = self.blocks[i].fixity().is_fixed();
             }
-            for m in &self.motions {
+            for m in &self.excitations.motions {
                 sc.fixed[m.block as usize] = self.blocks[m.block as usize].fixity().is_fixed();
             }
         }
-        if sc.contact_keys.len() != self.pairs.len() {
+        if sc.contact_keys.len() != self.contacts.pairs.len() {
             sc.contact_keys.clear();
-            sc.contact_keys.extend(self.pairs.iter().map(|p| (p.a, p.b)));
+            sc.contact_keys.extend(self.contacts.pairs.iter().map(|p| (p.a, p.b)));
         }
-        if sc.tested_keys.len() != self.tested.len() {
+        if sc.tested_keys.len() != self.found.tested.len() {
             sc.tested_keys.clear();
-            sc.tested_keys.extend(self.tested.iter().map(|t| (t.a, t.b)));
+            sc.tested_keys.extend(self.found.tested.iter().map(|t| (t.a, t.b)));
         }
         plan(
             &sc.candidates,
@@ -367,10 +371,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         let test = PairTest {
             blocks: &self.blocks,
-            tested: &self.tested,
+            tested: &self.found.tested,
             params: &params,
             keep_within: (!full).then_some(KEEP_FRACTION * trigger),
-            pairs: &self.pairs,
+            pairs: &self.contacts.pairs,
         };
         // In batches, so that the seeds of a full detection are not all held at once: the tests
         // of a batch in parallel; the places of its contacts in the staging lists, in plan
@@ -385,7 +389,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 // Nothing of the contacts has changed yet, but the moved blocks took their
                 // reference poses: the next detection is a full one.
                 self.changes.insert(Changes::DETECTION);
-                return Err(Error::Interrupted { step: self.step });
+                return Err(Error::Interrupted { step: self.clock.step });
             }
             let batch = start..(start + BATCH).min(sc.plan.len());
             sc.outcomes[batch.clone()]
@@ -393,7 +397,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 .zip(sc.plan[batch.clone()].par_chunks(chunk))
                 .zip(sc.chunks.par_iter_mut())
                 .for_each(|((outcomes, plan), scratch)| test.run(plan, outcomes, scratch));
-            if self.started {
+            if self.clock.started {
                 // Blocks passing through each other (the joints overloaded): an error at the
                 // first such pair in plan order, before anything changes. (At the first
                 // detection, deep initial overlaps are `Error::InitialOverlap`.)
@@ -415,11 +419,16 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 slices,
             )?;
         }
-        if sc.staging_spread && sc.staging.pairs.len().is_multiple_of(SEGMENT) {
+        if sc.staging_spread && sc.staging.store.pairs.len().is_multiple_of(SEGMENT) {
             // No dead room after the last segment.
-            let end = sc.staging.pairs.last().map_or(0, |p| (p.first + p.count) as usize);
-            sc.staging.subs.truncate(end);
-            sc.staging.records.truncate(end);
+            let end = sc
+                .staging
+                .store
+                .pairs
+                .last()
+                .map_or(0, |p| (p.first + p.count) as usize);
+            sc.staging.store.subs.truncate(end);
+            sc.staging.store.sub_records.truncate(end);
         }
         let index = BlockIndex {
             offsets: &pipeline.block_offsets,
@@ -437,12 +446,12 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         self.energy.damping += dashpot;
         if !in_place {
             sc.contact_keys.clear();
-            sc.contact_keys.extend(self.pairs.iter().map(|p| (p.a, p.b)));
+            sc.contact_keys.extend(self.contacts.pairs.iter().map(|p| (p.a, p.b)));
         }
         // A full detection follows a change of parameters (the tolerance that the slack of a
         // pair found apart was measured against): its entries are merged afresh.
         let merged = !update_tested(
-            &mut self.tested,
+            &mut self.found.tested,
             &sc.plan,
             &sc.outcomes,
             &sc.moved,
@@ -451,10 +460,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         );
         if merged {
             sc.tested_keys.clear();
-            sc.tested_keys.extend(self.tested.iter().map(|t| (t.a, t.b)));
+            sc.tested_keys.extend(self.found.tested.iter().map(|t| (t.a, t.b)));
         }
         sc.tests += sc.outcomes.iter().filter(|o| o.tested).count() as u64;
-        self.detections += 1;
+        self.found.detections += 1;
         if sc.reindex {
             self.rebuild_block_index(pipeline);
         }
@@ -463,7 +472,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // those contacts' blocks. A forced full detection follows a change of laws, parameters
         // or fixity: every block's bound is re-evaluated then. The flag is set (or stays set) if
         // that fails, so the error repeats rather than the run going on with an unstable step.
-        if full || self.critical.is_none() {
+        if full || self.clock.critical.is_none() {
             self.changes.insert(Changes::DETECTION);
             self.refresh_time_step(pipeline)?;
         } else {
@@ -473,7 +482,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 let replaced = &pipeline.detection.replaced;
                 self.take_grown(replaced.iter().map(|r| r.contact as usize), &mut blocks);
             } else {
-                self.take_grown(0..self.pairs.len(), &mut blocks);
+                self.take_grown(0..self.contacts.pairs.len(), &mut blocks);
             }
             let grew = !blocks.is_empty();
             pipeline.refresh_blocks = blocks;
@@ -501,7 +510,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .find_map(|(p, o)| {
                 let limit = 0.5 * self.blocks[p.a as usize].radius.min(self.blocks[p.b as usize].radius);
                 (o.overlap > limit).then_some(Error::Overlap {
-                    step: self.step,
+                    step: self.clock.step,
                     a: BlockId(p.a),
                     b: BlockId(p.b),
                     depth: o.overlap,
@@ -528,7 +537,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let n = self.blocks.len();
         pipeline.block_offsets.clear();
         pipeline.block_offsets.resize(n + 1, 0);
-        for p in &self.pairs {
+        for p in &self.contacts.pairs {
             pipeline.block_offsets[p.a as usize + 1] += 1;
             pipeline.block_offsets[p.b as usize + 1] += 1;
         }
@@ -539,7 +548,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         pipeline.block_contacts.resize(pipeline.block_offsets[n] as usize, 0);
         let mut fill: Vec<u32> = pipeline.block_offsets[..n].to_vec();
         // Each entry is `2 × contact + side`, side 1 when the block is the contact's `b`.
-        for (c, p) in self.pairs.iter().enumerate() {
+        for (c, p) in self.contacts.pairs.iter().enumerate() {
             for (k, side) in [(p.a as usize, 0), (p.b as usize, 1)] {
                 pipeline.block_contacts[fill[k] as usize] = 2 * c as u32 + side;
                 fill[k] += 1;

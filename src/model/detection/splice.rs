@@ -6,7 +6,7 @@ use super::super::ModelState;
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    stored_node_frame, ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord,
+    stored_node_frame, ContactLists, ContactPair, ContactWrench, DisplacementMode, OldContacts, SubContactRecord,
 };
 use crate::error::Result;
 use crate::geometry::{ContactKind, NodeId};
@@ -226,34 +226,6 @@ pub(super) struct Run {
     pub(super) len: u32,
 }
 
-/// The contact lists before a re-detection, for [`dropped_work`].
-pub(super) struct OldContacts<'a, S> {
-    pub(super) pairs: &'a [ContactPair],
-    pub(super) references: &'a [ContactReference],
-    pub(super) subs: &'a [SubContact<S>],
-    pub(super) records: &'a [SubContactRecord],
-}
-
-/// Contact lists as detection writes them: the staging lists, or the model's as they are
-/// rearranged.
-pub(super) struct ContactLists<'a, S> {
-    pub(super) pairs: &'a mut Vec<ContactPair>,
-    pub(super) references: &'a mut Vec<ContactReference>,
-    pub(super) wrenches: &'a mut Vec<ContactWrench>,
-    pub(super) subs: &'a mut Vec<SubContact<S>>,
-    pub(super) records: &'a mut Vec<SubContactRecord>,
-}
-
-impl<S: Clone + Default> ContactLists<'_, S> {
-    pub(super) fn clear(&mut self) {
-        self.pairs.clear();
-        self.references.clear();
-        self.wrenches.clear();
-        self.subs.clear();
-        self.records.clear();
-    }
-}
-
 /// The work still owed by sub-contacts that re-detection drops while they carry a force:
 /// `(joint work, dashpot dissipation)` (J).
 ///
@@ -354,7 +326,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         index: BlockIndex<'_>,
     ) -> Option<(Real, Real)> {
         let n = self.blocks.len();
-        if index.offsets.len() != n + 1 || index.offsets[n] as usize != 2 * self.pairs.len() {
+        if index.offsets.len() != n + 1 || index.offsets[n] as usize != 2 * self.contacts.pairs.len() {
             return None;
         }
         sc.replaced.clear();
@@ -370,7 +342,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     sc.replaced.push(Replaced {
                         contact: k as u32,
                         staged: o.staged,
-                        first: self.pairs[k].first,
+                        first: self.contacts.pairs[k].first,
                     });
                 }
             }
@@ -381,7 +353,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         for i in (0..n).filter(|&i| moved[i]) {
             for &e in &index.contacts[index.offsets[i] as usize..index.offsets[i + 1] as usize] {
                 // Counted once: at `a`, or at `b` when `a` did not move.
-                if e % 2 == 0 || !moved[self.pairs[(e / 2) as usize].a as usize] {
+                if e % 2 == 0 || !moved[self.contacts.pairs[(e / 2) as usize].a as usize] {
                     moved_contacts += 1;
                 }
             }
@@ -391,19 +363,19 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         // Where the re-tested contacts go, and the kept ones they push.
         sc.pushed.clear();
-        let contacts = self.pairs.len();
-        let room = self.subs.len() as u32;
+        let contacts = self.contacts.pairs.len();
+        let room = self.contacts.subs.len() as u32;
         let mut needed = room;
         let mut window_end = 0;
-        let count = |staged: u32| sc.staging.pairs[staged as usize].count;
+        let count = |staged: u32| sc.staging.store.pairs[staged as usize].count;
         for r in 0..sc.replaced.len() {
             let Replaced { contact: k, staged, .. } = sc.replaced[r];
             let k = k as usize;
             if k < window_end {
                 continue; // placed by the push of a contact before it
             }
-            let end = self.pairs.get(k + 1).map_or(room, |q| q.first);
-            let (first, m) = (self.pairs[k].first, count(staged));
+            let end = self.contacts.pairs.get(k + 1).map_or(room, |q| q.first);
+            let (first, m) = (self.contacts.pairs[k].first, count(staged));
             if first + m <= end {
                 continue;
             }
@@ -411,7 +383,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             // until one's home is far enough back.
             let mut cursor = first + m + headroom(m);
             let (mut j, mut next) = (k + 1, r + 1);
-            while j < contacts && cursor > self.pairs[j].first {
+            while j < contacts && cursor > self.contacts.pairs[j].first {
                 match sc.replaced.get(next).copied() {
                     Some(q) if q.contact as usize == j => {
                         sc.replaced[next].first = cursor;
@@ -420,7 +392,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     }
                     _ => {
                         // Neighbours pushed by as much move as one run.
-                        let (p, shift) = (&self.pairs[j], cursor - self.pairs[j].first);
+                        let (p, shift) = (&self.contacts.pairs[j], cursor - self.contacts.pairs[j].first);
                         match sc.pushed.last_mut() {
                             Some(run) if run.contacts.end as usize == j && run.shift == shift => run.contacts.end += 1,
                             _ => sc.pushed.push(Pushed {
@@ -441,16 +413,18 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         // The work of the dropped sub-contacts, in contact order as `dropped_work` sums it,
         // before anything moves.
-        let old = OldContacts {
-            pairs: &self.pairs,
-            references: &self.references,
-            subs: &self.subs,
-            records: &self.sub_records,
+        let old = self.contacts.old();
+        let dt = if self.clock.drift > 0.0 {
+            self.clock.drift
+        } else {
+            self.clock.dt
         };
-        let dt = if self.drift > 0.0 { self.drift } else { self.dt };
         let mut owed = (0.0, 0.0);
         for r in &sc.replaced {
-            let successor = (&sc.staging.pairs[r.staged as usize], sc.staging.records.as_slice());
+            let successor = (
+                &sc.staging.store.pairs[r.staged as usize],
+                sc.staging.store.sub_records.as_slice(),
+            );
             add_dropped_work(
                 &old,
                 r.contact as usize,
@@ -464,40 +438,40 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if needed > room {
             // Dead room (sub-contacts not in any contact's range are never read).
             let (sub, record) = dead_subcontact();
-            self.subs.resize(needed as usize, sub);
-            self.sub_records.resize(needed as usize, record);
+            self.contacts.subs.resize(needed as usize, sub);
+            self.contacts.sub_records.resize(needed as usize, record);
         }
         // Pushed contacts move from the last: each moves into room that is dead by then (the
         // old room of the ones after it, which moved further back, or of re-tested ones).
         for run in sc.pushed.iter().rev() {
-            let contacts = &mut self.pairs[run.contacts.start as usize..run.contacts.end as usize];
+            let contacts = &mut self.contacts.pairs[run.contacts.start as usize..run.contacts.end as usize];
             let last = &contacts[contacts.len() - 1];
             let (start, end) = (
                 contacts[0].first as usize,
                 (last.first + last.count + run.shift) as usize,
             );
             let moved = start..end - run.shift as usize;
-            move_into_dead_room(&mut self.subs, moved.clone(), i64::from(run.shift));
-            move_into_dead_room(&mut self.sub_records, moved, i64::from(run.shift));
+            move_into_dead_room(&mut self.contacts.subs, moved.clone(), i64::from(run.shift));
+            move_into_dead_room(&mut self.contacts.sub_records, moved, i64::from(run.shift));
             for p in contacts {
                 p.first += run.shift;
             }
         }
         for r in &sc.replaced {
             let (k, s) = (r.contact as usize, r.staged as usize);
-            let q = &sc.staging.pairs[s];
+            let q = &sc.staging.store.pairs[s];
             let to = r.first as usize..(r.first + q.count) as usize;
-            self.subs[to.clone()].clone_from_slice(&sc.staging.subs[q.range()]);
-            self.sub_records[to].clone_from_slice(&sc.staging.records[q.range()]);
-            self.pairs[k] = q.clone();
-            self.pairs[k].first = r.first;
-            self.references[k] = sc.staging.references[s].clone();
-            self.wrenches[k] = sc.staging.wrenches[s];
+            self.contacts.subs[to.clone()].clone_from_slice(&sc.staging.store.subs[q.range()]);
+            self.contacts.sub_records[to].clone_from_slice(&sc.staging.store.sub_records[q.range()]);
+            self.contacts.pairs[k] = q.clone();
+            self.contacts.pairs[k].first = r.first;
+            self.contacts.references[k] = sc.staging.store.references[s].clone();
+            self.contacts.wrenches[k] = sc.staging.store.wrenches[s];
         }
         sc.reindex = false;
         sc.splices.in_place += 1;
         sc.splices.pushed += u64::from(!sc.pushed.is_empty() || needed > room);
-        if STAGING_FRACTION * sc.staging.subs.capacity() > self.subs.len().max(1) {
+        if STAGING_FRACTION * sc.staging.store.subs.capacity() > self.contacts.subs.len().max(1) {
             sc.release_staging();
         }
         Some(owed)
@@ -512,12 +486,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// when contacts changed places.
     pub(super) fn splice_contacts(&mut self, sc: &mut DetectionScratch<L::State>) -> Result<(Real, Real)> {
         // The new order: kept old contacts and staged new ones, by pair.
-        let old = OldContacts {
-            pairs: &self.pairs,
-            references: &self.references,
-            subs: &self.subs,
-            records: &self.sub_records,
-        };
+        let old = self.contacts.old();
         sc.kept.clear();
         sc.kept.resize(old.pairs.len(), false);
         sc.layout.clear();
@@ -552,30 +521,34 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         let owed = dropped_work(
             &old,
-            (&sc.staging.pairs, &sc.staging.records),
+            (&sc.staging.store.pairs, &sc.staging.store.sub_records),
             &sc.kept,
             &self.blocks,
             self.params.mode,
-            if self.drift > 0.0 { self.drift } else { self.dt },
+            if self.clock.drift > 0.0 {
+                self.clock.drift
+            } else {
+                self.clock.dt
+            },
         );
-        sc.reindex = sc.layout.len() != self.pairs.len()
+        sc.reindex = sc.layout.len() != self.contacts.pairs.len()
             || sc.layout.iter().enumerate().any(|(k, slot)| match *slot {
                 Slot::Kept(c) => c as usize != k,
                 Slot::Staged { staged, .. } => {
-                    let q = &sc.staging.pairs[staged as usize];
-                    self.pairs.get(k).is_none_or(|p| (p.a, p.b) != (q.a, q.b))
+                    let q = &sc.staging.store.pairs[staged as usize];
+                    self.contacts.pairs.get(k).is_none_or(|p| (p.a, p.b) != (q.a, q.b))
                 }
             });
         if sc.layout.iter().all(|slot| matches!(slot, Slot::Staged { .. })) {
             // Every contact detected afresh (the first detection, a full one): the staging lists
             // are the new lists, and the old ones are released rather than kept as staging.
-            std::mem::swap(&mut self.pairs, &mut sc.staging.pairs);
-            std::mem::swap(&mut self.references, &mut sc.staging.references);
-            std::mem::swap(&mut self.wrenches, &mut sc.staging.wrenches);
-            std::mem::swap(&mut self.subs, &mut sc.staging.subs);
-            std::mem::swap(&mut self.sub_records, &mut sc.staging.records);
+            std::mem::swap(&mut self.contacts.pairs, &mut sc.staging.store.pairs);
+            std::mem::swap(&mut self.contacts.references, &mut sc.staging.store.references);
+            std::mem::swap(&mut self.contacts.wrenches, &mut sc.staging.store.wrenches);
+            std::mem::swap(&mut self.contacts.subs, &mut sc.staging.store.subs);
+            std::mem::swap(&mut self.contacts.sub_records, &mut sc.staging.store.sub_records);
             sc.release_staging();
-            sc.room_limit = room_limit(self.pairs.iter().map(|p| p.count as usize).sum());
+            sc.room_limit = room_limit(self.contacts.pairs.iter().map(|p| p.count as usize).sum());
             sc.splices.full += 1;
             sc.splices.fresh += 1;
             if !sc.staging_spread {
@@ -587,9 +560,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // room between contacts (`place_subcontacts`).
         let (end, limit, fresh) = place_subcontacts(
             &sc.layout,
-            &self.pairs,
-            &sc.staging.pairs,
-            self.subs.len() as u32,
+            &self.contacts.pairs,
+            &sc.staging.store.pairs,
+            self.contacts.subs.len() as u32,
             sc.room_limit == 0 || sc.fresh_forced(),
             &mut sc.firsts,
         );
@@ -597,18 +570,21 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         sc.splices.full += 1;
         sc.splices.fresh += u64::from(fresh);
         let (contacts, room) = (sc.layout.len(), end as usize);
-        if contacts > self.pairs.len() {
+        if contacts > self.contacts.pairs.len() {
             // Room for the new contacts (the fillers are overwritten below).
-            let filler = (sc.staging.pairs[0].clone(), sc.staging.references[0].clone());
-            self.pairs.resize(contacts, filler.0);
-            self.references.resize(contacts, filler.1);
-            self.wrenches.resize(contacts, ContactWrench::default());
+            let filler = (
+                sc.staging.store.pairs[0].clone(),
+                sc.staging.store.references[0].clone(),
+            );
+            self.contacts.pairs.resize(contacts, filler.0);
+            self.contacts.references.resize(contacts, filler.1);
+            self.contacts.wrenches.resize(contacts, ContactWrench::default());
         }
-        if room > self.subs.len() {
+        if room > self.contacts.subs.len() {
             // Dead room (sub-contacts not in any contact's range are never read).
             let (sub, record) = dead_subcontact();
-            self.subs.resize(room, sub);
-            self.sub_records.resize(room, record);
+            self.contacts.subs.resize(room, sub);
+            self.contacts.sub_records.resize(room, record);
         }
         // The kept contacts' sub-contacts move first, in runs of equal shift (while the contacts
         // still hold their old ranges), then the contacts, in runs that were neighbours and stay
@@ -619,7 +595,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let mut last_shift = 0;
         for (k, slot) in sc.layout.iter().enumerate() {
             let Slot::Kept(c) = *slot else { continue };
-            let p = &self.pairs[c as usize];
+            let p = &self.contacts.pairs[c as usize];
             let (start, end) = (p.first, p.first + p.count);
             let shift = i64::from(sc.firsts[k]) - i64::from(start);
             // A run takes in the dead room between its contacts (that of re-tested ones).
@@ -638,13 +614,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 }),
             }
         }
-        let mut lists = ContactLists {
-            pairs: &mut self.pairs,
-            references: &mut self.references,
-            wrenches: &mut self.wrenches,
-            subs: &mut self.subs,
-            records: &mut self.sub_records,
-        };
+        let mut lists = self.contacts.lists();
         for run in &sc.sub_runs {
             lists.move_subcontacts(run.start as usize..run.end as usize, run.shift, Direction::Front);
         }
@@ -662,23 +632,23 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             match *slot {
                 Slot::Kept(_) => lists.pairs[k].first = first,
                 Slot::Staged { staged: s, .. } => {
-                    let q = &sc.staging.pairs[s as usize];
+                    let q = &sc.staging.store.pairs[s as usize];
                     let (from, to) = (q.range(), first as usize..(first + q.count) as usize);
-                    lists.subs[to.clone()].clone_from_slice(&sc.staging.subs[from.clone()]);
-                    lists.records[to].clone_from_slice(&sc.staging.records[from]);
+                    lists.subs[to.clone()].clone_from_slice(&sc.staging.store.subs[from.clone()]);
+                    lists.records[to].clone_from_slice(&sc.staging.store.sub_records[from]);
                     lists.pairs[k] = q.clone();
                     lists.pairs[k].first = first;
-                    lists.references[k] = sc.staging.references[s as usize].clone();
-                    lists.wrenches[k] = sc.staging.wrenches[s as usize];
+                    lists.references[k] = sc.staging.store.references[s as usize].clone();
+                    lists.wrenches[k] = sc.staging.store.wrenches[s as usize];
                 }
             }
         }
-        self.pairs.truncate(contacts);
-        self.references.truncate(contacts);
-        self.wrenches.truncate(contacts);
-        self.subs.truncate(room);
-        self.sub_records.truncate(room);
-        if STAGING_FRACTION * sc.staging.subs.capacity() > self.subs.len().max(1) {
+        self.contacts.pairs.truncate(contacts);
+        self.contacts.references.truncate(contacts);
+        self.contacts.wrenches.truncate(contacts);
+        self.contacts.subs.truncate(room);
+        self.contacts.sub_records.truncate(room);
+        if STAGING_FRACTION * sc.staging.store.subs.capacity() > self.contacts.subs.len().max(1) {
             sc.release_staging();
         }
         Ok(owed)
@@ -687,26 +657,32 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// Leaves [`segment_slack`] after every [`SEGMENT`] contacts of packed lists (as a full
     /// detection stages them): the fresh layout of [`place_subcontacts`].
     pub(super) fn spread_segments(&mut self) {
-        let segments = self.pairs.len().div_ceil(SEGMENT);
-        let contacts = self.pairs.len();
+        let segments = self.contacts.pairs.len().div_ceil(SEGMENT);
+        let contacts = self.contacts.pairs.len();
         let segment = |k: usize| k * SEGMENT..((k + 1) * SEGMENT).min(contacts);
         let slack = |pairs: &[ContactPair], k: usize| segment_slack(pairs[segment(k)].iter().map(|p| p.count).sum());
         // Segment `k` moves back by the slack of the segments before it, the last one first,
         // into room that is dead by then.
-        let mut shift: u32 = (0..segments.saturating_sub(1)).map(|k| slack(&self.pairs, k)).sum();
+        let mut shift: u32 = (0..segments.saturating_sub(1))
+            .map(|k| slack(&self.contacts.pairs, k))
+            .sum();
         let (sub, record) = dead_subcontact();
-        self.subs.resize(self.subs.len() + shift as usize, sub);
-        self.sub_records.resize(self.sub_records.len() + shift as usize, record);
+        self.contacts
+            .subs
+            .resize(self.contacts.subs.len() + shift as usize, sub);
+        self.contacts
+            .sub_records
+            .resize(self.contacts.sub_records.len() + shift as usize, record);
         for k in (1..segments).rev() {
-            let contacts = &mut self.pairs[segment(k)];
+            let contacts = &mut self.contacts.pairs[segment(k)];
             let last = &contacts[contacts.len() - 1];
             let (start, end) = (contacts[0].first as usize, (last.first + last.count) as usize);
-            move_into_dead_room(&mut self.subs, start..end, i64::from(shift));
-            move_into_dead_room(&mut self.sub_records, start..end, i64::from(shift));
+            move_into_dead_room(&mut self.contacts.subs, start..end, i64::from(shift));
+            move_into_dead_room(&mut self.contacts.sub_records, start..end, i64::from(shift));
             for p in contacts.iter_mut() {
                 p.first += shift;
             }
-            shift -= slack(&self.pairs, k - 1);
+            shift -= slack(&self.contacts.pairs, k - 1);
         }
     }
 }

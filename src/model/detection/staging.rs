@@ -7,7 +7,8 @@ use super::super::ModelState;
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    node_frame, AnchorPlane, ContactPair, ContactReference, ContactWrench, ForceMoments, SubContact, SubContactRecord,
+    node_frame, AnchorPlane, ContactLists, ContactPair, ContactReference, ContactStore, ContactWrench, ForceMoments,
+    OldContacts, SubContact, SubContactRecord,
 };
 use crate::error::Result;
 use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubContactSeed, SubKey, PARALLEL_ANGLE};
@@ -65,11 +66,8 @@ pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
 /// and of each task of its narrow phase.
 #[derive(Debug, Clone)]
 pub(super) struct StagedLists<S> {
-    pub(super) pairs: Vec<ContactPair>,
-    pub(super) references: Vec<ContactReference>,
-    pub(super) wrenches: Vec<ContactWrench>,
-    pub(super) subs: Vec<SubContact<S>>,
-    pub(super) records: Vec<SubContactRecord>,
+    /// The lists, as the model's.
+    pub(super) store: ContactStore<S>,
     /// The contacts and sub-contacts (dead room included) placed so far.
     pub(super) placed: (usize, usize),
 }
@@ -77,11 +75,7 @@ pub(super) struct StagedLists<S> {
 impl<S> Default for StagedLists<S> {
     fn default() -> Self {
         Self {
-            pairs: Vec::new(),
-            references: Vec::new(),
-            wrenches: Vec::new(),
-            subs: Vec::new(),
-            records: Vec::new(),
+            store: ContactStore::default(),
             placed: (0, 0),
         }
     }
@@ -89,13 +83,7 @@ impl<S> Default for StagedLists<S> {
 
 impl<S> StagedLists<S> {
     pub(super) fn lists(&mut self) -> ContactLists<'_, S> {
-        ContactLists {
-            pairs: &mut self.pairs,
-            references: &mut self.references,
-            wrenches: &mut self.wrenches,
-            subs: &mut self.subs,
-            records: &mut self.records,
-        }
+        self.store.lists()
     }
 }
 
@@ -104,25 +92,31 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
     /// dead entries written in parallel (the first touch of a large list's memory is most of
     /// its cost), and returns the slices of the new entries, for the contacts to be written.
     pub(super) fn grow(&mut self) -> StagingSlices<'_, S> {
-        let (pair_base, sub_base) = (self.pairs.len(), self.subs.len());
+        let (pair_base, sub_base) = (self.store.pairs.len(), self.store.subs.len());
         let (contacts, subs) = self.placed;
         let (pair, reference) = dead_contact();
         let (sub, record) = dead_subcontact();
-        self.pairs.par_extend(rayon::iter::repeat_n(pair, contacts - pair_base));
-        self.references
+        self.store
+            .pairs
+            .par_extend(rayon::iter::repeat_n(pair, contacts - pair_base));
+        self.store
+            .references
             .par_extend(rayon::iter::repeat_n(reference, contacts - pair_base));
-        self.wrenches
+        self.store
+            .wrenches
             .par_extend(rayon::iter::repeat_n(ContactWrench::default(), contacts - pair_base));
-        self.subs.par_extend(rayon::iter::repeat_n(sub, subs - sub_base));
-        self.records.par_extend(rayon::iter::repeat_n(record, subs - sub_base));
+        self.store.subs.par_extend(rayon::iter::repeat_n(sub, subs - sub_base));
+        self.store
+            .sub_records
+            .par_extend(rayon::iter::repeat_n(record, subs - sub_base));
         StagingSlices {
             pair_base,
             sub_base,
-            pairs: &mut self.pairs[pair_base..],
-            references: &mut self.references[pair_base..],
-            wrenches: &mut self.wrenches[pair_base..],
-            subs: &mut self.subs[sub_base..],
-            records: &mut self.records[sub_base..],
+            pairs: &mut self.store.pairs[pair_base..],
+            references: &mut self.store.references[pair_base..],
+            wrenches: &mut self.store.wrenches[pair_base..],
+            subs: &mut self.store.subs[sub_base..],
+            records: &mut self.store.sub_records[sub_base..],
         }
     }
 }
@@ -354,10 +348,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         let Some(scratch) = chunks.first() else { return Ok(()) };
         let old = OldContacts {
-            pairs: &self.pairs,
-            references: &self.references,
-            subs: &self.subs,
-            records: &self.sub_records,
+            pairs: &self.contacts.pairs,
+            references: &self.contacts.references,
+            subs: &self.contacts.subs,
+            records: &self.contacts.sub_records,
         };
         let mut slices = slices;
         for (p, o) in plan.iter().zip(outcomes) {

@@ -1,6 +1,6 @@
 //! The step's pass over the blocks, after the contact pass: each block gathers its contacts'
 //! wrenches, adds gravity and its load, and the integrator moves it; the energy terms due
-//! before and after the move are booked on the way (see [`Model::advance_blocks`]).
+//! before and after the move are booked on the way (see [`ModelState::block_pass`]).
 //!
 //! The integrator advances each block on its own ([`Integrator::advance_chunk`]), so the three
 //! stages run chunk by chunk in one parallel pass, while the chunk's blocks are in cache, with
@@ -17,15 +17,9 @@ use crate::block::{Block, Dof, RigidBlock, Wrench};
 use crate::contact::{ContactWrench, DisplacementMode};
 use crate::error::Error;
 use crate::ids::BlockId;
-use crate::integrate::{Integrator, StepDurations, StepRecord, TimeStep};
+use crate::integrate::{Integrator, StepDurations, StepRecord};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real, Vector};
-
-/// The fraction of the contact tolerance that an automatic step lets the fastest block move
-/// (estimated from the speeds at the end of the last step and gravity): half, so that a speed
-/// that doubles within a step still moves no block further than the tolerance, beyond which a
-/// contact could be missed and the run stops ([`Error::StepTooLong`]).
-pub(super) const STEP_TRAVEL: Real = 0.5;
 
 /// What the per-block stages read besides the block itself.
 #[derive(Clone, Copy)]
@@ -186,20 +180,20 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// exact identity of central difference for translation. Sums are taken per chunk of
     /// [`BLOCK_CHUNK`] blocks in block order, then over the chunks in order: the results do not
     /// depend on the thread count.
-    pub(super) fn advance_blocks(
+    pub(super) fn block_pass(
         &mut self,
         pipeline: &mut Pipeline<L::State>,
         kick: Real,
         drift: Real,
     ) -> (Option<usize>, Option<(usize, Real)>) {
         let pass = BlockPass {
-            wrenches: &self.wrenches,
+            wrenches: &self.contacts.wrenches,
             contacts: &pipeline.block_contacts,
             offsets: &pipeline.block_offsets,
             gravity: self.params.gravity,
-            dt: self.drift,
+            dt: self.clock.drift,
             drift_over_kick: if kick == drift { 1.0 } else { drift / kick },
-            first: if self.step == 0 { 0.5 } else { 1.0 },
+            first: if self.clock.step == 0 { 0.5 } else { 1.0 },
             max_speed2: self.params.max_speed * self.params.max_speed,
             trigger: (self.params.mode == DisplacementMode::Large)
                 .then_some(self.params.contact.redetect_fraction * self.params.contact.tolerance),
@@ -224,7 +218,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .zip(self.records.par_chunks_mut(BLOCK_CHUNK))
             .zip(pipeline.rotations.par_chunks_mut(BLOCK_CHUNK))
             .zip(pipeline.detection.moved.par_chunks_mut(BLOCK_CHUNK))
-            .zip(self.ref_poses.par_chunks(BLOCK_CHUNK))
+            .zip(self.found.ref_poses.par_chunks(BLOCK_CHUNK))
             .zip(pipeline.block_sums.par_iter_mut())
             .enumerate()
             .for_each(
@@ -271,10 +265,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             e.damping += s.dashpot_work;
         }
         let force_magnitudes: Real = pipeline.pair_sums.iter().map(|s| s.force_magnitude).sum();
-        let mean_contact = if self.pairs.is_empty() {
+        let mean_contact = if self.contacts.pairs.is_empty() {
             0.0
         } else {
-            force_magnitudes / self.pairs.len() as Real
+            force_magnitudes / self.contacts.pairs.len() as Real
         };
         self.unbalanced_ratio = if mean_contact > 0.0 {
             max_unbalanced / mean_contact
@@ -284,42 +278,14 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         (first_diverged, first_too_far)
     }
 
-    /// `drift` cut, with an automatic step ([`TimeStep::Auto`]), so that the fastest block moves
-    /// at most [`STEP_TRAVEL`] of the contact tolerance: `d` with `v d + g d² = STEP_TRAVEL ×
-    /// tolerance`, `v` a bound of the largest speed at the end of the last step
-    /// ([`speed_bound`]), `g` the gravity (central difference moves a block by its velocity
-    /// after the kick, `(v + g d) d`). A fixed step is not cut (the block pass stops the run
-    /// instead).
-    pub(super) fn cap_drift(&self, pipeline: &mut Pipeline<L::State>, drift: Real) -> Real {
-        if !matches!(self.params.time_step, TimeStep::Auto { .. }) {
-            return drift;
-        }
-        let v = *pipeline.max_speed.get_or_insert_with(|| self.max_move_speed());
-        // While a node contact's impact is being resolved, the travel too: a kink of a node's
-        // potential inside the other block (its normal turning to another face) is crossed at
-        // the relative speed, by steps as short as a spring's kink is.
-        let refine = match self.params.impact_step {
-            Some(r) if self.refine_omega2 > 0.0 && self.refine_travel => r,
-            _ => 1.0,
-        };
-        let c = STEP_TRAVEL * refine * self.params.contact.tolerance;
-        let a = self.params.gravity.length();
-        let root = v + (v * v + 4.0 * a * c).sqrt();
-        if root > 0.0 {
-            drift.min(2.0 * c / root)
-        } else {
-            drift
-        }
-    }
-
     /// [`Error::StepTooLong`] for block `i` moved `distance` by the step of length `drift` that
     /// has just been booked.
     pub(super) fn too_far_error(&self, i: usize, distance: Real, drift: Real) -> Error {
         let tolerance = self.params.contact.tolerance;
         let speed = distance / drift;
         Error::StepTooLong {
-            step: self.step,
-            time: self.time - drift,
+            step: self.clock.step,
+            time: self.clock.time - drift,
             dt: drift,
             block: BlockId(i as u32),
             distance,

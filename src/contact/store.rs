@@ -1,0 +1,165 @@
+//! The contacts as the step stores them: the pairs, their references and wrenches, the
+//! sub-contacts and their records, struct of arrays (each contact owns a contiguous range of
+//! the sub-contacts, `ContactPair::range`). One owner, [`ContactStore`], and the views the
+//! stages take of it: [`OldContacts`] (detection reading the contacts it replaces),
+//! [`ContactLists`] (detection rearranging them) and [`ContactSlices`] (the contact pass
+//! writing them, split at chunk boundaries).
+
+use super::{ContactPair, ContactReference, ContactWrench, SubContact, SubContactRecord};
+
+/// The contacts of a model (or detection's staging lists): struct of arrays, kept index for
+/// index (`pairs`, `references`, `wrenches`; `subs`, `sub_records`).
+#[derive(Debug, Clone)]
+pub(crate) struct ContactStore<S> {
+    /// The contacts, sorted by block pair.
+    pub pairs: Vec<ContactPair>,
+    /// The contacts' reference geometry and areas, index for index with `pairs`.
+    pub references: Vec<ContactReference>,
+    /// The contacts' resultants and moments, index for index with `pairs`: written by the
+    /// contact pass, read by the per-block gather and the accessors (kept out of
+    /// `ContactPair`, whose stream they would lengthen by 72 bytes per contact). Detection
+    /// carries a kept contact's wrench and starts a new one at zero; checkpointed.
+    pub wrenches: Vec<ContactWrench>,
+    /// The sub-contacts, each contact's in its range.
+    pub subs: Vec<SubContact<S>>,
+    /// The sub-contacts' records (key, dashpot force), index for index with `subs`.
+    pub sub_records: Vec<SubContactRecord>,
+}
+
+impl<S> Default for ContactStore<S> {
+    fn default() -> Self {
+        Self {
+            pairs: Vec::new(),
+            references: Vec::new(),
+            wrenches: Vec::new(),
+            subs: Vec::new(),
+            sub_records: Vec::new(),
+        }
+    }
+}
+
+impl<S> ContactStore<S> {
+    /// The contacts as detection reads the ones it replaces.
+    pub(crate) fn old(&self) -> OldContacts<'_, S> {
+        OldContacts {
+            pairs: &self.pairs,
+            references: &self.references,
+            subs: &self.subs,
+            records: &self.sub_records,
+        }
+    }
+
+    /// The lists as detection rearranges them.
+    pub(crate) fn lists(&mut self) -> ContactLists<'_, S> {
+        ContactLists {
+            pairs: &mut self.pairs,
+            references: &mut self.references,
+            wrenches: &mut self.wrenches,
+            subs: &mut self.subs,
+            records: &mut self.sub_records,
+        }
+    }
+
+    /// The contact pass's view: the references it reads, and the contacts from the first as
+    /// it writes them, with one of `sums` per chunk of contacts.
+    pub(crate) fn pass_view<'a, T>(
+        &'a mut self,
+        sums: &'a mut [T],
+    ) -> (&'a [ContactReference], ContactSlices<'a, S, T>) {
+        let first_sub = self.pairs.first().map_or(0, |p| p.first as usize);
+        (
+            &self.references,
+            ContactSlices {
+                first: 0,
+                pairs: &mut self.pairs,
+                wrenches: &mut self.wrenches,
+                sums,
+                subs: &mut self.subs[first_sub..],
+                records: &mut self.sub_records[first_sub..],
+            },
+        )
+    }
+
+    /// Whether the lists that run index for index do (kept so by detection and checkpoint
+    /// load; the step asserts it).
+    pub(crate) fn in_step(&self) -> bool {
+        self.sub_records.len() == self.subs.len()
+            && self.wrenches.len() == self.pairs.len()
+            && self.references.len() == self.pairs.len()
+    }
+}
+
+/// The contacts detection replaces, read-only.
+pub(crate) struct OldContacts<'a, S> {
+    pub(crate) pairs: &'a [ContactPair],
+    pub(crate) references: &'a [ContactReference],
+    pub(crate) subs: &'a [SubContact<S>],
+    pub(crate) records: &'a [SubContactRecord],
+}
+
+/// Contact lists as detection writes them: the staging lists, or the model's as they are
+/// rearranged.
+pub(crate) struct ContactLists<'a, S> {
+    pub(crate) pairs: &'a mut Vec<ContactPair>,
+    pub(crate) references: &'a mut Vec<ContactReference>,
+    pub(crate) wrenches: &'a mut Vec<ContactWrench>,
+    pub(crate) subs: &'a mut Vec<SubContact<S>>,
+    pub(crate) records: &'a mut Vec<SubContactRecord>,
+}
+
+impl<S> ContactLists<'_, S> {
+    /// Empties every list.
+    pub(crate) fn clear(&mut self) {
+        self.pairs.clear();
+        self.references.clear();
+        self.wrenches.clear();
+        self.subs.clear();
+        self.records.clear();
+    }
+}
+
+/// What the contact pass writes: the contacts, their wrenches and per-chunk sums `T`, and the
+/// sub-contacts with their records, all starting at the same contact.
+pub(crate) struct ContactSlices<'a, S, T> {
+    /// Index of the first contact.
+    pub first: usize,
+    pub pairs: &'a mut [ContactPair],
+    pub wrenches: &'a mut [ContactWrench],
+    /// One per chunk of contacts.
+    pub sums: &'a mut [T],
+    /// The sub-contacts of `pairs`, from the first contact's first one.
+    pub subs: &'a mut [SubContact<S>],
+    pub records: &'a mut [SubContactRecord],
+}
+
+impl<S, T> ContactSlices<'_, S, T> {
+    /// Splits after `chunks` chunks of `chunk` contacts (at least one contact must follow).
+    pub(crate) fn split(self, chunks: usize, chunk: usize) -> (Self, Self) {
+        let at = chunks * chunk;
+        let base = self.pairs[0].first as usize;
+        let sub_at = self.pairs[at].first as usize - base;
+        let (pairs, pairs_right) = self.pairs.split_at_mut(at);
+        let (wrenches, wrenches_right) = self.wrenches.split_at_mut(at);
+        let (sums, sums_right) = self.sums.split_at_mut(chunks);
+        let (subs, subs_right) = self.subs.split_at_mut(sub_at);
+        let (records, records_right) = self.records.split_at_mut(sub_at);
+        (
+            Self {
+                first: self.first,
+                pairs,
+                wrenches,
+                sums,
+                subs,
+                records,
+            },
+            Self {
+                first: self.first + at,
+                pairs: pairs_right,
+                wrenches: wrenches_right,
+                sums: sums_right,
+                subs: subs_right,
+                records: records_right,
+            },
+        )
+    }
+}
