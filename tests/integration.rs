@@ -31,6 +31,7 @@ mod mortar;
 mod moving_detection;
 mod pushover;
 mod quasi_static;
+mod run_errors;
 mod scene;
 mod sharp_contacts;
 mod statics;

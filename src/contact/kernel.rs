@@ -2,7 +2,7 @@
 //! law, dashpot), summed into the contact's resultant, moments and energy increments in the same
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
-use super::elastic::{update_elastic_first, WholeContact};
+use super::elastic_step::{update_elastic_first, WholeContact};
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};

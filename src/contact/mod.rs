@@ -2,12 +2,12 @@
 //! per-sub-contact kinematics kernel.
 
 mod closed_lanes;
-mod elastic;
+mod elastic_step;
 mod kernel;
 mod lanes;
 mod law_update;
 mod moments;
-mod nodes;
+mod node_step;
 mod spread;
 mod store;
 mod view;
@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 pub(crate) use closed_lanes::LaneBuild;
 pub(crate) use kernel::{face_gap_coefficients, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
-pub(crate) use nodes::{node_frame, stored_node_frame, update_nodes};
+pub(crate) use node_step::{node_frame, stored_node_frame, update_nodes};
 pub(crate) use spread::tension_free;
 pub(crate) use store::{ContactLists, ContactSlices, ContactStore, OldContacts};
 pub(crate) use view::{CellGeometry, NodeGeometry, TensionFree};
@@ -122,7 +122,7 @@ impl CellSummary {
             let half = sub.half();
             s.lo = s.lo.min(sub.plane - half);
             s.hi = s.hi.max(sub.plane + half);
-            s.closed_moments += elastic::cell_moments(sub.area, half);
+            s.closed_moments += elastic_step::cell_moments(sub.area, half);
         }
         s
     }

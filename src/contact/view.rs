@@ -16,7 +16,7 @@ use crate::law::{JointAxes, JointStatus};
 use crate::math::{Matrix, Pose, Real, Vector, Vector2};
 
 /// The two blocks of a node contact as its views need them: a node's point and axes follow
-/// from its key, the blocks' poses and shapes (`contact/nodes.rs`).
+/// from its key, the blocks' poses and shapes (`contact/node_step.rs`).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct NodeGeometry<'a> {
     pub states: [&'a BlockState; 2],

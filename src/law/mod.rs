@@ -9,7 +9,7 @@
 mod any;
 pub mod conformance;
 mod coulomb;
-mod elastic;
+mod linear_elastic;
 mod mortar;
 mod table;
 
@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 
 pub use any::{AnyLaw, AnyState};
 pub use coulomb::{CoulombSlip, CoulombState};
-pub use elastic::LinearElastic;
+pub use linear_elastic::LinearElastic;
 pub use mortar::{MortarJoint, MortarJointBuilder, MortarState, MortarStrengths, Softening};
 pub use table::LawTable;
 

@@ -101,7 +101,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
         );
         let (sa, sb) = ((&model.state.blocks[a].state, &ra), (&model.state.blocks[b].state, &rb));
         if matches!(model.state.contacts.pairs[k].kind, crate::geometry::ContactKind::Nodes) {
-            // Node contacts have one loop (`contact/nodes.rs`).
+            // Node contacts have one loop (`contact/node_step.rs`).
             counts[3] += r.len();
             continue;
         }

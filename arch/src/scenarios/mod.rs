@@ -5,6 +5,7 @@
 pub mod arch_impact;
 pub mod arch_limit;
 pub mod arch_static;
+pub mod impact_case;
 pub mod impact_summary;
 
 use voussoir::build::arch::{Arch, ArchSpec};

@@ -240,7 +240,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
         for ((seed, sub_slot), record_slot) in seeds.iter().zip(subs.iter_mut()).zip(records.iter_mut()) {
             let plane = if nodes {
                 // A node's plane coordinates hold the face of the other block it lies deepest
-                // under (`contact/nodes.rs`).
+                // under (`contact/node_step.rs`).
                 let frame = node_frame(
                     NodeId::from_key(seed.key),
                     (&bi.state, &rotations.0, bi.shape()),
