@@ -17,6 +17,7 @@ pub fn is_finite_vector(v: Vector) -> bool {
 /// Returns `true` for a pose with a finite translation and a finite unit rotation (to 1e-9,
 /// as blocks are checked): what a file may hold.
 #[inline]
+#[cfg(feature = "serde")]
 pub(crate) fn is_unit_pose(p: &Pose) -> bool {
     is_finite_vector(p.translation) && p.rotation.is_finite() && (p.rotation.length() - 1.0).abs() <= 1e-9
 }

@@ -690,3 +690,34 @@ def test_model_defaults_are_voussoirs_own():
         params = inspect.signature(fn).parameters
         assert params["subcontacts_per_edge"].default is None
         assert params["contact_tolerance"].default is None
+
+
+def test_fracture_energies_make_mortared_joints():
+    """compas_dem's Mohr–Coulomb model has strengths but no fracture energies: with
+    ``fracture=`` (or an interface's ``gf_i``, ``gf_ii``) the joints are voussoir.MortarJoint,
+    softening on them; without, brittle CoulombSlip as before (issue 44, item 4). What the law
+    then dissipates is tested with the law (python/tests/test_mortar.py, tests/mortar.rs)."""
+    model = block_on_support()
+    problem = Problem(model)
+    problem.set_contact_model("MohrCoulomb", phi=30.0, c=2e5, t_c=1e5)
+    conv = cv.to_voussoir(problem, density=2000.0)
+    assert isinstance(conv.model.joint_law(0, 0), vs.CoulombSlip) and conv.law["law"] == "CoulombSlip"
+    conv = cv.to_voussoir(problem, density=2000.0, fracture={"gf_i": 10.0, "gf_ii": 50.0, "phi_r": 25.0})
+    law = conv.model.joint_law(0, 0)
+    assert isinstance(law, vs.MortarJoint) and conv.law["law"] == "MortarJoint"
+    assert law.mode_i_fracture_energy == 10.0 and law.mode_ii_fracture_energy == 50.0
+    assert law.tensile_strength == 1e5 and law.cohesion == 2e5 and law.residual_friction_deg == 25.0
+    # Per interface: its own fracture energies; the others keep the problem's law.
+    a, b = sorted(conv.index)[:2]
+    conv = cv.to_voussoir(problem, density=2000.0, interfaces={(a, b): {"gf_i": 5.0}})
+    il = conv.model.interface_law(conv.index[a], conv.index[b])
+    assert isinstance(il, vs.MortarJoint) and il.mode_i_fracture_energy == 5.0
+    assert isinstance(conv.model.joint_law(0, 0), vs.CoulombSlip)
+    # A fracture energy needs its strength; unknown keys are named.
+    problem.set_contact_model("MohrCoulomb", phi=30.0)
+    with pytest.raises(ValueError, match="gf_i = 10.0 softens the t_c"):
+        cv.to_voussoir(problem, density=2000.0, fracture={"gf_i": 10.0})
+    with pytest.raises(ValueError, match="unknown keys \\['gfi'\\]"):
+        cv.to_voussoir(problem, density=2000.0, fracture={"gfi": 10.0})
+    with pytest.raises(ValueError, match="need a fracture energy"):
+        cv.to_voussoir(problem, density=2000.0, fracture={"phi_r": 20.0})

@@ -109,9 +109,49 @@ def _stiffness(value, name):
     return v
 
 
-def joint_law(problem, kn=None, ks=None):
-    """The ``voussoir.CoulombSlip`` of the problem's contact and joint models, and its parameters
-    (``kn``, ``ks`` in Pa/m: per unit joint area; ``sources`` says where each came from)."""
+#: The keys of a fracture specification (``fracture=`` and an interface's entries): the
+#: fracture energies (J/m²) of mode I (with the tensile strength ``t_c``) and mode II (with the
+#: cohesion ``c``), the residual friction angle (degrees) and the softening curve.
+FRACTURE_KEYS = ("gf_i", "gf_ii", "phi_r", "softening")
+
+
+def _law(kn, ks, phi, cohesion, tension, fracture, where):
+    """``voussoir.MortarJoint`` when ``fracture`` gives a fracture energy (softening on it),
+    else ``voussoir.CoulombSlip`` (brittle, as before)."""
+    fracture = fracture or {}
+    extra = sorted(set(fracture) - set(FRACTURE_KEYS))
+    if extra:
+        raise ValueError(f"{where}: unknown keys {extra}; the fracture keys are {', '.join(FRACTURE_KEYS)}")
+    gf_i, gf_ii = fracture.get("gf_i"), fracture.get("gf_ii")
+    phi_r = float(fracture.get("phi_r", phi))
+    if gf_i is None and gf_ii is None:
+        if "phi_r" in fracture or "softening" in fracture:
+            raise ValueError(f"{where}: phi_r and softening need a fracture energy (gf_i or gf_ii)")
+        return vs.CoulombSlip(kn, ks, phi, residual_friction_deg=phi, cohesion=cohesion, tensile_strength=tension)
+    for name, g, strength, strength_name in (("gf_i", gf_i, tension, "t_c"), ("gf_ii", gf_ii, cohesion, "c")):
+        if g is not None and strength <= 0.0:
+            raise ValueError(f"{where}: {name} = {g!r} softens the {strength_name}, which is {strength}: give {strength_name} > 0")
+    return vs.MortarJoint(
+        kn,
+        ks,
+        phi,
+        residual_friction_deg=phi_r,
+        tensile_strength=tension,
+        # A strength without its fracture energy stays brittle (0); no strength, no energy.
+        mode_i_fracture_energy=float(gf_i) if gf_i is not None else (0.0 if tension > 0.0 else None),
+        cohesion=cohesion,
+        mode_ii_fracture_energy=float(gf_ii) if gf_ii is not None else (0.0 if cohesion > 0.0 else None),
+        softening=fracture.get("softening", "exponential"),
+    )
+
+
+def joint_law(problem, kn=None, ks=None, fracture=None):
+    """The joint law of the problem's contact and joint models, and its parameters (``kn``,
+    ``ks`` in Pa/m: per unit joint area; ``sources`` says where each came from):
+    ``voussoir.CoulombSlip`` (brittle tension cut-off and cohesion, as compas_dem's Mohr–Coulomb
+    model), or ``voussoir.MortarJoint`` when ``fracture`` gives fracture energies
+    (:data:`FRACTURE_KEYS`; compas_dem's model has none): the tensile strength and cohesion then
+    soften on them, friction going to ``phi_r``."""
     props = problem.contact_properties
     cm = props.contact_model
     if cm is None:
@@ -135,8 +175,10 @@ def joint_law(problem, kn=None, ks=None):
     else:
         ks, ks_from = 0.4 * kn, "0.4 kn"
     default = kn_from == "default"
-    law = vs.CoulombSlip(kn, ks, phi, residual_friction_deg=phi, cohesion=cohesion, tensile_strength=tension)
+    law = _law(kn, ks, phi, cohesion, tension, fracture, "fracture")
     return law, {
+        "law": type(law).__name__,
+        "fracture": dict(fracture or {}),
         "kn": kn,
         "ks": ks,
         "units": "Pa/m",
@@ -219,6 +261,7 @@ def to_voussoir(
     kn: Optional[float] = None,
     ks: Optional[float] = None,
     interfaces: Optional[Dict[tuple, dict]] = None,
+    fracture: Optional[dict] = None,
     subcontacts_per_edge: Optional[int] = None,
     contact_tolerance: Optional[float] = None,
     **model_options,
@@ -230,7 +273,11 @@ def to_voussoir(
     graph node. ``kn``, ``ks`` (Pa/m) override the joint model. ``interfaces`` maps a pair of
     graph nodes to the Mohr–Coulomb and stiffness values of that interface only
     (``{"phi", "c", "t_c", "kn", "kt"}``, missing ones taken from the problem), as
-    ``compas_3dec``'s per-interface properties. Stiffnesses are per unit joint area (Pa/m);
+    ``compas_3dec``'s per-interface properties, and its fracture energies
+    (:data:`FRACTURE_KEYS`). ``fracture`` (``{"gf_i", "gf_ii", "phi_r", "softening"}``, J/m² and
+    degrees) makes every joint a ``voussoir.MortarJoint`` softening on those fracture energies
+    (compas_dem's Mohr–Coulomb model has none; without them the joints are brittle
+    ``voussoir.CoulombSlip``, as before). Stiffnesses are per unit joint area (Pa/m);
     one outside :data:`PLAUSIBLE_STIFFNESS` is warned about (:class:`StiffnessUnitsWarning`).
     ``model_options``: the ``voussoir.Model`` keywords in :data:`MODEL_OPTIONS`.
     """
@@ -241,7 +288,7 @@ def to_voussoir(
             f"unexpected keyword argument{'s' if len(unknown) > 1 else ''} {', '.join(map(repr, unknown))}; "
             f"voussoir.Model options are {', '.join(MODEL_OPTIONS)}"
         )
-    law, params = joint_law(problem, kn, ks)
+    law, params = joint_law(problem, kn, ks, fracture)
     g = _gravity(problem)
     # None: voussoir's own default (``voussoir.Model.defaults()``), not restated here.
     given = {"subcontacts_per_edge": subcontacts_per_edge, "contact_tolerance": contact_tolerance}
@@ -272,9 +319,11 @@ def to_voussoir(
         a, b = key
         if a not in index or b not in index:
             raise ValueError(f"interfaces: no block {a if a not in index else b} in the model")
-        extra = sorted(set(values) - {"phi", "c", "t_c", "kn", "kt"})
+        extra = sorted(set(values) - {"phi", "c", "t_c", "kn", "kt", *FRACTURE_KEYS})
         if extra:
-            raise ValueError(f"interfaces[{key!r}]: unknown keys {extra}; expected phi, c, t_c, kn, kt")
+            raise ValueError(
+                f"interfaces[{key!r}]: unknown keys {extra}; expected phi, c, t_c, kn, kt, {', '.join(FRACTURE_KEYS)}"
+            )
         kn_i = _stiffness(values["kn"], f"interfaces[{key!r}]['kn']") if "kn" in values else params["kn"]
         if "kt" in values:
             ks_i = _stiffness(values["kt"], f"interfaces[{key!r}]['kt']")
@@ -284,16 +333,19 @@ def to_voussoir(
             if name in values:
                 stiffnesses[f"interfaces[{key!r}]['{name}']"] = kn_i if name == "kn" else ks_i
         phi_i = float(values.get("phi", params["phi"]))
+        # An interface's fracture energies, else the problem's (``fracture=``).
+        own = {k: values[k] for k in FRACTURE_KEYS if k in values}
         m.set_interface_law(
             index[a],
             index[b],
-            vs.CoulombSlip(
+            _law(
                 kn_i,
                 ks_i,
                 phi_i,
-                residual_friction_deg=phi_i,
-                cohesion=float(values.get("c", params["cohesion"]) or 0.0),
-                tensile_strength=float(values.get("t_c", params["tensile_strength"]) or 0.0),
+                float(values.get("c", params["cohesion"]) or 0.0),
+                float(values.get("t_c", params["tensile_strength"]) or 0.0),
+                own or fracture,
+                f"interfaces[{key!r}]",
             ),
         )
     params["units_warning"] = check_stiffnesses(stiffnesses, m)

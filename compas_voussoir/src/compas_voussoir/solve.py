@@ -105,6 +105,7 @@ def run(
     kn: Optional[float] = None,
     ks: Optional[float] = None,
     interfaces: Optional[Dict[tuple, dict]] = None,
+    fracture: Optional[dict] = None,
     subcontacts_per_edge: Optional[int] = None,
     contact_tolerance: Optional[float] = None,
     ramp_time: float = 0.5,
@@ -184,7 +185,10 @@ def run(
     graph node; ``kn``, ``ks`` (**Pa/m, stiffness per unit joint area**; compas_dem's
     ``set_joint_model`` docstring says N/m: a value outside 1e8–1e14 Pa/m is warned about,
     :class:`compas_voussoir.StiffnessUnitsWarning`) over the problem's joint model;
-    ``interfaces`` ``{(u, v): {"phi", "c", "t_c", "kn", "kt"}}`` per pair of graph nodes;
+    ``interfaces`` ``{(u, v): {"phi", "c", "t_c", "kn", "kt", "gf_i", "gf_ii", "phi_r",
+    "softening"}}`` per pair of graph nodes; ``fracture`` ``{"gf_i", "gf_ii", "phi_r",
+    "softening"}`` (J/m², degrees): mortared joints (``voussoir.MortarJoint``) that soften on
+    these fracture energies instead of the brittle Mohr–Coulomb joints;
     ``subcontacts_per_edge``, ``contact_tolerance`` (None: voussoir's defaults,
     ``voussoir.Model.defaults()``); the ``voussoir.Model`` keywords of
     ``compas_voussoir.convert.MODEL_OPTIONS``. Any other keyword is refused (``TypeError``
@@ -228,6 +232,7 @@ def run(
         kn=kn,
         ks=ks,
         interfaces=interfaces,
+        fracture=fracture,
         subcontacts_per_edge=subcontacts_per_edge,
         contact_tolerance=contact_tolerance,
         **model_options,
