@@ -32,7 +32,7 @@ impl JointStrength {
     /// A joint with friction coefficient `μ` and cohesion `c` (Pa).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for a negative or non-finite value.
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) for a negative or non-finite value.
     pub fn new(friction: Real, cohesion: Real) -> Result<Self> {
         Ok(Self {
             friction: non_negative("limit analysis friction coefficient", friction)?,
@@ -43,7 +43,7 @@ impl JointStrength {
     /// A joint with friction angle `φ` (degrees, in `[0°, 90°)`) and cohesion `c` (Pa).
     ///
     /// # Errors
-    /// [`Error::InvalidParameter`] for an angle outside `[0°, 90°)` or a bad cohesion.
+    /// [`Error::InvalidParameter`](crate::Error::InvalidParameter) for an angle outside `[0°, 90°)` or a bad cohesion.
     pub fn from_degrees(friction_deg: Real, cohesion: Real) -> Result<Self> {
         crate::error::in_range(
             "limit analysis friction angle (degrees)",
@@ -60,8 +60,8 @@ impl JointStrength {
 ///
 /// [`CoulombSlip`] gives its (initial) friction angle and cohesion — the intact joint's; its
 /// tensile strength is left out (no tension). A law with no strength limit
-/// ([`LinearElastic`]) gives `None`, and [`LimitProblem::from_model`] refuses its contacts; give
-/// their strength with [`LimitProblem::from_model_with`].
+/// ([`LinearElastic`]) gives `None`, and [`LimitProblem::from_model`](super::LimitProblem::from_model) refuses its contacts; give
+/// their strength with [`LimitProblem::from_model_with`](super::LimitProblem::from_model_with).
 pub trait LimitStrength {
     /// The joint's strength, or `None` when the law has no strength limit.
     fn limit_strength(&self) -> Option<JointStrength>;
