@@ -9,6 +9,7 @@ mod common;
 
 mod base_excitation;
 mod checkpoint;
+mod collapse;
 mod custom_law;
 mod dynamics;
 mod energy_and_determinism;
