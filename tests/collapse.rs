@@ -190,9 +190,9 @@ fn limit_load(model: &Model, block: BlockId, point: Vector) -> Real {
         .multiplier
 }
 
-/// The capacity of the thin semicircle under the quarter-span point load at `kn`, and its limit
-/// load (the library's, on the arch as built).
-fn semicircle_capacity(kn: Real) -> (Capacity, Real) {
+/// The capacity of the thin semicircle under the quarter-span point load at `kn`, its limit
+/// load (the library's, on the arch as built) and the model as built (stepped once).
+fn semicircle_capacity(kn: Real) -> (Capacity, Real, Model) {
     let arch = Arch::new(&thin_semicircle()).unwrap();
     let (block, point) = quarter_span_point(&arch);
     let mut built = arch_model(&arch, kn);
@@ -207,7 +207,7 @@ fn semicircle_capacity(kn: Real) -> (Capacity, Real) {
         1.03 * limit,
         RESOLUTION * limit,
     );
-    (cap, limit)
+    (cap, limit, built)
 }
 
 /// Checks the convergence of two capacities measured at `kn` and `8 kn` to `limit`, and prints
@@ -258,7 +258,7 @@ fn check_convergence(what: &str, soft: &Capacity, stiff: &Capacity, limit: Real)
 #[test]
 fn thin_semicircle_hinges_converge_to_the_rigid_limit() {
     let kn = 100.0 * PAPER_KN;
-    let ((soft, limit), (stiff, _)) = rayon::join(|| semicircle_capacity(kn), || semicircle_capacity(8.0 * kn));
+    let ((soft, limit, _), (stiff, _, _)) = rayon::join(|| semicircle_capacity(kn), || semicircle_capacity(8.0 * kn));
     check_convergence("thin semicircle, point load (N)", &soft, &stiff, limit);
 }
 
@@ -457,18 +457,7 @@ fn thin_semicircle_soft_joint_loss_is_winkler_with_p_delta() {
     let arch = Arch::new(&spec).unwrap();
     let (block, point) = quarter_span_point(&arch);
     let kn = PAPER_KN;
-    let mut built = arch_model(&arch, kn);
-    built.step().unwrap();
-    let rigid = limit_load(&built, block, point);
-    let mut model = arch_model(&arch, kn);
-    model.run_to_equilibrium(SETTLED, 1_000_000).unwrap();
-    let cap = capacity(
-        &model,
-        |m, p| point_load(m, block, point, p),
-        (block, point),
-        1.03 * rigid,
-        RESOLUTION * rigid,
-    );
+    let (cap, rigid, built) = semicircle_capacity(kn);
     let dem = cap.estimate();
     let mut m: Model = Model::from_checkpoint_str(&cap.stood).unwrap();
     // The DEM's load: a force and a constant moment about the centroid, a vertical line at
