@@ -1,22 +1,17 @@
 //! The model: blocks, joint laws, gravity and loads; stepping and runs.
 
-mod block_pass;
-mod changes;
 #[cfg(feature = "serde")]
 mod checkpoint;
-mod contact_pass;
-mod detection;
 mod energy;
 mod excitation;
 mod observe;
 mod parameters;
-mod pipeline;
 mod queries;
 mod run;
 mod setters;
 mod step;
-mod step_length;
-mod time_step;
+// The stages by name, for the rest of the model (checkpoints, setters, queries).
+use step::{block_pass, changes, detection, pipeline};
 
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};

@@ -1,18 +1,28 @@
 //! The step: its stages in order, each a method of the model's state given the pipeline's
 //! scratch it uses (`docs/architecture.md`).
 
-use super::changes::Changes;
-use super::Pipeline;
-use super::{is_finite_state, ModelState};
+// The stages, in the step's order (`docs/architecture.md`, "The step").
+pub(super) mod block_pass;
+pub(super) mod changes;
+pub(super) mod contact_pass;
+pub(super) mod detection;
+pub(super) mod step_length;
+pub(super) mod time_step;
+// The stages' scratch.
+pub(super) mod pipeline;
+
+use self::changes::Changes;
 use crate::block::{Block, BlockId};
 use crate::contact::DisplacementMode;
 use crate::error::{Error, Result};
 use crate::law::ConstitutiveLaw;
 use crate::math::Real;
+use crate::model::Pipeline;
+use crate::model::{is_finite_state, ModelState};
 
 impl<L: ConstitutiveLaw> ModelState<L> {
     /// One step: the stages in order, each given the state and the pipeline it uses.
-    pub(super) fn step(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
+    pub(in crate::model) fn step(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
         if self.blocks.is_empty() {
             return Err(Error::EmptyModel);
         }

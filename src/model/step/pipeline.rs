@@ -3,16 +3,16 @@
 //! store it, and a restored model rebuilds it.
 
 use super::contact_pass::PairSums;
-use super::{BlockSums, Timings};
 use crate::block::Wrench;
 use crate::integrate::StiffnessBound;
 use crate::math::{Matrix, Real};
+use crate::model::{BlockSums, Timings};
 
 /// Scratch of the step's stages. `D` is the detection's scratch
 /// (`detection::DetectionScratch`), a parameter so that the pipeline, which the detection stage
-/// takes, does not depend on that stage (`super::Pipeline` names the model's pipeline).
+/// takes, does not depend on that stage (`crate::model::Pipeline` names the model's pipeline).
 #[derive(Debug, Clone)]
-pub(super) struct PipelineOf<D> {
+pub(in crate::model) struct PipelineOf<D> {
     /// Block → contact index (CSR with `block_offsets`): `2 × contact + side`, side 1 when the
     /// block is the contact's `b`. Rebuilt at detection and on checkpoint load.
     pub block_contacts: Vec<u32>,

@@ -2,7 +2,6 @@
 //! written over the old ones) or in general (kept contacts moved, new ones placed), the layout
 //! of sub-contacts with dead room, and the work owed by dropped sub-contacts.
 
-use super::super::ModelState;
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
@@ -12,6 +11,7 @@ use crate::error::Result;
 use crate::geometry::{ContactKind, NodeId};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real, Vector};
+use crate::model::ModelState;
 
 /// A contact after detection: an old one kept (its index), or one detected afresh (its index
 /// in the staging lists, and the old contact of the same pair it replaces or `u32::MAX`).

@@ -1,9 +1,9 @@
 //! The model's time step: the contacts' stiffness handed to the integrator's stability limit
 //! ([`crate::integrate::Integrator::critical_step`]), then the step the parameters ask for.
 
-use super::ModelState;
-use super::Pipeline;
 use crate::error::{Error, Result};
+use crate::model::ModelState;
+use crate::model::Pipeline;
 use rayon::prelude::*;
 
 use crate::block::Block;
@@ -16,7 +16,7 @@ use crate::math::{Matrix, Real, Vector};
 impl<L: ConstitutiveLaw> ModelState<L> {
     /// Re-evaluates the critical step from the current contacts and each block's potential
     /// contact on its largest face, then sets `dt`.
-    pub(super) fn refresh_time_step(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
+    pub(in crate::model) fn refresh_time_step(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
         if self.blocks.is_empty() {
             return Ok(());
         }
@@ -50,7 +50,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// Of `contacts`, those whose area grew by more than 5 % since their last evaluation (or
     /// that are new): their areas are taken as evaluated, and their blocks added to `blocks`.
     /// Only a contact detected afresh can have grown: a caller may pass those alone.
-    pub(super) fn take_grown(&mut self, contacts: impl Iterator<Item = usize>, blocks: &mut Vec<u32>) {
+    pub(in crate::model) fn take_grown(&mut self, contacts: impl Iterator<Item = usize>, blocks: &mut Vec<u32>) {
         for k in contacts {
             let reference = &mut self.contacts.references[k];
             if reference.area > GROWTH * reference.bound_area {
@@ -64,7 +64,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// couple with its own through its fixity), then the critical step: what a change of `i`'s
     /// fixity changes, without a pass over every block. The whole evaluation when the block →
     /// contact index or the bounds are not up to date (blocks added since the last step).
-    pub(super) fn refresh_time_step_around(&mut self, pipeline: &mut Pipeline<L::State>, i: u32) -> Result<()> {
+    pub(in crate::model) fn refresh_time_step_around(
+        &mut self,
+        pipeline: &mut Pipeline<L::State>,
+        i: u32,
+    ) -> Result<()> {
         let n = self.blocks.len();
         let offsets = &pipeline.block_offsets;
         if offsets.len() != n + 1 || offsets[n] as usize != 2 * self.contacts.pairs.len() || pipeline.bounds.len() != n
@@ -86,7 +90,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// Re-evaluates the bounds of the blocks in `pipeline.refresh_blocks` (those of the grown
     /// contacts, [`ModelState::take_grown`]), then the critical step from all the bounds: a
     /// block's bound depends only on its own contacts. Needs the block → contact index.
-    pub(super) fn refresh_time_step_of_grown(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
+    pub(in crate::model) fn refresh_time_step_of_grown(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
         let mut blocks = std::mem::take(&mut pipeline.refresh_blocks);
         blocks.sort_unstable();
         blocks.dedup();

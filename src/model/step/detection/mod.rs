@@ -5,14 +5,14 @@ use parry3d_f64::shape::Shape;
 use rayon::prelude::*;
 
 use super::changes::Changes;
-use super::Pipeline;
-use super::{ModelState, BLOCK_CHUNK};
 use crate::block::{Block, BlockId, RigidBlock};
 use crate::contact::DisplacementMode;
 use crate::error::{Error, Result};
 use crate::geometry::BroadPhase;
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Pose, Real};
+use crate::model::Pipeline;
+use crate::model::{ModelState, BLOCK_CHUNK};
 
 #[cfg(test)]
 mod detection_tests;
@@ -57,7 +57,7 @@ fn plan_chunk(pairs: usize) -> usize {
 /// Buffers reused from one detection to the next.
 #[derive(Debug, Clone)]
 pub(crate) struct DetectionScratch<S> {
-    /// Set by the fused block pass ([`ModelState::block_pass`](super::ModelState::block_pass)) after it moved the blocks and
+    /// Set by the fused block pass ([`ModelState::block_pass`](crate::model::ModelState::block_pass)) after it moved the blocks and
     /// took their rotation matrices and movement check for the next step: whether any block
     /// moved beyond the re-detection trigger. Taken (reset) by the next step.
     pub prepared: Option<bool>,
@@ -210,7 +210,7 @@ impl<S> Default for DetectionScratch<S> {
 /// them moved beyond it since their reference poses in `refs` (`moved`, all `false` without a
 /// trigger); returns whether any did.
 #[inline]
-pub(super) fn prepare_chunk(
+pub(in crate::model) fn prepare_chunk(
     rotations: &mut [Matrix],
     moved: &mut [bool],
     blocks: &[RigidBlock],
@@ -266,7 +266,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// blocks moved more than the re-detection trigger since their reference poses (the flags in
     /// [`DetectionScratch::moved`]; whether any did is returned). (After a step of a blockwise
     /// integrator the block pass has done this already, see [`DetectionScratch::prepared`].)
-    pub(super) fn prepare_blocks(&mut self, pipeline: &mut Pipeline<L::State>, check: bool) -> bool {
+    pub(in crate::model) fn prepare_blocks(&mut self, pipeline: &mut Pipeline<L::State>, check: bool) -> bool {
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
         let n = self.blocks.len();
         pipeline.rotations.resize(n, Matrix::IDENTITY);
@@ -294,7 +294,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// ones by key. Where the contacts keep their pairs and sub-contact counts (the usual case),
     /// the re-tested contacts are rewritten in place; otherwise the lists are rebuilt in pair
     /// order. Either way the result does not depend on the number of threads.
-    pub(super) fn detect(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
+    pub(in crate::model) fn detect(&mut self, pipeline: &mut Pipeline<L::State>) -> Result<()> {
         let params = self.params.contact;
         let full = self.changes.need_full_detection() || self.params.mode == DisplacementMode::Small;
         let trigger = params.redetect_fraction * params.tolerance;
@@ -533,7 +533,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             })
     }
 
-    pub(super) fn rebuild_block_index(&mut self, pipeline: &mut Pipeline<L::State>) {
+    pub(in crate::model) fn rebuild_block_index(&mut self, pipeline: &mut Pipeline<L::State>) {
         let n = self.blocks.len();
         pipeline.block_offsets.clear();
         pipeline.block_offsets.resize(n + 1, 0);

@@ -3,7 +3,6 @@
 
 use rayon::prelude::*;
 
-use super::super::ModelState;
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
@@ -14,6 +13,7 @@ use crate::error::Result;
 use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubContactSeed, SubKey, PARALLEL_ANGLE};
 use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Real, Vector, Vector2};
+use crate::model::ModelState;
 
 /// A sub-contact and a record to fill dead room with (never read).
 pub(super) fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord) {

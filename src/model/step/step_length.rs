@@ -2,13 +2,13 @@
 //! `dt`, shortened around impacts by the impact refinement ([`ModelParameters::impact_step`]),
 //! then cut so that the fastest block moves at most half the contact tolerance.
 //!
-//! [`ModelParameters::impact_step`]: super::ModelParameters::impact_step
+//! [`ModelParameters::impact_step`]: crate::model::ModelParameters::impact_step
 
 use super::contact_pass::CONTACT_CHUNK;
-use super::{ModelState, Pipeline};
 use crate::integrate::TimeStep;
 use crate::law::ConstitutiveLaw;
 use crate::math::Real;
+use crate::model::{ModelState, Pipeline};
 
 /// The fraction of the contact tolerance that an automatic step lets the fastest block move
 /// (estimated from the speeds at the end of the last step and gravity): half, so that a speed
@@ -25,7 +25,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// middle of a flat impact, where the sub-contacts are deep and the probe is quiet) has
     /// passed and none of the contacts the probe marked is both loaded and fast. The step thus
     /// changes while the impacting contacts are open, or once the motion is quiet.
-    pub(super) fn next_drift(&mut self, pipeline: &Pipeline<L::State>, impact: Real, busy: bool) -> Real {
+    pub(in crate::model) fn next_drift(&mut self, pipeline: &Pipeline<L::State>, impact: Real, busy: bool) -> Real {
         let (Some(r), TimeStep::Auto { .. }) = (self.params.impact_step, self.params.time_step) else {
             return self.clock.dt;
         };
@@ -65,7 +65,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// ([`speed_bound`](super::block_pass::speed_bound)), `g` the gravity (central difference moves a block by its velocity
     /// after the kick, `(v + g d) d`). A fixed step is not cut (the block pass stops the run
     /// instead).
-    pub(super) fn cap_drift(&self, pipeline: &mut Pipeline<L::State>, drift: Real) -> Real {
+    pub(in crate::model) fn cap_drift(&self, pipeline: &mut Pipeline<L::State>, drift: Real) -> Real {
         if !matches!(self.params.time_step, TimeStep::Auto { .. }) {
             return drift;
         }

@@ -11,8 +11,6 @@
 use rayon::prelude::*;
 
 use super::detection::prepare_chunk;
-use super::Pipeline;
-use super::{diverged, BlockSums, ModelState, BLOCK_CHUNK};
 use crate::block::{Block, Dof, RigidBlock, Wrench};
 use crate::contact::{ContactWrench, DisplacementMode};
 use crate::error::Error;
@@ -20,6 +18,8 @@ use crate::ids::BlockId;
 use crate::integrate::{Integrator, StepDurations, StepRecord};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real, Vector};
+use crate::model::Pipeline;
+use crate::model::{diverged, BlockSums, ModelState, BLOCK_CHUNK};
 
 /// What the per-block stages read besides the block itself.
 #[derive(Clone, Copy)]
@@ -57,7 +57,7 @@ struct BlockPass<'a> {
 /// prescribed axis is the prescribed one, so these are what the block just moved at, as the
 /// block pass measures them from the state alone.
 #[inline]
-pub(super) fn move_speeds2(b: &RigidBlock) -> (Real, Real) {
+pub(in crate::model) fn move_speeds2(b: &RigidBlock) -> (Real, Real) {
     let mut v = b.state.velocity.to_array();
     for (v, d) in v.iter_mut().zip(b.fixity().translation) {
         if let Dof::Velocity(p) = d {
@@ -71,14 +71,14 @@ pub(super) fn move_speeds2(b: &RigidBlock) -> (Real, Real) {
 /// The speed bound of the step length from the largest squared speeds of translation and of
 /// rotation at the radius (m/s): at least the largest speed of any point of any block.
 #[inline]
-pub(super) fn speed_bound(max_v2: Real, max_w2: Real) -> Real {
+pub(in crate::model) fn speed_bound(max_v2: Real, max_w2: Real) -> Real {
     max_v2.sqrt() + max_w2.sqrt()
 }
 
 /// `total` plus the wrenches of a block's contacts, in index order: `entries` are the block's
 /// slice of the block → contact index (`2·contact + side`, side 1 when the block is `b`).
 #[inline]
-pub(super) fn add_contact_wrenches(mut total: Wrench, entries: &[u32], wrenches: &[ContactWrench]) -> Wrench {
+pub(in crate::model) fn add_contact_wrenches(mut total: Wrench, entries: &[u32], wrenches: &[ContactWrench]) -> Wrench {
     for &e in entries {
         let w = &wrenches[(e >> 1) as usize];
         if e & 1 == 1 {
@@ -180,7 +180,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// exact identity of central difference for translation. Sums are taken per chunk of
     /// [`BLOCK_CHUNK`] blocks in block order, then over the chunks in order: the results do not
     /// depend on the thread count.
-    pub(super) fn block_pass(
+    pub(in crate::model) fn block_pass(
         &mut self,
         pipeline: &mut Pipeline<L::State>,
         kick: Real,
@@ -280,7 +280,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
 
     /// [`Error::StepTooLong`] for block `i` moved `distance` by the step of length `drift` that
     /// has just been booked.
-    pub(super) fn too_far_error(&self, i: usize, distance: Real, drift: Real) -> Error {
+    pub(in crate::model) fn too_far_error(&self, i: usize, distance: Real, drift: Real) -> Error {
         let tolerance = self.params.contact.tolerance;
         let speed = distance / drift;
         Error::StepTooLong {
@@ -296,7 +296,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     }
 
     /// The [`speed_bound`] of the blocks' [`move_speeds2`] (m/s), as the block pass leaves it.
-    pub(super) fn max_move_speed(&self) -> Real {
+    pub(in crate::model) fn max_move_speed(&self) -> Real {
         let (v2, w2) = self
             .blocks
             .iter()

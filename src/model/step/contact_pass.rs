@@ -9,23 +9,23 @@
 //! needed. Sums are kept per chunk of [`CONTACT_CHUNK`] contacts and added in chunk order
 //! afterwards, so that they do not depend on the number of threads.
 
-use super::{ModelState, Pipeline};
 use crate::block::{Block, RigidBlock};
 use crate::contact::{update_contact, update_nodes, ContactReference, KernelContext, LaneBuild};
 use crate::geometry::ContactKind;
 use crate::integrate::{StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Matrix, Real};
+use crate::model::{ModelState, Pipeline};
 
 /// Contacts per chunk of the contact pass: sums are taken per chunk, then over the chunks in
 /// order.
-pub(super) const CONTACT_CHUNK: usize = 64;
+pub(in crate::model) const CONTACT_CHUNK: usize = 64;
 
 /// Chunks a task runs one after the other rather than splitting further.
 const CHUNKS_PER_TASK: usize = 4;
 
 /// What the contact pass reads, shared by its tasks.
-pub(super) struct ContactPass<'a, L: ConstitutiveLaw> {
+pub(in crate::model) struct ContactPass<'a, L: ConstitutiveLaw> {
     pub blocks: &'a [RigidBlock],
     /// The blocks' rotation matrices, index for index.
     pub rotations: &'a [Matrix],
@@ -44,7 +44,7 @@ type Slices<'a, S> = crate::contact::ContactSlices<'a, S, PairSums>;
 
 /// Per-chunk sums of the contact pass.
 #[derive(Debug, Clone, Copy, Default)]
-pub(super) struct PairSums {
+pub(in crate::model) struct PairSums {
     /// Σ |resultant| (N), for the unbalanced-force ratio.
     pub force_magnitude: Real,
     pub work: Real,
@@ -184,7 +184,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     /// The contact pass; returns the largest squared frequency bound of the blocks of the
     /// contacts the impact probe marked (0: none), and whether a loaded contact it marked
     /// since the refinement began moves fast.
-    pub(super) fn contact_pass(&mut self, pipeline: &mut Pipeline<L::State>) -> (Real, bool) {
+    pub(in crate::model) fn contact_pass(&mut self, pipeline: &mut Pipeline<L::State>) -> (Real, bool) {
         // The probe: normal speeds beyond that of a fall through the contact tolerance,
         // `√(2 g tol)` (a block settling on its joints moves much slower), crossing the kink
         // within two steps.

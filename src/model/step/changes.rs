@@ -1,5 +1,5 @@
 //! What the user changed between steps: one set, written by the setters and read first by
-//! [`Model::step`](super::Model::step), instead of flags each setter has to remember.
+//! [`Model::step`](crate::model::Model::step), instead of flags each setter has to remember.
 
 /// A set of changes since the last step.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
