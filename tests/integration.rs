@@ -35,6 +35,7 @@ mod quasi_static;
 mod run_errors;
 mod scene;
 mod sharp_contacts;
+mod shear_wall;
 mod statics;
 mod viewer;
 mod vtk_output;
