@@ -29,6 +29,48 @@ fn settle_step(bencher: divan::Bencher, blocks: usize) {
         .bench_local(|| model.step().expect("step"));
 }
 
+/// The wall of [`wall`] with its joints of law `law` (same blocks, parameters and damping):
+/// what a law costs per sub-contact on a resting wall.
+fn wall_with<L: ConstitutiveLaw>(blocks: usize, law: L) -> Model<L> {
+    let coulomb = benchmark_wall(blocks).expect("wall");
+    let mut model: Model<L> = Model::new(*coulomb.parameters()).expect("model");
+    model.set_damping(coulomb.damping()).expect("damping");
+    model.set_joint_law(MaterialId(0), MaterialId(0), law).expect("law");
+    for b in coulomb.blocks() {
+        model.add_block(b.clone()).expect("block");
+    }
+    model.run_steps(20).expect("settling");
+    model
+}
+
+/// [`settle_step`] with bonded mortar joints (`MortarJoint`: f_t 0.25 MPa, c 0.35 MPa, G_f^I 18
+/// N/m, G_f^II 125 N/m, the wall's kn, ks and φ), all elastic at rest: the softening law's
+/// cost per sub-contact against `CoulombSlip`'s (issue 44, item 5: at most 1.3×).
+#[divan::bench(args = [10_000, 100_000], sample_count = 10, sample_size = 5)]
+fn settle_step_mortar(bencher: divan::Bencher, blocks: usize) {
+    let law = MortarJoint::builder(1e9, 4e8, 30.0)
+        .tension(2.5e5, 18.0)
+        .cohesion(3.5e5, 125.0)
+        .build()
+        .expect("law");
+    let mut model = wall_with(blocks, law);
+    let updates = model.subcontact_count();
+    bencher
+        .counter(ItemsCount::new(updates))
+        .bench_local(|| model.step().expect("step"));
+}
+
+/// [`settle_step`] through `AnyLaw` (the Python package's model): the same Coulomb joints, with
+/// every sub-contact holding `AnyState` (all laws' states side by side).
+#[divan::bench(args = [10_000, 100_000], sample_count = 10, sample_size = 5)]
+fn settle_step_any_law(bencher: divan::Bencher, blocks: usize) {
+    let mut model = wall_with(blocks, AnyLaw::from(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law")));
+    let updates = model.subcontact_count();
+    bencher
+        .counter(ItemsCount::new(updates))
+        .bench_local(|| model.step().expect("step"));
+}
+
 /// The wall of [`wall`] undamped, its base shaken across the wall at 0.3 g and 3 Hz from the
 /// first step (`scenes::shaking_wall`), after the same 20 steps.
 fn shaking(blocks: usize) -> Model {
