@@ -37,7 +37,7 @@ use std::ops::Range;
 #[path = "support/planar_limit.rs"]
 mod planar_limit;
 
-use planar_limit::PlanarLimit;
+use planar_limit::{turn, PlanarLimit};
 use voussoir::analysis::limit::{LimitOptions, LimitProblem, LiveLoad};
 use voussoir::build::arch::{AbutmentShape, Arch, ArchSpec};
 use voussoir::prelude::*;
@@ -312,14 +312,6 @@ fn tilted_arch_hinges_converge_to_the_rigid_limit() {
     let kn = 100.0 * PAPER_KN;
     let ((soft, limit), (stiff, _)) = rayon::join(|| tilt_capacity(kn), || tilt_capacity(8.0 * kn));
     check_convergence("semicircle t/R 0.25, tilted gravity (tan α)", &soft, &stiff, limit);
-}
-
-/// The rotation of `block` about z since it was built (rad).
-fn turn(m: &Model, block: BlockId) -> Real {
-    let b = m.block(block).unwrap();
-    (b.state().pose.rotation * b.initial_pose().rotation.inverse())
-        .to_scaled_axis()
-        .z
 }
 
 /// One joint of a ring at a settled state: its force, the distance of its resultant from the

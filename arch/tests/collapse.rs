@@ -19,7 +19,7 @@
 #[path = "../../tests/support/planar_limit.rs"]
 mod planar_limit;
 
-use planar_limit::{PlanarAnswer, PlanarLimit};
+use planar_limit::{turn, PlanarAnswer, PlanarLimit};
 use rayon::prelude::*;
 use voussoir::analysis::JointRef;
 use voussoir::block::{Block, BlockId};
@@ -188,13 +188,6 @@ struct JointReading {
     inside: Real,
     winkler: Real,
     ends: [Vector; 2],
-}
-
-fn turn(m: &Model, block: BlockId) -> Real {
-    let b = m.block(block).unwrap();
-    (b.state().pose.rotation * b.initial_pose().rotation.inverse())
-        .to_scaled_axis()
-        .z
 }
 
 fn read_joints(m: &Model, pl: &PlanarLimit, arch: &Arch, kn: Real) -> Vec<JointReading> {

@@ -240,3 +240,11 @@ impl PlanarLimit {
         }
     }
 }
+
+/// The rotation of `block` about z since it was built (rad).
+pub fn turn(m: &voussoir::model::Model, block: BlockId) -> f64 {
+    let b = m.block(block).unwrap();
+    (b.state().pose.rotation * b.initial_pose().rotation.inverse())
+        .to_scaled_axis()
+        .z
+}
