@@ -60,6 +60,19 @@ fn settle_step_mortar(bencher: divan::Bencher, blocks: usize) {
         .bench_local(|| model.step().expect("step"));
 }
 
+/// [`settle_step`] with bonded `CoulombSlip` joints of [`settle_step_mortar`]'s strengths
+/// (tension cut-off 0.25 MPa, cohesion 0.35 MPa, brittle): what carrying tension costs, apart
+/// from what softening costs.
+#[divan::bench(args = [10_000, 100_000], sample_count = 10, sample_size = 5)]
+fn settle_step_bonded_coulomb(bencher: divan::Bencher, blocks: usize) {
+    let law = CoulombSlip::new(1e9, 4e8, 30.0, 30.0, 3.5e5, 2.5e5).expect("law");
+    let mut model = wall_with(blocks, law);
+    let updates = model.subcontact_count();
+    bencher
+        .counter(ItemsCount::new(updates))
+        .bench_local(|| model.step().expect("step"));
+}
+
 /// [`settle_step`] through `AnyLaw` (the Python package's model): the same Coulomb joints, with
 /// every sub-contact holding `AnyState` (all laws' states side by side).
 #[divan::bench(args = [10_000, 100_000], sample_count = 10, sample_size = 5)]

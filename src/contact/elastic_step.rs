@@ -49,41 +49,43 @@ pub(super) fn update_elastic_first<L: ConstitutiveLaw>(
     // regime) the loop below takes over from it, with the `Σ J` of the cells before it.
     let mut start = 0;
     if let (Some(g), Some(e), WholeContact::Closed(cells)) = (face, exact, whole) {
-        if e.virgin_without_tension {
-            // Four cells at a time while they fit (`closed_lanes.rs`), then one at a time.
-            let mut lane_sums = LaneSums::default();
-            let (groups, _) = subs.as_chunks_mut::<LANES>();
-            let joint = ClosedJoint {
-                regime,
-                kinematics,
-                gap: g,
-                virgin: &virgin,
-            };
-            start = LANES * closed_groups(lanes, groups, &joint, &mut lane_sums, &mut dissipated);
-            sums = lane_sums.total().0;
-            for sub in subs[start..].iter_mut() {
-                if sub.state != virgin {
-                    break;
-                }
-                let (x, y) = (sub.plane.x, sub.plane.y);
-                let [_, du_1, du_2] = increment(kinematics, x, y);
-                let gap = face_gap(g, x, y);
-                let du_s = Vector2::new(du_1, du_2);
-                let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) else {
-                    break;
-                };
-                take_elastic_step(regime, sub, (force, status), gap, du_s, &mut dissipated);
-                sums.add_joint(&force, sub.plane);
-                start += 1;
+        // A law that carries tension has its virgin cells taken at their anchors (no exact
+        // moments), but closed all over they are in its elastic regime all the same.
+        // Four cells at a time while they fit (`closed_lanes.rs`), then one at a time.
+        let mut lane_sums = LaneSums::default();
+        let (groups, _) = subs.as_chunks_mut::<LANES>();
+        let joint = ClosedJoint {
+            regime,
+            kinematics,
+            gap: g,
+            virgin: &virgin,
+        };
+        start = LANES * closed_groups(lanes, groups, &joint, &mut lane_sums, &mut dissipated);
+        sums = lane_sums.total().0;
+        for sub in subs[start..].iter_mut() {
+            if sub.state != virgin {
+                break;
             }
-            closed_moments = if start == subs.len() {
-                cells.closed_moments
-            } else {
-                subs[..start]
-                    .iter()
-                    .fold(Vector2::ZERO, |m, sub| m + cell_moments(sub.area, sub.half()))
+            let (x, y) = (sub.plane.x, sub.plane.y);
+            let [_, du_1, du_2] = increment(kinematics, x, y);
+            let gap = face_gap(g, x, y);
+            let du_s = Vector2::new(du_1, du_2);
+            let Some((force, status)) = regime.step(sub.area, gap, du_s, sub.force.shear) else {
+                break;
             };
+            take_elastic_step(regime, sub, (force, status), gap, du_s, &mut dissipated);
+            sums.add_joint(&force, sub.plane);
+            start += 1;
         }
+        closed_moments = if !e.virgin_without_tension {
+            Vector2::ZERO
+        } else if start == subs.len() {
+            cells.closed_moments
+        } else {
+            subs[..start]
+                .iter()
+                .fold(Vector2::ZERO, |m, sub| m + cell_moments(sub.area, sub.half()))
+        };
     }
     // An open, unloaded virgin cell that the law keeps open only takes its smallest gap
     // ([`stays_open_cell`]).
@@ -384,6 +386,15 @@ mod tests {
         };
         let dry = AnyLaw::Coulomb(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
         let cohesive = AnyLaw::Coulomb(CoulombSlip::new(1e9, 4e8, 35.0, 30.0, 2e4, 0.0).expect("law"));
+        // Carrying tension: its virgin cells are taken at their anchors, closed or not.
+        let bonded = AnyLaw::Coulomb(CoulombSlip::new(1e9, 4e8, 35.0, 30.0, 2e4, 1e4).expect("law"));
+        let mortar = AnyLaw::Mortar(
+            crate::law::MortarJoint::builder(1e9, 4e8, 35.0)
+                .tension(1e4, 10.0)
+                .cohesion(2e4, 50.0)
+                .build()
+                .expect("law"),
+        );
         let elastic = AnyLaw::Elastic(LinearElastic {
             normal_stiffness: 1e9,
             shear_stiffness: 4e8,
@@ -395,6 +406,9 @@ mod tests {
                 (elastic, vec![]),
                 (cohesive, vec![]),
                 (cohesive, vec![5, 9]),
+                (bonded, vec![]),
+                (bonded, vec![5, 9]),
+                (mortar, vec![]),
             ] {
                 let regime = law.elastic_regime().expect("a regime");
                 let exact = ExactCells::of(&law, Some(g));
