@@ -1,6 +1,6 @@
-//! The command lines of the core crate's examples (`block_on_incline`, `scaling`) against hostile
-//! input (issue 18), and the argument checks they share with `voussoir-arch`
-//! (`examples/common/args.rs`). The runs of the built examples need
+//! The command lines of the core crate's examples (`block_on_incline`, `scaling`,
+//! `shear_wall`) against hostile input (issue 18), and the argument checks they share with
+//! `voussoir-arch` (`examples/common/args.rs`). The runs of the built examples need
 //! `cargo build --release --examples`, which `cargo test --release` does.
 
 #[path = "../examples/common/args.rs"]
@@ -192,5 +192,28 @@ fn scaling_shakes_the_wall_on_request() {
     assert!(stdout.contains("settling"), "{stdout}");
     let summary = std::fs::read_to_string(dir.join("r/summary.json")).expect("summary");
     assert!(summary.contains("\"scene\": \"rest\""), "{summary}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn shear_wall_refuses_bad_options_before_it_runs() {
+    let dir = scratch("shear_wall");
+    let out = dir.join("out");
+    let out_arg = out.to_str().expect("utf-8 path");
+    for (args, expected) in [
+        (&["--ensemble", "1"][..], "--ensemble"),
+        (&["--ensemble", "two"], "--ensemble"),
+        (&["--masonry-strength-mpa", "0"], "--masonry-strength-mpa"),
+        (&["--masonry-strength-mpa", "nan"], "--masonry-strength-mpa"),
+        (&["--stiffness", "elastic"], "--stiffness"),
+        (&["--top", "free"], "--top"),
+    ] {
+        let mut all = args.to_vec();
+        all.extend(["--out", out_arg]);
+        let (code, _, stderr, _) = run("shear_wall", &all, &dir);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(!out.exists(), "{args:?} wrote {}", out.display());
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -37,6 +37,10 @@ impl Softening {
     /// exactly 0 from the end of the curve on (`52 ln 2`, or 2).
     #[inline]
     fn remaining(self, d: Real) -> Real {
+        // The intact joint (most sub-contacts) without the exponential: `e^{−0} = 1` exactly.
+        if d == 0.0 {
+            return 1.0;
+        }
         match self {
             Softening::Exponential if d < EXPONENTIAL_END => (-d).exp(),
             Softening::Linear if d < 2.0 => 1.0 - 0.5 * d,
