@@ -184,10 +184,10 @@ struct Options {
     #[arg(long, value_name = "MM", value_parser = TRAVEL.parser(), default_value = "3")]
     max_travel_mm: f64,
     /// The servo's advance (µm per advancing step), in [0.05, 50]
-    #[arg(long, value_name = "UM", value_parser = INCREMENT.parser(), default_value = "2")]
+    #[arg(long, value_name = "UM", value_parser = INCREMENT.parser(), default_value = "1")]
     increment_um: f64,
     /// The servo's unbalanced-force ratio threshold, in [1e-5, 0.1]
-    #[arg(long, value_name = "RATIO", value_parser = RATIO.parser(), default_value = "1e-3")]
+    #[arg(long, value_name = "RATIO", value_parser = RATIO.parser(), default_value = "5e-4")]
     threshold: f64,
     /// A potential crack in the middle of each whole brick, with the brick's strength
     #[arg(long)]
@@ -802,6 +802,9 @@ fn summary_of(o: &Outcome) -> serde_json::Value {
         "final_travel_mm": r.curve.last().map_or(0.0, |s| s.travel) * 1e3,
         "final_load_kN": last * 1e-3,
         "final_over_peak": last / r.peak_load,
+        // Whether the load fell past its maximum within the travel (a peak), or was still at
+        // its maximum at the end of it.
+        "peaked": r.travel_at_peak < r.curve.last().map_or(0.0, |s| s.travel) - 0.1e-3,
         "stop": format!("{:?}", r.stop),
         "first_overstress": o.first_overstress.map(|(t, l)| json!({"travel_mm": t * 1e3, "load_kN": l * 1e-3})),
         "overstressed_cells": o.overstressed_cells,
