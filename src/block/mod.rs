@@ -301,6 +301,7 @@ impl RigidBlock {
     }
 
     /// Makes this block share `other`'s shape when the two are the same bit for bit.
+    #[cfg(feature = "serde")]
     pub(crate) fn share_shape_of(&mut self, other: &RigidBlock) -> bool {
         let same = Arc::ptr_eq(&self.shape, &other.shape) || self.shape.same_as(&other.shape);
         if same {
@@ -465,6 +466,7 @@ impl Block for RigidBlock {
 
 /// Makes blocks whose shapes are the same bit for bit share one (a checkpoint's bricks, each
 /// read on its own): memory, not physics.
+#[cfg(feature = "serde")]
 pub(crate) fn share_shapes(blocks: &mut [RigidBlock]) {
     let mut first: std::collections::HashMap<u64, Vec<usize>> = std::collections::HashMap::new();
     for i in 0..blocks.len() {

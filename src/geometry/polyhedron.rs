@@ -462,6 +462,7 @@ impl Polyhedron {
 
     /// Whether `other` is this shape bit for bit: the same vertices (as bits: `-0.0` is not
     /// `0.0`), faces and edges. Derived data follow from these.
+    #[cfg(feature = "serde")]
     pub(crate) fn same_as(&self, other: &Self) -> bool {
         let bits = |v: &Vector| v.to_array().map(Real::to_bits);
         self.vertices.len() == other.vertices.len()
@@ -476,6 +477,7 @@ impl Polyhedron {
     }
 
     /// A hash of the vertices' bits (for [`Polyhedron::same_as`] lookups).
+    #[cfg(feature = "serde")]
     pub(crate) fn vertex_hash(&self) -> u64 {
         let mut h: u64 = 0xcbf2_9ce4_8422_2325;
         for v in &self.vertices {
