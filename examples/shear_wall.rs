@@ -91,6 +91,8 @@ const GF_II: Real = 125.0; // 0.125 N/mm
 /// units. Rigid blocks need it in the joints.
 const UNIT_E: Real = 16.7e9;
 const UNIT_NU: Real = 0.15;
+/// The bricks' shear modulus, `E / 2(1 + ν)`.
+const UNIT_G: Real = UNIT_E / (2.0 * (1.0 + UNIT_NU));
 
 /// The potential crack in the units (`--unit-cracks`): the brick's tensile strength and
 /// mode-I fracture energy (Lourenço 1996: 2.0 MPa, 0.08 N/mm), a cohesion of 1.4 f_t and
@@ -146,10 +148,7 @@ impl StiffnessArg {
     fn of(self, l: Real) -> (Real, Real) {
         match self {
             StiffnessArg::Joints => (KN, KS),
-            StiffnessArg::Lumped => {
-                let g = UNIT_E / (2.0 * (1.0 + UNIT_NU));
-                (1.0 / (1.0 / KN + l / UNIT_E), 1.0 / (1.0 / KS + l / g))
-            }
+            StiffnessArg::Lumped => (1.0 / (1.0 / KN + l / UNIT_E), 1.0 / (1.0 / KS + l / UNIT_G)),
         }
     }
 }
@@ -261,11 +260,7 @@ impl Stiffnesses {
         let head_length = if unit_cracks { 0.5 * UNIT_LENGTH } else { UNIT_LENGTH };
         let unit = match stiffness {
             StiffnessArg::Joints => (UNIT_STIFFNESS_FACTOR * KN, UNIT_STIFFNESS_FACTOR * KS),
-            StiffnessArg::Lumped => {
-                let g = UNIT_E / (2.0 * (1.0 + UNIT_NU));
-                let l = 0.5 * UNIT_LENGTH;
-                (UNIT_E / l, g / l)
-            }
+            StiffnessArg::Lumped => (UNIT_E / (0.5 * UNIT_LENGTH), UNIT_G / (0.5 * UNIT_LENGTH)),
         };
         Self {
             bed: stiffness.of(COURSE_HEIGHT),
