@@ -19,7 +19,9 @@ use serde::{Deserialize, Serialize};
 pub use any::{AnyLaw, AnyState};
 pub use coulomb::{CoulombSlip, CoulombState};
 pub use linear_elastic::LinearElastic;
-pub use mortar::{MortarJoint, MortarJointBuilder, MortarState, MortarStrengths, Softening};
+pub use mortar::{
+    CompressionCap, MortarJoint, MortarJointBuilder, MortarState, MortarStrengths, Softening, LOURENCO_SHEAR_FACTOR,
+};
 pub use table::LawTable;
 
 pub use crate::ids::MaterialId;

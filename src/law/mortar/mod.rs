@@ -6,7 +6,10 @@
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
+mod cap;
 mod spec;
+
+pub use cap::{CompressionCap, LOURENCO_SHEAR_FACTOR};
 
 use super::{ConstitutiveLaw, ElasticRegime, JointForce, JointStatus, JointStep, JointStiffness};
 use crate::error::{in_range, non_negative, positive, Error, Result};
@@ -97,10 +100,14 @@ impl Softening {
 /// A fracture energy of zero is brittle: the strengths drop at once, as [`super::CoulombSlip`]'s
 /// do (with both zero, for a joint with a cohesion of at least `f_t0 tan φ₀`, the law gives
 /// `CoulombSlip`'s forces, failures and dissipation bit for bit, the step that fails in shear
-/// carrying the peak strength as there). Compression is not
-/// capped (a rigid block has no volume to crush: a softening cap would let the blocks sink into
-/// each other without bound); give [`MortarJointBuilder::compressive_strength`] to have each
-/// sub-contact whose compressive stress passes `f_m` flagged ([`MortarState::overstressed`]).
+/// carrying the peak strength as there).
+///
+/// Compression is not capped unless a [`CompressionCap`] is given
+/// ([`MortarJointBuilder::compression_cap`]): then the joint crushes on Lourenço–Rots' elliptical
+/// cap `σ² + C_ss τ² ≤ σ_c(κ_c)²`, hardening and softening with its plastic closure `κ_c`
+/// ([`MortarState::crushing`]) by the compressive fracture energy `G_c`. Without a cap, give
+/// [`MortarJointBuilder::compressive_strength`] to have each sub-contact whose compressive
+/// stress passes `f_m` flagged ([`MortarState::overstressed`]).
 ///
 /// The fracture energy a step consumes is reported by [`ConstitutiveLaw::fracture_work`] and
 /// booked in [`crate::model::Energies::fracture`].
@@ -152,6 +159,7 @@ pub struct MortarJoint {
     mode_ii_fracture_energy: Real,
     softening: Softening,
     compressive_strength: Option<Real>,
+    cap: Option<CompressionCap>,
     /// `tan φ₀`, `tan φ_r`, `tan ψ₀`, cached out of the hot loop.
     tan_friction: Real,
     tan_residual: Real,
@@ -215,13 +223,22 @@ impl MortarJointBuilder {
         self
     }
 
+    /// A compression cap: the joint crushes ([`CompressionCap`]); without one it does not.
+    /// Not with [`compressive_strength`](Self::compressive_strength), which only flags.
+    pub fn compression_cap(mut self, cap: CompressionCap) -> Self {
+        self.law.cap = Some(cap);
+        self
+    }
+
     /// The law, validated.
     ///
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming the first bad value: a stiffness not positive
     /// and finite, an angle outside `[0°, 90°)`, a strength or fracture energy negative or not
     /// finite, a dilatancy without cohesion or mode-II fracture energy, a compressive strength
-    /// not positive and finite.
+    /// not positive and finite, a cap's strength not positive or its other parameters negative
+    /// (`cap_strength`, `cap_fracture_energy`, `cap_shear_factor`, `cap_peak_closure`), a cap
+    /// together with a compressive strength to flag.
     pub fn build(self) -> Result<MortarJoint> {
         let mut law = self.law;
         law.tan_friction = law.friction_deg.to_radians().tan();
@@ -243,6 +260,10 @@ pub struct MortarState {
     /// (slip beyond, on a joint with nothing left to lose, is not counted: see
     /// [`crate::contact::SubContactView::slip`] for all the slip).
     pub plastic_slip: Real,
+    /// The plastic closure `κ_c` (m) of a joint that crushed on its [`CompressionCap`]: its
+    /// faces carry compression from `κ_c` further in than before; also the cap's hardening
+    /// parameter. Zero without a cap.
+    pub crushing: Real,
     /// Whether the compressive stress has passed the law's compressive strength `f_m` at some
     /// step ([`MortarJointBuilder::compressive_strength`]).
     pub overstressed: bool,
@@ -261,6 +282,8 @@ pub struct MortarStrengths {
     pub tan_friction: Real,
     /// Dilatancy `tan ψ`.
     pub tan_dilatancy: Real,
+    /// The compression cap's strength `σ_c(κ_c)` (Pa); infinite without a cap.
+    pub compressive: Real,
 }
 
 /// At most this many alternations of the tension and the shear return in one step (each
@@ -329,6 +352,7 @@ impl MortarJoint {
                 mode_ii_fracture_energy: 0.0,
                 softening: Softening::Exponential,
                 compressive_strength: None,
+                cap: None,
                 tan_friction: Real::NAN,
                 tan_residual: Real::NAN,
                 tan_dilatancy: Real::NAN,
@@ -380,6 +404,10 @@ impl MortarJoint {
     pub fn compressive_strength(&self) -> Option<Real> {
         self.compressive_strength
     }
+    /// The compression cap, if the joint crushes.
+    pub fn compression_cap(&self) -> Option<CompressionCap> {
+        self.cap
+    }
 
     /// The softening parameter `D = f_t0 κ_t/G_f^I + c₀ κ_s/G_f^II` of `state` (infinite
     /// once a brittle mode has failed).
@@ -407,6 +435,7 @@ impl MortarJoint {
             cohesion: self.cohesion * r,
             tan_friction: self.tan_friction_at(r),
             tan_dilatancy: self.tan_dilatancy * self.softening.remaining(self.shear_damage(state.plastic_slip)),
+            compressive: self.cap.map_or(Real::INFINITY, |cap| cap.strength_at(state.crushing)),
         }
     }
 
@@ -460,11 +489,19 @@ impl MortarJoint {
         self.tan_dilatancy * (self.mode_ii_fracture_energy / self.cohesion) * self.softening.integral(0.0, d)
     }
 
-    /// The normal force on area `a` at normal displacement `u`, dilatant opening `dilatant`
-    /// and crack opening `crack`; `−kn·u·a` to the bit for the intact joint.
+    /// Where the joint's faces touch, as a normal displacement: the dilatant opening less the
+    /// crushing; exactly `0.0` for the intact joint.
     #[inline]
-    fn normal_force(&self, u: Real, dilatant: Real, crack: Real, a: Real) -> Real {
-        let e = u - dilatant;
+    fn contact_offset(&self, slip: Real, crushing: Real) -> Real {
+        self.dilatant_opening_at(slip) - crushing
+    }
+
+    /// The normal force on area `a` at normal displacement `u`, contact offset `offset`
+    /// ([`Self::contact_offset`]) and crack opening `crack`; `−kn·u·a` to the bit for the
+    /// intact joint.
+    #[inline]
+    fn normal_force(&self, u: Real, offset: Real, crack: Real, a: Real) -> Real {
+        let e = u - offset;
         let elastic = if e > 0.0 { (e - crack).max(0.0) } else { e };
         -self.normal_stiffness * elastic * a
     }
@@ -492,21 +529,21 @@ impl MortarJoint {
     }
 
     /// The shear limit per unit area, `max(c + σ tan φ, 0)`, at normal displacement `u`, crack
-    /// opening `crack` and plastic slip `slip`.
+    /// opening `crack`, plastic slip `slip` and crushing `crushing`.
     #[inline]
-    fn shear_limit(&self, u: Real, crack: Real, slip: Real) -> Real {
+    fn shear_limit(&self, u: Real, crack: Real, slip: Real, crushing: Real) -> Real {
         let r = self.softening.remaining(self.damage(crack, slip));
-        let sigma = self.normal_force(u, self.dilatant_opening_at(slip), crack, 1.0);
+        let sigma = self.normal_force(u, self.contact_offset(slip, crushing), crack, 1.0);
         (self.cohesion * r + sigma * self.tan_friction_at(r)).max(0.0)
     }
 
     /// The shear return: the plastic slip of the step, from `done` on, at which the shear
     /// stress `tau` of the trial less `k_s` times it meets the shear limit (`slip0` the plastic
     /// slip before the step).
-    fn shear_return(&self, u: Real, crack: Real, slip0: Real, tau: Real, done: Real) -> Real {
+    fn shear_return(&self, u: Real, crack: Real, crushing: Real, slip0: Real, tau: Real, done: Real) -> Real {
         let ks = self.shear_stiffness;
         bracketed_root(done, tau / ks, |q| {
-            (tau - ks * q) - self.shear_limit(u, crack, slip0 + q)
+            (tau - ks * q) - self.shear_limit(u, crack, slip0 + q, crushing)
         })
     }
 }
@@ -526,7 +563,12 @@ impl ConstitutiveLaw for MortarJoint {
         let a = s.area;
         let u = s.normal_displacement;
         let r = self.softening.remaining(self.softening_parameter(state));
-        f.normal = self.normal_force(u, self.dilatant_opening_at(state.plastic_slip), state.crack_opening, a);
+        f.normal = self.normal_force(
+            u,
+            self.contact_offset(state.plastic_slip, state.crushing),
+            state.crack_opening,
+            a,
+        );
         let tensile = self.tensile_strength * r;
         // Open: no tensile strength (left) and no compression, touching included.
         if tensile == 0.0 && f.normal <= 0.0 {
@@ -543,15 +585,21 @@ impl ConstitutiveLaw for MortarJoint {
         // `|F_s| > max(limit, 0)`, without a square root while the joint holds. A trial of no
         // shear beyond the apex of the Coulomb line (`limit < 0`) has nothing to slip.
         let shear_beyond = (limit < 0.0 && trial_squared > 0.0) || trial_squared > limit * limit;
-        if !tension_beyond && !shear_beyond {
+        let cap_beyond = self
+            .cap
+            .is_some_and(|cap| cap.exceeded(f.normal / a, trial_squared.sqrt() / a, state.crushing));
+        if !tension_beyond && !shear_beyond && !cap_beyond {
             self.flag_overstress(f, a, state);
             return JointStatus::Elastic;
         }
         let trial = trial_squared.sqrt();
-        if !tension_beyond && (!self.slip_softens(r, state.plastic_slip) || self.mode_ii_fracture_energy == 0.0) {
+        if !tension_beyond
+            && !cap_beyond
+            && (!self.slip_softens(r, state.plastic_slip) || self.mode_ii_fracture_energy == 0.0)
+        {
             // Slip that loses nothing more (a dry joint, or one cracked through), or the
             // brittle failure of a cohesive joint, as `CoulombSlip`: onto the strength of the
-            // start of the step.
+            // start of the step (which leaves the cap as it was: only the shear falls).
             let cap = limit.max(0.0);
             f.shear *= if trial > 0.0 { cap / trial } else { 0.0 };
             if self.slip_softens(r, state.plastic_slip) {
@@ -560,67 +608,7 @@ impl ConstitutiveLaw for MortarJoint {
             self.flag_overstress(f, a, state);
             return JointStatus::Sliding;
         }
-        // The return mapping, per unit area: the tension and the shear return in turn, each
-        // onto its strength at the end of the step, until neither is exceeded.
-        let slip0 = state.plastic_slip;
-        let tau = trial / a;
-        let (mut crack, mut slip) = (state.crack_opening, slip0);
-        // Plastic slip of the step (m); slip beyond what softens is not state.
-        let mut slipped: Real = 0.0;
-        for round in 0..MAX_ROUNDS {
-            let mut changed = false;
-            let r = self.softening.remaining(self.damage(crack, slip));
-            let e = u - self.dilatant_opening_at(slip);
-            // The first round takes the tension test on the forces above (as `CoulombSlip`).
-            let beyond = if round == 0 {
-                tension_beyond
-            } else {
-                r > 0.0 && e > crack && self.normal_stiffness * (e - crack) > self.tensile_strength * r
-            };
-            if beyond {
-                let before = crack;
-                crack = self.tension_return(e, crack, slip);
-                changed = crack != before;
-            }
-            let limit = self.shear_limit(u, crack, slip);
-            if tau - self.shear_stiffness * slipped > limit {
-                let r = self.softening.remaining(self.damage(crack, slip));
-                if self.slip_softens(r, slip) && self.mode_ii_fracture_energy > 0.0 {
-                    let before = slipped;
-                    slipped = self.shear_return(u, crack, slip0, tau, slipped);
-                    slip = slip0 + slipped;
-                    changed |= slipped != before;
-                } else {
-                    // Nothing left to soften (or brittle): onto the strength, at once.
-                    let more = (tau - limit) / self.shear_stiffness;
-                    if self.slip_softens(r, slip) {
-                        slip = slip0 + more;
-                        changed = true;
-                    }
-                    slipped = more;
-                }
-            }
-            if !changed {
-                break;
-            }
-        }
-        state.crack_opening = crack;
-        state.plastic_slip = slip;
-        let r = self.softening.remaining(self.damage(crack, slip));
-        f.normal = self.normal_force(u, self.dilatant_opening_at(slip), crack, a);
-        if self.tensile_strength * r == 0.0 && f.normal <= 0.0 {
-            f.normal = 0.0;
-            f.shear = Vector2::ZERO;
-            return JointStatus::Open;
-        }
-        let left = (tau - self.shear_stiffness * slipped).max(0.0);
-        f.shear *= if trial > 0.0 { left / tau } else { 0.0 };
-        self.flag_overstress(f, a, state);
-        if slipped > 0.0 {
-            JointStatus::Sliding
-        } else {
-            JointStatus::Elastic
-        }
+        self.return_mapping(s, f, state, tension_beyond, trial)
     }
 
     /// The open test of [`MortarJoint::update`], evaluated the same way: no tensile strength
@@ -630,7 +618,7 @@ impl ConstitutiveLaw for MortarJoint {
         let r = self.softening.remaining(self.softening_parameter(state));
         let normal = self.normal_force(
             normal_displacement,
-            self.dilatant_opening_at(state.plastic_slip),
+            self.contact_offset(state.plastic_slip, state.crushing),
             state.crack_opening,
             area,
         );
@@ -639,10 +627,10 @@ impl ConstitutiveLaw for MortarJoint {
 
     /// The intact joint in compression below its strength: `c₀` and `tan φ₀`; sliding too when
     /// nothing softens as it slides (no cohesion, no dilatancy). None with a compressive
-    /// strength to flag.
+    /// strength to flag or a cap.
     #[inline]
     fn elastic_regime(&self) -> Option<ElasticRegime> {
-        if self.compressive_strength.is_some() {
+        if self.compressive_strength.is_some() || self.cap.is_some() {
             return None;
         }
         Some(ElasticRegime {
@@ -657,7 +645,8 @@ impl ConstitutiveLaw for MortarJoint {
     /// The fracture energy consumed from `before` to `after` (J): the work against the softening
     /// strengths, `A ∫ (f_t dκ_t + c dκ_s) = A (f_t0 Δκ_t + c₀ Δκ_s) ∫r dD / ΔD` along the
     /// step's proportional path — exactly `G_f^I A Δ∫r` in pure opening and `G_f^II A Δ∫r` in
-    /// pure slip; none for a brittle failure.
+    /// pure slip; none for a brittle failure — and the work of crushing against the cap,
+    /// `A ∫ σ_c dκ_c` ([`CompressionCap::work_to`]).
     fn fracture_work(&self, area: Real, before: &MortarState, after: &MortarState) -> Real {
         let d0 = self.softening_parameter(before);
         let (dt, ds) = (
@@ -673,16 +662,22 @@ impl ConstitutiveLaw for MortarJoint {
         };
         let dd = increment(self.tensile_strength, self.mode_i_fracture_energy, dt)
             + increment(self.cohesion, self.mode_ii_fracture_energy, ds);
+        let crushing = match self.cap {
+            Some(cap) if after.crushing > before.crushing => {
+                area * (cap.work_to(after.crushing) - cap.work_to(before.crushing))
+            }
+            _ => 0.0,
+        };
         if !(dd > 0.0 && dd.is_finite() && d0.is_finite()) {
-            return 0.0;
+            return crushing;
         }
         let work = self.tensile_strength * dt + self.cohesion * ds;
-        area * work * (self.softening.integral(d0, dd) / dd)
+        area * work * (self.softening.integral(d0, dd) / dd) + crushing
     }
 
-    /// Cracked or softened at all: some strength lost.
+    /// Cracked, softened or crushed at all.
     fn is_failed(&self, state: &MortarState) -> bool {
-        self.softening_parameter(state) > 0.0
+        self.softening_parameter(state) > 0.0 || state.crushing > 0.0
     }
 
     fn validate(&self) -> Result<()> {
@@ -707,11 +702,109 @@ impl ConstitutiveLaw for MortarJoint {
         if let Some(f_m) = self.compressive_strength {
             positive("compressive_strength", f_m)?;
         }
+        if let Some(cap) = self.cap {
+            cap.validate()?;
+            if let Some(f_m) = self.compressive_strength {
+                return Err(Error::InvalidParameter {
+                    name: "compressive_strength".into(),
+                    value: f_m,
+                    expected: "only flags, for a joint without a compression cap: the cap crushes at its own strength",
+                });
+            }
+        }
         Ok(())
     }
 }
 
 impl MortarJoint {
+    /// The return mapping of [`ConstitutiveLaw::update`] from the trial (shear force `f.shear`
+    /// of magnitude `trial`), per unit area: the tension, the shear and the cap return in turn,
+    /// each onto its strength at the end of the step, until none is exceeded.
+    fn return_mapping(
+        &self,
+        s: &JointStep,
+        f: &mut JointForce,
+        state: &mut MortarState,
+        tension_beyond: bool,
+        trial: Real,
+    ) -> JointStatus {
+        let (a, u) = (s.area, s.normal_displacement);
+        let ks = self.shear_stiffness;
+        let slip0 = state.plastic_slip;
+        let tau = trial / a;
+        let (mut crack, mut slip, mut crushing) = (state.crack_opening, slip0, state.crushing);
+        // Plastic slip of the step on the Coulomb surface (m); slip beyond what softens is not
+        // state. And the cap's plastic shear displacement (m), which softens nothing.
+        let (mut slipped, mut cap_slipped): (Real, Real) = (0.0, 0.0);
+        for round in 0..MAX_ROUNDS {
+            let mut changed = false;
+            let r = self.softening.remaining(self.damage(crack, slip));
+            let e = u - self.contact_offset(slip, crushing);
+            // The first round takes the tension test on the forces above (as `CoulombSlip`).
+            let beyond = if round == 0 {
+                tension_beyond
+            } else {
+                r > 0.0 && e > crack && self.normal_stiffness * (e - crack) > self.tensile_strength * r
+            };
+            if beyond {
+                let before = crack;
+                crack = self.tension_return(e, crack, slip);
+                changed = crack != before;
+            }
+            let limit = self.shear_limit(u, crack, slip, crushing);
+            // The shear left after the cap's plastic shear.
+            let tau_cap = tau - ks * cap_slipped;
+            if tau_cap - ks * slipped > limit {
+                let r = self.softening.remaining(self.damage(crack, slip));
+                if self.slip_softens(r, slip) && self.mode_ii_fracture_energy > 0.0 {
+                    let before = slipped;
+                    slipped = self.shear_return(u, crack, crushing, slip0, tau_cap, slipped);
+                    slip = slip0 + slipped;
+                    changed |= slipped != before;
+                } else {
+                    // Nothing left to soften (or brittle): onto the strength, at once.
+                    let more = (tau_cap - limit) / ks;
+                    if self.slip_softens(r, slip) {
+                        slip = slip0 + more;
+                        changed = true;
+                    }
+                    slipped = more;
+                }
+            }
+            if let Some(cap) = self.cap {
+                let sigma = self.normal_force(u, self.contact_offset(slip, crushing), crack, 1.0);
+                let tau_now = (tau_cap - ks * slipped).max(0.0);
+                if cap.exceeded(sigma, tau_now, crushing) {
+                    let (kappa, tau_after) = cap.ret(self.normal_stiffness, ks, sigma, tau_now, crushing);
+                    changed |= kappa != crushing;
+                    crushing = kappa;
+                    cap_slipped += (tau_now - tau_after) / ks;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        state.crack_opening = crack;
+        state.plastic_slip = slip;
+        state.crushing = crushing;
+        let r = self.softening.remaining(self.damage(crack, slip));
+        f.normal = self.normal_force(u, self.contact_offset(slip, crushing), crack, a);
+        if self.tensile_strength * r == 0.0 && f.normal <= 0.0 {
+            f.normal = 0.0;
+            f.shear = Vector2::ZERO;
+            return JointStatus::Open;
+        }
+        let left = (tau - ks * (slipped + cap_slipped)).max(0.0);
+        f.shear *= if trial > 0.0 { left / tau } else { 0.0 };
+        self.flag_overstress(f, a, state);
+        if slipped > 0.0 || cap_slipped > 0.0 {
+            JointStatus::Sliding
+        } else {
+            JointStatus::Elastic
+        }
+    }
+
     /// Sets [`MortarState::overstressed`] when the compressive stress passes `f_m`.
     #[inline]
     fn flag_overstress(&self, f: &JointForce, area: Real, state: &mut MortarState) {
@@ -734,5 +827,7 @@ impl crate::analysis::limit::LimitStrength for MortarJoint {
     }
 }
 
+#[cfg(test)]
+mod cap_tests;
 #[cfg(test)]
 mod tests;

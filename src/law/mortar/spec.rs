@@ -3,7 +3,7 @@
 #[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
-use super::{MortarJoint, Softening};
+use super::{CompressionCap, MortarJoint, Softening};
 use crate::error::{Error, Result};
 use crate::math::Real;
 
@@ -41,6 +41,9 @@ pub(super) struct MortarSpec {
     /// Pa.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
     compressive_strength: Option<Real>,
+    /// The crushing cap, if any.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    compression_cap: Option<CompressionCap>,
 }
 
 /// The fracture energy of a strength read from a file: required when the strength is not zero.
@@ -70,6 +73,9 @@ impl TryFrom<MortarSpec> for MortarJoint {
         if let Some(f_m) = s.compressive_strength {
             builder = builder.compressive_strength(f_m);
         }
+        if let Some(cap) = s.compression_cap {
+            builder = builder.compression_cap(cap);
+        }
         builder.build()
     }
 }
@@ -88,6 +94,7 @@ impl From<MortarJoint> for MortarSpec {
             dilatancy_deg: l.dilatancy_deg,
             softening: l.softening,
             compressive_strength: l.compressive_strength,
+            compression_cap: l.cap,
         }
     }
 }

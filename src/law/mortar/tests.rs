@@ -23,25 +23,25 @@ fn mortar(softening: Softening) -> MortarJoint {
 /// One sub-contact driven by prescribed displacements, with the books the contact kernel keeps
 /// (`contact/law_update.rs`, the same expressions): the work done on the springs, the
 /// dissipation, and the fracture work.
-struct Driver<'a> {
-    law: &'a MortarJoint,
-    area: Real,
-    gap: Real,
-    force: JointForce,
-    state: MortarState,
-    status: JointStatus,
+pub(super) struct Driver<'a> {
+    pub(super) law: &'a MortarJoint,
+    pub(super) area: Real,
+    pub(super) gap: Real,
+    pub(super) force: JointForce,
+    pub(super) state: MortarState,
+    pub(super) status: JointStatus,
     /// `Σ −½ (F⁻ + F)·Δu` (J).
-    work: Real,
+    pub(super) work: Real,
     /// What the kernel books as dissipated, fracture apart (J).
-    friction: Real,
+    pub(super) friction: Real,
     /// What the kernel books as fracture (J).
-    fracture: Real,
+    pub(super) fracture: Real,
     /// The law's fracture work, before the kernel's bound (J).
-    consumed: Real,
+    pub(super) consumed: Real,
 }
 
 impl<'a> Driver<'a> {
-    fn new(law: &'a MortarJoint, area: Real) -> Self {
+    pub(super) fn new(law: &'a MortarJoint, area: Real) -> Self {
         Self {
             law,
             area,
@@ -57,7 +57,7 @@ impl<'a> Driver<'a> {
     }
 
     /// One step to the normal displacement `gap` with the shear increment `du` (along `t₁`).
-    fn step(&mut self, gap: Real, du: Real) -> JointStatus {
+    pub(super) fn step(&mut self, gap: Real, du: Real) -> JointStatus {
         let du_s = Vector2::new(du, 0.0);
         let step = JointStep {
             area: self.area,
@@ -96,7 +96,7 @@ impl<'a> Driver<'a> {
         status
     }
 
-    fn elastic(&self) -> Real {
+    pub(super) fn elastic(&self) -> Real {
         self.law.elastic_energy(self.area, &self.force, &self.state)
     }
 }
@@ -456,7 +456,7 @@ fn opening_erodes_cohesion_and_slip_erodes_tension() {
         let s = law.strengths(&MortarState {
             crack_opening: crack,
             plastic_slip: slip,
-            overstressed: false,
+            ..MortarState::default()
         });
         let r = (-(2e5 / 10.0) * (crack + alpha * slip)).exp();
         assert!((s.tensile - 2e5 * r).abs() < 1e-9 * 2e5);
@@ -626,6 +626,24 @@ fn bad_parameters_are_named() {
         MortarJoint::builder(1e9, 1e9, 30.0).compressive_strength(0.0).build(),
         "compressive_strength",
     );
+    let capped = |cap: CompressionCap| MortarJoint::builder(1e9, 1e9, 30.0).compression_cap(cap).build();
+    named(capped(CompressionCap::new(0.0, 1.0)), "cap_strength");
+    named(capped(CompressionCap::new(1e6, -1.0)), "cap_fracture_energy");
+    named(
+        capped(CompressionCap::new(1e6, 1.0).with_shear_factor(Real::NAN)),
+        "cap_shear_factor",
+    );
+    named(
+        capped(CompressionCap::new(1e6, 1.0).with_peak_closure(-1e-4)),
+        "cap_peak_closure",
+    );
+    named(
+        MortarJoint::builder(1e9, 1e9, 30.0)
+            .compressive_strength(1e6)
+            .compression_cap(CompressionCap::new(1e6, 1.0))
+            .build(),
+        "compressive_strength",
+    );
     assert!(MortarJoint::builder(1e9, 1e9, 30.0).build().is_ok());
 }
 
@@ -675,6 +693,17 @@ fn laws() -> Vec<MortarJoint> {
             .compressive_strength(1e6)
             .build()
             .unwrap(),
+        // Crushing: a cap with hardening, and one on the normal stress alone, without tension.
+        base()
+            .tension(2e5, 10.0)
+            .cohesion(3e5, 50.0)
+            .compression_cap(CompressionCap::new(2e6, 100.0).with_peak_closure(1e-4))
+            .build()
+            .unwrap(),
+        base()
+            .compression_cap(CompressionCap::new(1e6, 0.0).with_shear_factor(0.0))
+            .build()
+            .unwrap(),
     ]
 }
 
@@ -685,14 +714,14 @@ fn laws() -> Vec<MortarJoint> {
 fn conforms_to_the_law_contract() {
     for law in laws() {
         let report = conformance::check(&law).unwrap_or_else(|e| panic!("{law:?}: {e}"));
-        if law.compressive_strength().is_none() {
+        if law.elastic_regime().is_some() {
             assert!(report.regime_stood > 1000, "{law:?}: {report:?}");
         } else {
             assert_eq!(report.regime_stood, 0);
         }
         assert!(report.open_promised > 100, "{law:?}: {report:?}");
-        // Only the dry joint has nothing to lose.
-        let dry = law.tensile_strength() == 0.0 && law.cohesion() == 0.0;
+        // Only the dry joint without a cap has nothing to lose.
+        let dry = law.tensile_strength() == 0.0 && law.cohesion() == 0.0 && law.compression_cap().is_none();
         assert_eq!(report.states == 1, dry, "{law:?}: {report:?}");
         assert_eq!(conformance::check(&crate::law::AnyLaw::from(law)), Ok(report));
     }
