@@ -3,8 +3,9 @@
 //!
 //! ```text
 //! cargo run --release --example shear_wall [-- --joints both|mortar|dry] [--per-edge 3]
-//!     [--top confined|loaded] [--stiffness lumped|joints] [--max-travel-mm 3] [--unit-cracks]
-//!     [--masonry-strength-mpa F] [--check] [--check-travel-mm 1.5] [--ensemble N] [--out DIR]
+//!     [--top confined|loaded] [--stiffness lumped|joints] [--cap lourenco|none]
+//!     [--max-travel-mm 3] [--unit-cracks] [--masonry-strength-mpa F] [--check]
+//!     [--check-travel-mm 1.5] [--ensemble N] [--out DIR]
 //! ```
 //!
 //! The wall, 990 × 1000 × 100 mm, is built of units expanded by half a joint (220 × 62.5 ×
@@ -18,8 +19,9 @@
 //! bricks are elastic (E 16 700 MPa, ν 0.15) and his interface stiffnesses do not include them;
 //! ours are rigid, so by default (`--stiffness lumped`) each joint carries in series the
 //! elasticity of the unit it stands for (a course's height for a bed joint, a unit's length for a
-//! head joint); `--stiffness joints` takes his kn, ks unchanged. `--unit-cracks` adds a potential
-//! crack in each whole brick's middle. The model, the adopted values and where they
+//! head joint); `--stiffness joints` takes his kn, ks unchanged. The joints crush on Lourenço's
+//! compression cap (f_m 10.5 MPa, G_c 5 N/mm, C_ss 9, κ_p 0.09 mm; `--cap none` leaves it out).
+//! `--unit-cracks` adds a potential crack in each whole brick's middle. The model, the adopted values and where they
 //! differ from the test are in `docs/benchmarks/shear-wall.md`.
 //!
 //! Writes into `--out` (default `out/shear_wall`): `summary.json` (`peak_kN` and the rest),
@@ -42,7 +44,7 @@ use std::time::Instant;
 use clap::{Parser, ValueEnum};
 use serde_json::json;
 use voussoir::io::viewer::Viewer;
-use voussoir::law::MortarJoint;
+use voussoir::law::{CompressionCap, MortarJoint};
 use voussoir::loading::{PushOver, PushOverResult, Servo};
 use voussoir::prelude::*;
 
@@ -84,6 +86,14 @@ const GF_I: Real = 18.0; // 0.018 N/mm
 const COHESION: Real = 0.35e6;
 const TAN_PHI: Real = 0.75;
 const GF_II: Real = 125.0; // 0.125 N/mm
+
+/// Lourenço's compression cap for these walls (1996; Lourenço & Rots 1997): compressive strength
+/// f_m 10.5 MPa, compressive fracture energy G_c 5 N/mm, shear factor C_ss 9, plastic closure at
+/// the peak κ_p 0.09 mm (as we have them from his thesis; to be checked against it).
+const CAP_STRENGTH: Real = 10.5e6;
+const CAP_FRACTURE_ENERGY: Real = 5000.0; // 5 N/mm
+const CAP_SHEAR_FACTOR: Real = 9.0;
+const CAP_PEAK_CLOSURE: Real = 0.09e-3;
 
 /// Lourenço's elastic bricks (E 16 700 MPa, ν 0.15): his interfaces' kn, ks were derived as
 /// `kn = E_u E_m / (h_m (E_u − E_m))` (and the same for shear), the mortar's compliance less that
@@ -191,8 +201,12 @@ struct Options {
     /// A potential crack in the middle of each whole brick, with the brick's strength
     #[arg(long)]
     unit_cracks: bool,
-    /// Flag the joints' cells whose compressive stress passes this masonry strength (MPa;
-    /// Lourenço's cap: 10.5): the law does not crush, the summary says where and from when
+    /// The joints' compression cap: Lourenço's (f_m 10.5 MPa, G_c 5 N/mm, C_ss 9, κ_p 0.09 mm),
+    /// or none (the joints do not crush)
+    #[arg(long, value_enum, default_value = "lourenco")]
+    cap: CapArg,
+    /// With `--cap none`: flag the joints' cells whose compressive stress passes this masonry
+    /// strength (MPa; Lourenço's cap: 10.5); the summary says where and from when
     #[arg(long, value_name = "MPA", value_parser = STRENGTH.parser())]
     masonry_strength_mpa: Option<f64>,
     /// Run the density and servo convergence checks on the mortared wall
@@ -213,6 +227,28 @@ struct Options {
     out: PathBuf,
 }
 
+/// The joints' compression cap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum CapArg {
+    /// Lourenço's cap for these walls.
+    Lourenco,
+    /// No cap: the joints do not crush.
+    None,
+}
+
+impl CapArg {
+    fn cap(self) -> Option<CompressionCap> {
+        match self {
+            CapArg::Lourenco => Some(
+                CompressionCap::new(CAP_STRENGTH, CAP_FRACTURE_ENERGY)
+                    .with_shear_factor(CAP_SHEAR_FACTOR)
+                    .with_peak_closure(CAP_PEAK_CLOSURE),
+            ),
+            CapArg::None => None,
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Joints {
     Mortar,
@@ -228,9 +264,9 @@ impl Joints {
     }
 
     /// The law of the mortar joints (and of the wall's faces against the beams) of stiffnesses
-    /// `(kn, ks)`.
-    /// `(kn, ks)`, flagging compressive stresses above `f_m` (Pa) if given.
-    fn law(self, (kn, ks): (Real, Real), f_m: Option<Real>) -> Result<MortarJoint> {
+    /// `(kn, ks)`, crushing on `cap` if given (dry joints too: the bricks crush whether the
+    /// joints are mortared or not), else flagging compressive stresses above `f_m` (Pa) if given.
+    fn law(self, (kn, ks): (Real, Real), cap: Option<CompressionCap>, f_m: Option<Real>) -> Result<MortarJoint> {
         let phi = TAN_PHI.atan().to_degrees();
         let builder = match self {
             Joints::Mortar => MortarJoint::builder(kn, ks, phi)
@@ -241,9 +277,10 @@ impl Joints {
             // Same stiffness and friction, no tension, no cohesion.
             Joints::Dry => MortarJoint::builder(kn, ks, phi),
         };
-        match f_m {
-            Some(f_m) => builder.compressive_strength(f_m).build(),
-            None => builder.build(),
+        match (cap, f_m) {
+            (Some(cap), _) => builder.compression_cap(cap).build(),
+            (None, Some(f_m)) => builder.compressive_strength(f_m).build(),
+            (None, None) => builder.build(),
         }
     }
 }
@@ -329,9 +366,10 @@ fn build(joints: Joints, options: &Options) -> Result<Wall> {
     };
     let mut model: Model<MortarJoint> = Model::new(params)?;
     let f_m = options.masonry_strength_mpa.map(|f| f * 1e6);
-    model.set_joint_law(EVEN, ODD, joints.law(stiffnesses.bed, f_m)?)?;
-    model.set_joint_law(EVEN, EVEN, joints.law(stiffnesses.head, f_m)?)?;
-    model.set_joint_law(ODD, ODD, joints.law(stiffnesses.head, f_m)?)?;
+    let cap = options.cap.cap();
+    model.set_joint_law(EVEN, ODD, joints.law(stiffnesses.bed, cap, f_m)?)?;
+    model.set_joint_law(EVEN, EVEN, joints.law(stiffnesses.head, cap, f_m)?)?;
+    model.set_joint_law(ODD, ODD, joints.law(stiffnesses.head, cap, f_m)?)?;
     model.set_damping(Damping::Local { alpha: 0.8 })?;
     // The fixed base: the bottom steel beam with the clamped bottom course.
     model.add_block(
@@ -649,6 +687,12 @@ struct Outcome {
     /// number of cells past it at the end.
     first_overstress: Option<(Real, Real)>,
     overstressed_cells: usize,
+    /// With the cap: travel (m) and load (N) at which a cell first yielded on it, and first
+    /// passed its peak (softening); the cells crushed (yielded) and softening at the end.
+    first_crush: Option<(Real, Real)>,
+    first_softening: Option<(Real, Real)>,
+    crushed_cells: usize,
+    softening_cells: usize,
     seconds: f64,
     steps: u64,
     blocks: usize,
@@ -667,8 +711,11 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
     let mut frame_error = None;
     let mut next_print = 0.25e-3;
     let mut vertical_kn = Vec::new();
-    // The travel (m) and load (N) at which a cell first passed the masonry strength.
+    // The travel (m) and load (N) at which a cell first passed the masonry strength, first
+    // crushed, and first passed the cap's peak.
     let mut first_overstress: Option<(Real, Real)> = None;
+    let (mut first_crush, mut first_softening): (Option<(Real, Real)>, Option<(Real, Real)>) = (None, None);
+    let peak_closure = options.cap.cap().map(|c| c.peak_closure);
     let result = push(
         &mut wall,
         servo,
@@ -681,6 +728,20 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
                     .any(|c| c.subcontacts().any(|s| s.law_state().overstressed))
             {
                 first_overstress = Some((travel, load));
+            }
+            if let Some(kp) = peak_closure {
+                if first_softening.is_none() {
+                    let most = m
+                        .contacts()
+                        .flat_map(|c| c.subcontacts().map(|s| s.law_state().crushing))
+                        .fold(0.0, Real::max);
+                    if most > 0.0 && first_crush.is_none() {
+                        first_crush = Some((travel, load));
+                    }
+                    if most > kp {
+                        first_softening = Some((travel, load));
+                    }
+                }
             }
             if travel >= next_frame {
                 next_frame += 0.25e-3;
@@ -746,6 +807,13 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
         .contacts()
         .map(|c| c.subcontacts().filter(|s| s.law_state().overstressed).count())
         .sum();
+    let crushing = |past: Real| -> usize {
+        wall.model
+            .contacts()
+            .map(|c| c.subcontacts().filter(|s| s.law_state().crushing > past).count())
+            .sum()
+    };
+    let (crushed_cells, softening_cells) = (crushing(0.0), peak_closure.map_or(0, crushing));
     Ok(Outcome {
         joints,
         vertical_kn,
@@ -754,6 +822,10 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
         damage,
         first_overstress,
         overstressed_cells,
+        first_crush,
+        first_softening,
+        crushed_cells,
+        softening_cells,
         seconds: started.elapsed().as_secs_f64(),
         steps: wall.model.step_count() - settled,
         blocks: wall.model.blocks().len(),
@@ -803,6 +875,10 @@ fn summary_of(o: &Outcome) -> serde_json::Value {
         "stop": format!("{:?}", r.stop),
         "first_overstress": o.first_overstress.map(|(t, l)| json!({"travel_mm": t * 1e3, "load_kN": l * 1e-3})),
         "overstressed_cells": o.overstressed_cells,
+        "first_crush": o.first_crush.map(|(t, l)| json!({"travel_mm": t * 1e3, "load_kN": l * 1e-3})),
+        "first_cap_softening": o.first_softening.map(|(t, l)| json!({"travel_mm": t * 1e3, "load_kN": l * 1e-3})),
+        "crushed_cells": o.crushed_cells,
+        "cap_softening_cells": o.softening_cells,
         "fracture_J": o.energies.fracture,
         "friction_J": o.energies.friction,
         "damping_J": o.energies.damping,
@@ -832,6 +908,15 @@ fn summary_of(o: &Outcome) -> serde_json::Value {
 
 fn run() -> Result<()> {
     let options = Options::parse();
+    if options.masonry_strength_mpa.is_some() && options.cap != CapArg::None {
+        use clap::CommandFactory;
+        Options::command()
+            .error(
+                clap::error::ErrorKind::ArgumentConflict,
+                "--masonry-strength-mpa flags stresses in joints that do not crush: give it with --cap none",
+            )
+            .exit();
+    }
     let walls: &[Joints] = match options.joints {
         JointsArg::Both => &[Joints::Mortar, Joints::Dry],
         JointsArg::Mortar => &[Joints::Mortar],
@@ -846,13 +931,14 @@ fn run() -> Result<()> {
     args::prepare_output_dir(&options.out, &[], &files)?;
     println!(
         "shear wall J4D: {LENGTH} × {HEIGHT} × {THICKNESS} m, {COURSES} courses of {:.1} mm units, {} per edge, \
-         servo {} µm / {:.0e}, top {:?}, stiffness {:?}{}",
+         servo {} µm / {:.0e}, top {:?}, stiffness {:?}, cap {:?}{}",
         COURSE_HEIGHT * 1e3,
         options.per_edge,
         options.increment_um,
         options.threshold,
         options.top,
         options.stiffness,
+        options.cap,
         if options.unit_cracks { ", unit cracks" } else { "" }
     );
     let mut outcomes = Vec::new();
@@ -882,6 +968,19 @@ fn run() -> Result<()> {
                 ),
                 None => println!("  no cell's compressive stress passed {f_m} MPa"),
             }
+        }
+        if options.cap != CapArg::None {
+            let at = |x: Option<(Real, Real)>| match x {
+                Some((t, l)) => format!("from {:.2} mm ({:.1} kN)", t * 1e3, l * 1e-3),
+                None => "never".to_owned(),
+            };
+            println!(
+                "  cap: cells yield {}, pass the peak {}; {} crushed, {} softening at the end",
+                at(o.first_crush),
+                at(o.first_softening),
+                o.crushed_cells,
+                o.softening_cells
+            );
         }
         print!("{}", crack_map(&o.damage));
         outcomes.push(o);
@@ -926,6 +1025,12 @@ fn run() -> Result<()> {
             "GfII_N_per_m": GF_II,
             "unit_cracks": options.unit_cracks,
             "masonry_strength_MPa": options.masonry_strength_mpa,
+            "cap": options.cap.cap().map(|c| json!({
+                "fm_MPa": c.strength * 1e-6,
+                "Gc_N_per_m": c.fracture_energy,
+                "Css": c.shear_factor,
+                "kappa_p_mm": c.peak_closure * 1e3,
+            })),
             "top": format!("{:?}", options.top),
             "subcontacts_per_edge": options.per_edge,
             "servo_increment_um": options.increment_um,

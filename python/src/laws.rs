@@ -1,7 +1,7 @@
 //! The shipped joint laws.
 
 use pyo3::prelude::*;
-use voussoir::law::{AnyLaw, ConstitutiveLaw, CoulombSlip, LinearElastic, MortarJoint, Softening};
+use voussoir::law::{AnyLaw, CompressionCap, ConstitutiveLaw, CoulombSlip, LinearElastic, MortarJoint, Softening};
 
 use crate::errors::{bad, OrPy};
 
@@ -113,7 +113,8 @@ fn degrees(law: &CoulombSlip, field: &str) -> f64 {
 ///
 /// ``MortarJoint(kn, ks, friction_deg, residual_friction_deg=None, tensile_strength=0.0,
 /// mode_i_fracture_energy=None, cohesion=0.0, mode_ii_fracture_energy=None, dilatancy_deg=0.0,
-/// softening="exponential", compressive_strength=None)``: stiffnesses in Pa/m, angles in degrees
+/// softening="exponential", compressive_strength=None, cap_strength=None, cap_fracture_energy=None,
+/// cap_shear_factor=9.0, cap_peak_closure=0.0)``: stiffnesses in Pa/m, angles in degrees
 /// ([0, 90)), strengths in Pa, fracture energies in J/m² (N/m). The tensile strength softens
 /// with the crack's opening on ``mode_i_fracture_energy`` and the cohesion with its slip on
 /// ``mode_ii_fracture_energy`` (each required with its strength; 0 is brittle, as
@@ -121,9 +122,14 @@ fn degrees(law: &CoulombSlip, field: &str) -> f64 {
 /// cohesion goes; opening erodes the cohesion and slip the tensile strength alike.
 /// ``softening`` is ``"exponential"`` or ``"linear"``. ``dilatancy_deg`` (needs a cohesion and
 /// a mode-II fracture energy) opens a slipping joint, decaying as it softens.
-/// ``compressive_strength`` (Pa) flags sub-contacts whose compression passes it (the law does
-/// not crush) and makes the step slower. The fracture energy consumed is
-/// ``Model.energies()["fracture"]``; see ``docs/theory.md`` §4.2.
+/// ``cap_strength`` (Pa) gives the joint a compression cap on which it crushes (Lourenço–Rots'
+/// ellipse ``σ² + C_ss τ² ≤ σ_c²``): ``cap_fracture_energy`` (J/m², required with it) is the
+/// energy a unit area dissipates past the cap's peak over its residual ``f_m/7``,
+/// ``cap_shear_factor`` is ``C_ss`` (Lourenço's 9 by default), ``cap_peak_closure`` (m) the
+/// plastic closure at the peak (0: the cap starts at ``f_m``, else at ``f_m/3`` and hardens).
+/// Without a cap the law does not crush; ``compressive_strength`` (Pa) then flags sub-contacts
+/// whose compression passes it. Either makes the step slower. The fracture energy consumed,
+/// crushing included, is ``Model.energies()["fracture"]``; see ``docs/theory.md`` §4.2.
 #[pyclass(name = "MortarJoint", module = "voussoir", frozen)]
 #[derive(Clone)]
 pub struct PyMortarJoint {
@@ -159,6 +165,10 @@ impl PyMortarJoint {
         dilatancy_deg=0.0,
         softening="exponential",
         compressive_strength=None,
+        cap_strength=None,
+        cap_fracture_energy=None,
+        cap_shear_factor=voussoir::law::LOURENCO_SHEAR_FACTOR,
+        cap_peak_closure=0.0,
     ))]
     #[allow(clippy::too_many_arguments)]
     fn new(
@@ -173,6 +183,10 @@ impl PyMortarJoint {
         dilatancy_deg: f64,
         softening: &str,
         compressive_strength: Option<f64>,
+        cap_strength: Option<f64>,
+        cap_fracture_energy: Option<f64>,
+        cap_shear_factor: f64,
+        cap_peak_closure: f64,
     ) -> PyResult<Self> {
         let g_i = fracture_energy("mode_i_fracture_energy", tensile_strength, mode_i_fracture_energy)?;
         let g_ii = fracture_energy("mode_ii_fracture_energy", cohesion, mode_ii_fracture_energy)?;
@@ -193,6 +207,18 @@ impl PyMortarJoint {
             .softening(shape);
         if let Some(f_m) = compressive_strength {
             builder = builder.compressive_strength(f_m);
+        }
+        if let Some(f_m) = cap_strength {
+            let g_c = cap_fracture_energy.ok_or_else(|| {
+                bad("cap_fracture_energy: must be given with cap_strength (0 for a brittle cap)".to_owned())
+            })?;
+            builder = builder.compression_cap(
+                CompressionCap::new(f_m, g_c)
+                    .with_shear_factor(cap_shear_factor)
+                    .with_peak_closure(cap_peak_closure),
+            );
+        } else if cap_fracture_energy.is_some() {
+            return Err(bad("cap_fracture_energy: given without cap_strength".to_owned()));
         }
         Ok(Self {
             inner: builder.build().py()?,
@@ -257,12 +283,38 @@ impl PyMortarJoint {
     fn compressive_strength(&self) -> Option<f64> {
         self.inner.compressive_strength()
     }
+    /// The compression cap's strength ``f_m`` (Pa), or None without a cap.
+    #[getter]
+    fn cap_strength(&self) -> Option<f64> {
+        self.inner.compression_cap().map(|c| c.strength)
+    }
+    /// The compression cap's fracture energy ``G_c`` (J/m²), or None without a cap.
+    #[getter]
+    fn cap_fracture_energy(&self) -> Option<f64> {
+        self.inner.compression_cap().map(|c| c.fracture_energy)
+    }
+    /// The compression cap's shear factor ``C_ss``, or None without a cap.
+    #[getter]
+    fn cap_shear_factor(&self) -> Option<f64> {
+        self.inner.compression_cap().map(|c| c.shear_factor)
+    }
+    /// The compression cap's plastic closure at its peak ``κ_p`` (m), or None without a cap.
+    #[getter]
+    fn cap_peak_closure(&self) -> Option<f64> {
+        self.inner.compression_cap().map(|c| c.peak_closure)
+    }
 
     fn __repr__(&self) -> String {
-        let f_m = match self.compressive_strength() {
+        let mut f_m = match self.compressive_strength() {
             Some(f) => format!(", compressive_strength={f}"),
             None => String::new(),
         };
+        if let Some(c) = self.inner.compression_cap() {
+            f_m += &format!(
+                ", cap_strength={}, cap_fracture_energy={}, cap_shear_factor={}, cap_peak_closure={}",
+                c.strength, c.fracture_energy, c.shear_factor, c.peak_closure
+            );
+        }
         format!(
             "MortarJoint(kn={:e}, ks={:e}, friction_deg={}, residual_friction_deg={}, tensile_strength={}, \
              mode_i_fracture_energy={}, cohesion={}, mode_ii_fracture_energy={}, dilatancy_deg={}, softening={:?}{f_m})",

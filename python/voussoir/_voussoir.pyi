@@ -63,7 +63,10 @@ class CoulombSlip:
 class MortarJoint:
     """A mortared joint that cracks in tension and shear and softens by its fracture energies
     (J/m²) per unit area, whatever the sub-contact count; each fracture energy is required with
-    its strength (0: brittle). The fracture energy consumed is ``Model.energies()["fracture"]``."""
+    its strength (0: brittle). With ``cap_strength`` (Pa) and ``cap_fracture_energy`` (J/m²) it
+    crushes on Lourenço–Rots' compression cap ``σ² + C_ss τ² ≤ σ_c²`` (``cap_shear_factor``
+    ``C_ss``, ``cap_peak_closure`` the plastic closure at the peak in m). The fracture energy
+    consumed, crushing included, is ``Model.energies()["fracture"]``."""
     def __init__(
         self,
         kn: float,
@@ -77,6 +80,10 @@ class MortarJoint:
         dilatancy_deg: float = 0.0,
         softening: Literal["exponential", "linear"] = "exponential",
         compressive_strength: Optional[float] = None,
+        cap_strength: Optional[float] = None,
+        cap_fracture_energy: Optional[float] = None,
+        cap_shear_factor: float = 9.0,
+        cap_peak_closure: float = 0.0,
     ) -> None: ...
     @property
     def kn(self) -> float: ...
@@ -100,6 +107,14 @@ class MortarJoint:
     def softening(self) -> Literal["exponential", "linear"]: ...
     @property
     def compressive_strength(self) -> Optional[float]: ...
+    @property
+    def cap_strength(self) -> Optional[float]: ...
+    @property
+    def cap_fracture_energy(self) -> Optional[float]: ...
+    @property
+    def cap_shear_factor(self) -> Optional[float]: ...
+    @property
+    def cap_peak_closure(self) -> Optional[float]: ...
 
 class LinearElastic:
     def __init__(self, kn: float, ks: float) -> None: ...
