@@ -205,8 +205,8 @@ struct Options {
     /// or none (the joints do not crush)
     #[arg(long, value_enum, default_value = "lourenco")]
     cap: CapArg,
-    /// With `--cap none`: flag the joints' cells whose compressive stress passes this masonry
-    /// strength (MPa; Lourenço's cap: 10.5); the summary says where and from when
+    /// Flag the joints' cells whose compressive stress passes this masonry strength (MPa;
+    /// Lourenço's cap: 10.5; useful with `--cap none`): the summary says from when and how many
     #[arg(long, value_name = "MPA", value_parser = STRENGTH.parser())]
     masonry_strength_mpa: Option<f64>,
     /// Run the density and servo convergence checks on the mortared wall
@@ -265,8 +265,8 @@ impl Joints {
 
     /// The law of the mortar joints (and of the wall's faces against the beams) of stiffnesses
     /// `(kn, ks)`, crushing on `cap` if given (dry joints too: the bricks crush whether the
-    /// joints are mortared or not), else flagging compressive stresses above `f_m` (Pa) if given.
-    fn law(self, (kn, ks): (Real, Real), cap: Option<CompressionCap>, f_m: Option<Real>) -> Result<MortarJoint> {
+    /// joints are mortared or not).
+    fn law(self, (kn, ks): (Real, Real), cap: Option<CompressionCap>) -> Result<MortarJoint> {
         let phi = TAN_PHI.atan().to_degrees();
         let builder = match self {
             Joints::Mortar => MortarJoint::builder(kn, ks, phi)
@@ -277,10 +277,9 @@ impl Joints {
             // Same stiffness and friction, no tension, no cohesion.
             Joints::Dry => MortarJoint::builder(kn, ks, phi),
         };
-        match (cap, f_m) {
-            (Some(cap), _) => builder.compression_cap(cap).build(),
-            (None, Some(f_m)) => builder.compressive_strength(f_m).build(),
-            (None, None) => builder.build(),
+        match cap {
+            Some(cap) => builder.compression_cap(cap).build(),
+            None => builder.build(),
         }
     }
 }
@@ -365,11 +364,10 @@ fn build(joints: Joints, options: &Options) -> Result<Wall> {
         ..ModelParameters::default()
     };
     let mut model: Model<MortarJoint> = Model::new(params)?;
-    let f_m = options.masonry_strength_mpa.map(|f| f * 1e6);
     let cap = options.cap.cap();
-    model.set_joint_law(EVEN, ODD, joints.law(stiffnesses.bed, cap, f_m)?)?;
-    model.set_joint_law(EVEN, EVEN, joints.law(stiffnesses.head, cap, f_m)?)?;
-    model.set_joint_law(ODD, ODD, joints.law(stiffnesses.head, cap, f_m)?)?;
+    model.set_joint_law(EVEN, ODD, joints.law(stiffnesses.bed, cap)?)?;
+    model.set_joint_law(EVEN, EVEN, joints.law(stiffnesses.head, cap)?)?;
+    model.set_joint_law(ODD, ODD, joints.law(stiffnesses.head, cap)?)?;
     model.set_damping(Damping::Local { alpha: 0.8 })?;
     // The fixed base: the bottom steel beam with the clamped bottom course.
     model.add_block(
@@ -693,6 +691,8 @@ struct Outcome {
     first_softening: Option<(Real, Real)>,
     crushed_cells: usize,
     softening_cells: usize,
+    /// The largest plastic closure of a cell at the end (m).
+    max_crushing: Real,
     seconds: f64,
     steps: u64,
     blocks: usize,
@@ -716,18 +716,19 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
     let mut first_overstress: Option<(Real, Real)> = None;
     let (mut first_crush, mut first_softening): (Option<(Real, Real)>, Option<(Real, Real)>) = (None, None);
     let peak_closure = options.cap.cap().map(|c| c.peak_closure);
+    let f_m = options.masonry_strength_mpa.map(|f| f * 1e6);
     let result = push(
         &mut wall,
         servo,
         options.max_travel_mm * 1e-3,
         |m, travel, load, vertical| {
             vertical_kn.push(vertical * 1e-3);
-            if options.masonry_strength_mpa.is_some()
-                && first_overstress.is_none()
-                && m.contacts()
-                    .any(|c| c.subcontacts().any(|s| s.law_state().overstressed))
-            {
-                first_overstress = Some((travel, load));
+            if let Some(f_m) = f_m {
+                if first_overstress.is_none()
+                    && m.contacts().any(|c| c.subcontacts().any(|s| s.normal_stress() > f_m))
+                {
+                    first_overstress = Some((travel, load));
+                }
             }
             if let Some(kp) = peak_closure {
                 if first_softening.is_none() {
@@ -802,11 +803,12 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
         damping: e.damping - before.damping,
         ..e
     };
-    let overstressed_cells = wall
-        .model
-        .contacts()
-        .map(|c| c.subcontacts().filter(|s| s.law_state().overstressed).count())
-        .sum();
+    let overstressed_cells = f_m.map_or(0, |f_m| {
+        wall.model
+            .contacts()
+            .map(|c| c.subcontacts().filter(|s| s.normal_stress() > f_m).count())
+            .sum()
+    });
     let crushing = |past: Real| -> usize {
         wall.model
             .contacts()
@@ -814,6 +816,11 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
             .sum()
     };
     let (crushed_cells, softening_cells) = (crushing(0.0), peak_closure.map_or(0, crushing));
+    let max_crushing = wall
+        .model
+        .contacts()
+        .flat_map(|c| c.subcontacts().map(|s| s.law_state().crushing))
+        .fold(0.0, Real::max);
     Ok(Outcome {
         joints,
         vertical_kn,
@@ -826,6 +833,7 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
         first_softening,
         crushed_cells,
         softening_cells,
+        max_crushing,
         seconds: started.elapsed().as_secs_f64(),
         steps: wall.model.step_count() - settled,
         blocks: wall.model.blocks().len(),
@@ -879,6 +887,7 @@ fn summary_of(o: &Outcome) -> serde_json::Value {
         "first_cap_softening": o.first_softening.map(|(t, l)| json!({"travel_mm": t * 1e3, "load_kN": l * 1e-3})),
         "crushed_cells": o.crushed_cells,
         "cap_softening_cells": o.softening_cells,
+        "max_crushing_mm": o.max_crushing * 1e3,
         "fracture_J": o.energies.fracture,
         "friction_J": o.energies.friction,
         "damping_J": o.energies.damping,
@@ -908,15 +917,7 @@ fn summary_of(o: &Outcome) -> serde_json::Value {
 
 fn run() -> Result<()> {
     let options = Options::parse();
-    if options.masonry_strength_mpa.is_some() && options.cap != CapArg::None {
-        use clap::CommandFactory;
-        Options::command()
-            .error(
-                clap::error::ErrorKind::ArgumentConflict,
-                "--masonry-strength-mpa flags stresses in joints that do not crush: give it with --cap none",
-            )
-            .exit();
-    }
+
     let walls: &[Joints] = match options.joints {
         JointsArg::Both => &[Joints::Mortar, Joints::Dry],
         JointsArg::Mortar => &[Joints::Mortar],
@@ -975,11 +976,12 @@ fn run() -> Result<()> {
                 None => "never".to_owned(),
             };
             println!(
-                "  cap: cells yield {}, pass the peak {}; {} crushed, {} softening at the end",
+                "  cap: cells yield {}, pass the peak {}; {} crushed, {} softening at the end, the deepest by {:.3} mm",
                 at(o.first_crush),
                 at(o.first_softening),
                 o.crushed_cells,
-                o.softening_cells
+                o.softening_cells,
+                o.max_crushing * 1e3
             );
         }
         print!("{}", crack_map(&o.damage));

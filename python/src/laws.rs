@@ -113,8 +113,8 @@ fn degrees(law: &CoulombSlip, field: &str) -> f64 {
 ///
 /// ``MortarJoint(kn, ks, friction_deg, residual_friction_deg=None, tensile_strength=0.0,
 /// mode_i_fracture_energy=None, cohesion=0.0, mode_ii_fracture_energy=None, dilatancy_deg=0.0,
-/// softening="exponential", compressive_strength=None, cap_strength=None, cap_fracture_energy=None,
-/// cap_shear_factor=9.0, cap_peak_closure=0.0)``: stiffnesses in Pa/m, angles in degrees
+/// softening="exponential", cap_strength=None, cap_fracture_energy=None, cap_shear_factor=9.0,
+/// cap_peak_closure=0.0)``: stiffnesses in Pa/m, angles in degrees
 /// ([0, 90)), strengths in Pa, fracture energies in J/m² (N/m). The tensile strength softens
 /// with the crack's opening on ``mode_i_fracture_energy`` and the cohesion with its slip on
 /// ``mode_ii_fracture_energy`` (each required with its strength; 0 is brittle, as
@@ -127,8 +127,8 @@ fn degrees(law: &CoulombSlip, field: &str) -> f64 {
 /// energy a unit area dissipates past the cap's peak over its residual ``f_m/7``,
 /// ``cap_shear_factor`` is ``C_ss`` (Lourenço's 9 by default), ``cap_peak_closure`` (m) the
 /// plastic closure at the peak (0: the cap starts at ``f_m``, else at ``f_m/3`` and hardens).
-/// Without a cap the law does not crush; ``compressive_strength`` (Pa) then flags sub-contacts
-/// whose compression passes it. Either makes the step slower. The fracture energy consumed,
+/// Without a cap the law does not crush (``Model.contacts()`` gives each sub-contact's stress);
+/// with one the step is slower. The fracture energy consumed,
 /// crushing included, is ``Model.energies()["fracture"]``; see ``docs/theory.md`` §4.2.
 #[pyclass(name = "MortarJoint", module = "voussoir", frozen)]
 #[derive(Clone)]
@@ -164,7 +164,6 @@ impl PyMortarJoint {
         mode_ii_fracture_energy=None,
         dilatancy_deg=0.0,
         softening="exponential",
-        compressive_strength=None,
         cap_strength=None,
         cap_fracture_energy=None,
         cap_shear_factor=voussoir::law::LOURENCO_SHEAR_FACTOR,
@@ -182,7 +181,6 @@ impl PyMortarJoint {
         mode_ii_fracture_energy: Option<f64>,
         dilatancy_deg: f64,
         softening: &str,
-        compressive_strength: Option<f64>,
         cap_strength: Option<f64>,
         cap_fracture_energy: Option<f64>,
         cap_shear_factor: f64,
@@ -205,9 +203,6 @@ impl PyMortarJoint {
             .cohesion(cohesion, g_ii)
             .dilatancy(dilatancy_deg)
             .softening(shape);
-        if let Some(f_m) = compressive_strength {
-            builder = builder.compressive_strength(f_m);
-        }
         if let Some(f_m) = cap_strength {
             let g_c = cap_fracture_energy.ok_or_else(|| {
                 bad("cap_fracture_energy: must be given with cap_strength (0 for a brittle cap)".to_owned())
@@ -278,11 +273,6 @@ impl PyMortarJoint {
             Softening::Linear => "linear",
         }
     }
-    /// Compressive strength that flags sub-contacts (Pa), or None.
-    #[getter]
-    fn compressive_strength(&self) -> Option<f64> {
-        self.inner.compressive_strength()
-    }
     /// The compression cap's strength ``f_m`` (Pa), or None without a cap.
     #[getter]
     fn cap_strength(&self) -> Option<f64> {
@@ -305,10 +295,7 @@ impl PyMortarJoint {
     }
 
     fn __repr__(&self) -> String {
-        let mut f_m = match self.compressive_strength() {
-            Some(f) => format!(", compressive_strength={f}"),
-            None => String::new(),
-        };
+        let mut f_m = String::new();
         if let Some(c) = self.inner.compression_cap() {
             f_m += &format!(
                 ", cap_strength={}, cap_fracture_energy={}, cap_shear_factor={}, cap_peak_closure={}",

@@ -85,8 +85,6 @@ def test_parameters_are_checked_and_named():
         mortar(residual_friction_deg=95.0)
     with pytest.raises(vs.VoussoirError, match="dilatancy_angle"):
         vs.MortarJoint(KN, KS, 35.0, dilatancy_deg=10.0)
-    with pytest.raises(vs.VoussoirError, match="compressive_strength"):
-        mortar(compressive_strength=0.0)
     with pytest.raises(vs.VoussoirError, match="normal_stiffness"):
         vs.MortarJoint(-1.0, KS, 35.0)
     with pytest.raises(vs.VoussoirError, match="softening"):
@@ -98,12 +96,12 @@ def test_parameters_are_checked_and_named():
 
 
 def test_the_law_reads_back_and_round_trips_through_scenes_and_checkpoints():
-    law = mortar(dilatancy_deg=5.0, softening="linear", compressive_strength=8e6)
+    law = mortar(dilatancy_deg=5.0, softening="linear")
     assert (law.friction_deg, law.residual_friction_deg, law.dilatancy_deg) == (35.0, 30.0, 5.0)
     assert (law.tensile_strength, law.mode_i_fracture_energy) == (FT, G_I)
     assert (law.cohesion, law.mode_ii_fracture_energy) == (3e5, 10.0)
-    assert (law.softening, law.compressive_strength) == ("linear", 8e6)
-    assert "MortarJoint(" in repr(law) and law == mortar(dilatancy_deg=5.0, softening="linear", compressive_strength=8e6)
+    assert law.softening == "linear"
+    assert "MortarJoint(" in repr(law) and law == mortar(dilatancy_deg=5.0, softening="linear")
     m = vs.Model()
     m.set_joint_law(0, 0, law)
     m.set_joint_law(0, 1, vs.CoulombSlip.dry(KN, KS, 30.0))
@@ -172,8 +170,6 @@ def test_the_cap_is_checked_read_back_and_round_tripped():
         mortar(cap_strength=0.0, cap_fracture_energy=G_C)
     with pytest.raises(vs.VoussoirError, match="cap_shear_factor"):
         mortar(cap_strength=F_M, cap_fracture_energy=G_C, cap_shear_factor=-1.0)
-    with pytest.raises(vs.VoussoirError, match="compressive_strength"):
-        mortar(cap_strength=F_M, cap_fracture_energy=G_C, compressive_strength=F_M)
     law = mortar(cap_strength=F_M, cap_fracture_energy=G_C, cap_peak_closure=2e-5)
     assert (law.cap_strength, law.cap_fracture_energy, law.cap_shear_factor, law.cap_peak_closure) == (
         F_M,

@@ -79,7 +79,6 @@ class MortarJoint:
         mode_ii_fracture_energy: Optional[float] = None,
         dilatancy_deg: float = 0.0,
         softening: Literal["exponential", "linear"] = "exponential",
-        compressive_strength: Optional[float] = None,
         cap_strength: Optional[float] = None,
         cap_fracture_energy: Optional[float] = None,
         cap_shear_factor: float = 9.0,
@@ -105,8 +104,6 @@ class MortarJoint:
     def mode_ii_fracture_energy(self) -> float: ...
     @property
     def softening(self) -> Literal["exponential", "linear"]: ...
-    @property
-    def compressive_strength(self) -> Optional[float]: ...
     @property
     def cap_strength(self) -> Optional[float]: ...
     @property

@@ -81,7 +81,7 @@ pub enum AnyLaw {
 /// have to read a foreign variant as its own. Here there is nothing to map: a sub-contact that
 /// changes law (its pair of materials given another law) keeps a state the new law reads as
 /// it would its own. The struct is `Copy` and as small as the states it holds side by side
-/// (40 bytes: [`MortarState`]'s three lengths and flag, and [`CoulombState`]'s flag).
+/// (32 bytes: [`MortarState`]'s three lengths, and [`CoulombState`]'s flag).
 ///
 /// ```
 /// use voussoir::law::{AnyLaw, AnyState, ConstitutiveLaw, CoulombSlip};
@@ -329,7 +329,6 @@ mod tests {
                 crack_opening: 1.25e-4,
                 plastic_slip: 3e-5,
                 crushing: 2e-5,
-                overstressed: true,
             },
         };
         let back: AnyState = serde_json::from_str(&serde_json::to_string(&state).unwrap()).unwrap();
@@ -358,15 +357,15 @@ mod tests {
         );
     }
 
-    /// The state is the laws' states side by side and no larger: `MortarState` (three lengths
-    /// and a flag, 32 bytes) and `CoulombState`'s flag, 40 bytes with the alignment.
+    /// The state is the laws' states side by side and no larger: `MortarState` (three lengths,
+    /// 24 bytes) and `CoulombState`'s flag, 32 bytes with the alignment.
     #[test]
     fn state_is_the_laws_states_side_by_side() {
-        assert_eq!(std::mem::size_of::<MortarState>(), 32);
+        assert_eq!(std::mem::size_of::<MortarState>(), 24);
         assert_eq!(std::mem::size_of::<CoulombState>(), 1);
-        assert_eq!(std::mem::size_of::<AnyState>(), 40);
-        // A sub-contact of a `Model<AnyLaw>`: 120 bytes (80 with `CoulombSlip`'s state alone).
-        assert_eq!(std::mem::size_of::<crate::contact::SubContact<AnyState>>(), 120);
+        assert_eq!(std::mem::size_of::<AnyState>(), 32);
+        // A sub-contact of a `Model<AnyLaw>`: 112 bytes (80 with `CoulombSlip`'s state alone).
+        assert_eq!(std::mem::size_of::<crate::contact::SubContact<AnyState>>(), 112);
     }
 
     fn mortar_laws() -> [MortarJoint; 2] {

@@ -293,3 +293,28 @@ fn a_brittle_cap_drops_to_its_residual() {
     d.step(gap - 1e-7, 0.0);
     assert!((d.force.normal / 1e-2 - cap.residual()).abs() < 1e-9 * cap.strength);
 }
+
+/// The serialised law carries its cap (with defaults for the shear factor and the hardening),
+/// and an earlier file's `compressive_strength` (a flag that changed no force) loads and is
+/// dropped.
+#[cfg(feature = "serde")]
+#[test]
+fn the_cap_round_trips_and_the_old_flag_is_dropped() {
+    let law = capped(j4d_cap(), 0.35e6);
+    let text = serde_json::to_string(&law).unwrap();
+    assert_eq!(serde_json::from_str::<MortarJoint>(&text).unwrap(), law);
+    let short = r#"{"normal_stiffness": 1e10, "shear_stiffness": 4e9, "friction_deg": 30.0,
+        "compression_cap": {"strength": 5e6, "fracture_energy": 100.0}}"#;
+    let read: MortarJoint = serde_json::from_str(short).unwrap();
+    let cap = read.compression_cap().unwrap();
+    assert_eq!((cap.shear_factor, cap.peak_closure), (LOURENCO_SHEAR_FACTOR, 0.0));
+    let old = r#"{"normal_stiffness": 1e10, "shear_stiffness": 4e9, "friction_deg": 30.0,
+        "compressive_strength": 8e6}"#;
+    let read: MortarJoint = serde_json::from_str(old).unwrap();
+    assert_eq!(read, MortarJoint::builder(1e10, 4e9, 30.0).build().unwrap());
+    assert!(!serde_json::to_string(&read).unwrap().contains("compressive_strength"));
+    let bad = r#"{"normal_stiffness": 1e10, "shear_stiffness": 4e9, "friction_deg": 30.0,
+        "compression_cap": {"strength": -5e6, "fracture_energy": 100.0}}"#;
+    let e = serde_json::from_str::<MortarJoint>(bad).unwrap_err();
+    assert!(e.to_string().contains("cap_strength"), "{e}");
+}

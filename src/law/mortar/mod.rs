@@ -105,9 +105,9 @@ impl Softening {
 /// Compression is not capped unless a [`CompressionCap`] is given
 /// ([`MortarJointBuilder::compression_cap`]): then the joint crushes on Lourenço–Rots' elliptical
 /// cap `σ² + C_ss τ² ≤ σ_c(κ_c)²`, hardening and softening with its plastic closure `κ_c`
-/// ([`MortarState::crushing`]) by the compressive fracture energy `G_c`. Without a cap, give
-/// [`MortarJointBuilder::compressive_strength`] to have each sub-contact whose compressive
-/// stress passes `f_m` flagged ([`MortarState::overstressed`]).
+/// ([`MortarState::crushing`]) by the compressive fracture energy `G_c`. Without a cap, where a
+/// joint's compressive stress passes the masonry's strength can be read from the sub-contacts'
+/// stresses ([`crate::contact::SubContactView::normal_stress`]).
 ///
 /// The fracture energy a step consumes is reported by [`ConstitutiveLaw::fracture_work`] and
 /// booked in [`crate::model::Energies::fracture`].
@@ -158,7 +158,6 @@ pub struct MortarJoint {
     cohesion: Real,
     mode_ii_fracture_energy: Real,
     softening: Softening,
-    compressive_strength: Option<Real>,
     cap: Option<CompressionCap>,
     /// `tan φ₀`, `tan φ_r`, `tan ψ₀`, cached out of the hot loop.
     tan_friction: Real,
@@ -214,17 +213,7 @@ impl MortarJointBuilder {
         self
     }
 
-    /// Compressive strength `f_m` (Pa) of the masonry: a sub-contact whose compressive stress
-    /// passes it is flagged ([`MortarState::overstressed`]); the law does not crush. With it,
-    /// the law offers no elastic regime (every sub-contact's update checks its stress), so a
-    /// step costs more.
-    pub fn compressive_strength(mut self, f_m: Real) -> Self {
-        self.law.compressive_strength = Some(f_m);
-        self
-    }
-
     /// A compression cap: the joint crushes ([`CompressionCap`]); without one it does not.
-    /// Not with [`compressive_strength`](Self::compressive_strength), which only flags.
     pub fn compression_cap(mut self, cap: CompressionCap) -> Self {
         self.law.cap = Some(cap);
         self
@@ -235,10 +224,9 @@ impl MortarJointBuilder {
     /// # Errors
     /// [`crate::Error::InvalidParameter`] naming the first bad value: a stiffness not positive
     /// and finite, an angle outside `[0°, 90°)`, a strength or fracture energy negative or not
-    /// finite, a dilatancy without cohesion or mode-II fracture energy, a compressive strength
-    /// not positive and finite, a cap's strength not positive or its other parameters negative
-    /// (`cap_strength`, `cap_fracture_energy`, `cap_shear_factor`, `cap_peak_closure`), a cap
-    /// together with a compressive strength to flag.
+    /// finite, a dilatancy without cohesion or mode-II fracture energy, a cap's strength not
+    /// positive and finite or its other parameters negative or not finite (`cap_strength`,
+    /// `cap_fracture_energy`, `cap_shear_factor`, `cap_peak_closure`).
     pub fn build(self) -> Result<MortarJoint> {
         let mut law = self.law;
         law.tan_friction = law.friction_deg.to_radians().tan();
@@ -264,9 +252,6 @@ pub struct MortarState {
     /// faces carry compression from `κ_c` further in than before; also the cap's hardening
     /// parameter. Zero without a cap.
     pub crushing: Real,
-    /// Whether the compressive stress has passed the law's compressive strength `f_m` at some
-    /// step ([`MortarJointBuilder::compressive_strength`]).
-    pub overstressed: bool,
 }
 
 /// The strengths of a [`MortarJoint`] in a given state ([`MortarJoint::strengths`]).
@@ -351,7 +336,6 @@ impl MortarJoint {
                 cohesion: 0.0,
                 mode_ii_fracture_energy: 0.0,
                 softening: Softening::Exponential,
-                compressive_strength: None,
                 cap: None,
                 tan_friction: Real::NAN,
                 tan_residual: Real::NAN,
@@ -399,10 +383,6 @@ impl MortarJoint {
     /// The shape of the softening curves.
     pub fn softening(&self) -> Softening {
         self.softening
-    }
-    /// Compressive strength `f_m` (Pa) above which a sub-contact is flagged, if given.
-    pub fn compressive_strength(&self) -> Option<Real> {
-        self.compressive_strength
     }
     /// The compression cap, if the joint crushes.
     pub fn compression_cap(&self) -> Option<CompressionCap> {
@@ -589,7 +569,6 @@ impl ConstitutiveLaw for MortarJoint {
             .cap
             .is_some_and(|cap| cap.exceeded(f.normal / a, trial_squared.sqrt() / a, state.crushing));
         if !tension_beyond && !shear_beyond && !cap_beyond {
-            self.flag_overstress(f, a, state);
             return JointStatus::Elastic;
         }
         let trial = trial_squared.sqrt();
@@ -605,7 +584,6 @@ impl ConstitutiveLaw for MortarJoint {
             if self.slip_softens(r, state.plastic_slip) {
                 state.plastic_slip += (trial - cap) / (self.shear_stiffness * a);
             }
-            self.flag_overstress(f, a, state);
             return JointStatus::Sliding;
         }
         self.return_mapping(s, f, state, tension_beyond, trial)
@@ -626,11 +604,10 @@ impl ConstitutiveLaw for MortarJoint {
     }
 
     /// The intact joint in compression below its strength: `c₀` and `tan φ₀`; sliding too when
-    /// nothing softens as it slides (no cohesion, no dilatancy). None with a compressive
-    /// strength to flag or a cap.
+    /// nothing softens as it slides (no cohesion, no dilatancy). None with a cap.
     #[inline]
     fn elastic_regime(&self) -> Option<ElasticRegime> {
-        if self.compressive_strength.is_some() || self.cap.is_some() {
+        if self.cap.is_some() {
             return None;
         }
         Some(ElasticRegime {
@@ -699,18 +676,8 @@ impl ConstitutiveLaw for MortarJoint {
                            cohesion's softening)",
             });
         }
-        if let Some(f_m) = self.compressive_strength {
-            positive("compressive_strength", f_m)?;
-        }
         if let Some(cap) = self.cap {
             cap.validate()?;
-            if let Some(f_m) = self.compressive_strength {
-                return Err(Error::InvalidParameter {
-                    name: "compressive_strength".into(),
-                    value: f_m,
-                    expected: "only flags, for a joint without a compression cap: the cap crushes at its own strength",
-                });
-            }
         }
         Ok(())
     }
@@ -797,7 +764,6 @@ impl MortarJoint {
         }
         let left = (tau - ks * (slipped + cap_slipped)).max(0.0);
         f.shear *= if trial > 0.0 { left / tau } else { 0.0 };
-        self.flag_overstress(f, a, state);
         if slipped > 0.0 || cap_slipped > 0.0 {
             JointStatus::Sliding
         } else {
@@ -805,15 +771,6 @@ impl MortarJoint {
         }
     }
 
-    /// Sets [`MortarState::overstressed`] when the compressive stress passes `f_m`.
-    #[inline]
-    fn flag_overstress(&self, f: &JointForce, area: Real, state: &mut MortarState) {
-        if let Some(f_m) = self.compressive_strength {
-            if f.normal > f_m * area {
-                state.overstressed = true;
-            }
-        }
-    }
 }
 
 #[cfg(feature = "limit")]

@@ -38,8 +38,9 @@ pub(super) struct MortarSpec {
     dilatancy_deg: Real,
     #[cfg_attr(feature = "serde", serde(default))]
     softening: Softening,
-    /// Pa.
-    #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
+    /// The stress above which earlier versions flagged a sub-contact (Pa): read from old files
+    /// and dropped (it changed no force), never written.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing))]
     compressive_strength: Option<Real>,
     /// The crushing cap, if any.
     #[cfg_attr(feature = "serde", serde(default, skip_serializing_if = "Option::is_none"))]
@@ -70,9 +71,6 @@ impl TryFrom<MortarSpec> for MortarJoint {
             .cohesion(s.cohesion, g_ii)
             .dilatancy(s.dilatancy_deg)
             .softening(s.softening);
-        if let Some(f_m) = s.compressive_strength {
-            builder = builder.compressive_strength(f_m);
-        }
         if let Some(cap) = s.compression_cap {
             builder = builder.compression_cap(cap);
         }
@@ -93,7 +91,7 @@ impl From<MortarJoint> for MortarSpec {
             mode_ii_fracture_energy: Some(l.mode_ii_fracture_energy),
             dilatancy_deg: l.dilatancy_deg,
             softening: l.softening,
-            compressive_strength: l.compressive_strength,
+            compressive_strength: None,
             compression_cap: l.cap,
         }
     }

@@ -1,6 +1,6 @@
 //! [`MortarJoint`] on its own, driven sub-contact by sub-contact: its curves and dissipation
 //! against their closed forms, unloading, the brittle limit against `CoulombSlip`, the
-//! coupling, dilatancy, the flag, the parameters and the law contract.
+//! coupling, dilatancy, the parameters and the law contract.
 
 use super::*;
 
@@ -554,31 +554,6 @@ fn dilatancy_raises_the_compression_and_saturates() {
     assert!(d.friction > 0.0 && d.fracture > 0.0);
 }
 
-/// The compressive strength flags, and only flags: the forces are the law's without it.
-#[test]
-fn compressive_strength_is_flagged() {
-    let plain = mortar(Softening::Exponential);
-    let flagged = MortarJoint::builder(1e11, 4e10, 35.0)
-        .residual_friction(30.0)
-        .tension(2e5, 10.0)
-        .cohesion(3e5, 50.0)
-        .compressive_strength(5.05e6)
-        .build()
-        .unwrap();
-    assert!(flagged.elastic_regime().is_none());
-    let (mut a, mut b) = (Driver::new(&plain, 0.01), Driver::new(&flagged, 0.01));
-    for k in 0..100 {
-        let gap = -1e-6 * k as Real;
-        a.step(gap, 0.0);
-        b.step(gap, 0.0);
-        assert_eq!(a.force, b.force);
-        // σ = 1e5 k Pa: passes 5.05 MPa at k = 51.
-        assert_eq!(b.state.overstressed, k > 50, "{k}");
-    }
-    b.step(0.0, 0.0);
-    assert!(b.state.overstressed, "the flag stays");
-}
-
 /// Every bad parameter is refused by name.
 #[test]
 fn bad_parameters_are_named() {
@@ -622,10 +597,6 @@ fn bad_parameters_are_named() {
             .build(),
         "dilatancy_angle",
     );
-    named(
-        MortarJoint::builder(1e9, 1e9, 30.0).compressive_strength(0.0).build(),
-        "compressive_strength",
-    );
     let capped = |cap: CompressionCap| MortarJoint::builder(1e9, 1e9, 30.0).compression_cap(cap).build();
     named(capped(CompressionCap::new(0.0, 1.0)), "cap_strength");
     named(capped(CompressionCap::new(1e6, -1.0)), "cap_fracture_energy");
@@ -637,13 +608,7 @@ fn bad_parameters_are_named() {
         capped(CompressionCap::new(1e6, 1.0).with_peak_closure(-1e-4)),
         "cap_peak_closure",
     );
-    named(
-        MortarJoint::builder(1e9, 1e9, 30.0)
-            .compressive_strength(1e6)
-            .compression_cap(CompressionCap::new(1e6, 1.0))
-            .build(),
-        "compressive_strength",
-    );
+
     assert!(MortarJoint::builder(1e9, 1e9, 30.0).build().is_ok());
 }
 
@@ -687,12 +652,6 @@ fn laws() -> Vec<MortarJoint> {
         base().cohesion(3e5, 50.0).build().unwrap(),
         base().tension(1e5, 20.0).build().unwrap(),
         base().build().unwrap(),
-        base()
-            .tension(2e5, 10.0)
-            .cohesion(3e5, 50.0)
-            .compressive_strength(1e6)
-            .build()
-            .unwrap(),
         // Crushing: a cap with hardening, and one on the normal stress alone, without tension.
         base()
             .tension(2e5, 10.0)
@@ -707,7 +666,7 @@ fn laws() -> Vec<MortarJoint> {
     ]
 }
 
-/// Intact, softening, brittle, dilatant, dry and flagged joints keep the law contract
+/// Intact, softening, brittle, dilatant, dry and crushing joints keep the law contract
 /// (`elastic_regime` and `stays_open` agree with `update`; energies and fracture work not
 /// negative; see [`crate::law::conformance`]).
 #[test]
