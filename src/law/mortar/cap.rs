@@ -105,6 +105,7 @@ impl CompressionCap {
     }
 
     /// The cap's strength `σ_c(κ_c)` (Pa) at plastic closure `κ_c ≥ 0` (m).
+    #[inline(never)]
     pub fn strength_at(&self, kappa: Real) -> Real {
         let (fm, kp) = (self.strength, self.peak_closure);
         if kappa < kp {

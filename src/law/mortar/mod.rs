@@ -391,6 +391,7 @@ impl MortarJoint {
 
     /// The softening parameter `D = f_t0 κ_t/G_f^I + c₀ κ_s/G_f^II` of `state` (infinite
     /// once a brittle mode has failed).
+    #[inline]
     pub fn softening_parameter(&self, state: &MortarState) -> Real {
         self.damage(state.crack_opening, state.plastic_slip)
     }
@@ -565,9 +566,10 @@ impl ConstitutiveLaw for MortarJoint {
         // `|F_s| > max(limit, 0)`, without a square root while the joint holds. A trial of no
         // shear beyond the apex of the Coulomb line (`limit < 0`) has nothing to slip.
         let shear_beyond = (limit < 0.0 && trial_squared > 0.0) || trial_squared > limit * limit;
-        let cap_beyond = self
-            .cap
-            .is_some_and(|cap| cap.exceeded(f.normal / a, trial_squared.sqrt() / a, state.crushing));
+        let cap_beyond = match &self.cap {
+            Some(cap) => cap.exceeded(f.normal / a, trial_squared.sqrt() / a, state.crushing),
+            None => false,
+        };
         if !tension_beyond && !shear_beyond && !cap_beyond {
             return JointStatus::Elastic;
         }
@@ -686,7 +688,9 @@ impl ConstitutiveLaw for MortarJoint {
 impl MortarJoint {
     /// The return mapping of [`ConstitutiveLaw::update`] from the trial (shear force `f.shear`
     /// of magnitude `trial`), per unit area: the tension, the shear and the cap return in turn,
-    /// each onto its strength at the end of the step, until none is exceeded.
+    /// each onto its strength at the end of the step, until none is exceeded. Out of line: most
+    /// updates are elastic and return before it.
+    #[inline(never)]
     fn return_mapping(
         &self,
         s: &JointStep,
