@@ -714,7 +714,8 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
     // The travel (m) and load (N) at which a cell first passed the masonry strength, first
     // crushed, and first passed the cap's peak.
     let mut first_overstress: Option<(Real, Real)> = None;
-    let (mut first_crush, mut first_softening): (Option<(Real, Real)>, Option<(Real, Real)>) = (None, None);
+    let mut first_crush: Option<(Real, Real)> = None;
+    let mut first_softening: Option<(Real, Real)> = None;
     let peak_closure = options.cap.cap().map(|c| c.peak_closure);
     let f_m = options.masonry_strength_mpa.map(|f| f * 1e6);
     let result = push(
@@ -724,8 +725,7 @@ fn run_wall(options: &Options, joints: Joints) -> Result<Outcome> {
         |m, travel, load, vertical| {
             vertical_kn.push(vertical * 1e-3);
             if let Some(f_m) = f_m {
-                if first_overstress.is_none()
-                    && m.contacts().any(|c| c.subcontacts().any(|s| s.normal_stress() > f_m))
+                if first_overstress.is_none() && m.contacts().any(|c| c.subcontacts().any(|s| s.normal_stress() > f_m))
                 {
                     first_overstress = Some((travel, load));
                 }

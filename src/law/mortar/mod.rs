@@ -774,7 +774,6 @@ impl MortarJoint {
             JointStatus::Elastic
         }
     }
-
 }
 
 #[cfg(feature = "limit")]
