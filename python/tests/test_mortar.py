@@ -23,24 +23,30 @@ def mortar(**kwargs):
     return vs.MortarJoint(KN, KS, 35.0, **spec)
 
 
-def pulled_off(per_edge, law=None):
-    """A 0.2 m square block bonded to a fixed base and driven straight up at 1 mm/s (1e-7 m a
-    step) by 0.6 mm: the crack runs through."""
+def driven(per_edge, law, vz, steps):
+    """A 0.2 m square block bonded to a fixed base by ``law`` and driven straight along z at
+    ``vz`` (m/s; 1e-4 s steps) for ``steps`` steps."""
     m = vs.Model(subcontacts_per_edge=per_edge, time_step=1e-4)
     m.set_damping("none")
-    m.set_joint_law(0, 0, law or mortar())
+    m.set_joint_law(0, 0, law)
     m.add_cuboid("base", (-1, -1, -0.2), (1, 1, 0), 2500.0, fixed=True)
-    up = (0.0, 0.0, 1e-3)
+    v = (0.0, 0.0, vz)
     m.add_cuboid(
         "block",
         (-0.1, -0.1, 0),
         (0.1, 0.1, 0.1),
         2500.0,
-        fixed={"translation": list(up), "rotation": ["fixed"] * 3},
-        velocity=up,
+        fixed={"translation": list(v), "rotation": ["fixed"] * 3},
+        velocity=v,
     )
-    m.run_steps(6000)
+    m.run_steps(steps)
     return m
+
+
+def pulled_off(per_edge, law=None):
+    """The block driven straight up at 1 mm/s (1e-7 m a step) by 0.6 mm: the crack runs
+    through."""
+    return driven(per_edge, law or mortar(), 1e-3, 6000)
 
 
 @pytest.mark.parametrize("per_edge", [5, 15, 30])
@@ -126,24 +132,9 @@ F_M, G_C = 2e6, 100.0
 
 
 def pushed_in(per_edge, depth_steps=6000, law=None):
-    """The 0.2 m square block driven straight down into its base at 1 mm/s (1e-7 m a step) by
-    0.6 mm: the joint crushes through its peak far into its residual."""
-    law = law or mortar(cap_strength=F_M, cap_fracture_energy=G_C)
-    m = vs.Model(subcontacts_per_edge=per_edge, time_step=1e-4)
-    m.set_damping("none")
-    m.set_joint_law(0, 0, law)
-    m.add_cuboid("base", (-1, -1, -0.2), (1, 1, 0), 2500.0, fixed=True)
-    down = (0.0, 0.0, -1e-3)
-    m.add_cuboid(
-        "block",
-        (-0.1, -0.1, 0),
-        (0.1, 0.1, 0.1),
-        2500.0,
-        fixed={"translation": list(down), "rotation": ["fixed"] * 3},
-        velocity=down,
-    )
-    m.run_steps(depth_steps)
-    return m
+    """The block driven straight down into its base at 1 mm/s (1e-7 m a step) by 0.6 mm: the
+    joint crushes through its peak far into its residual."""
+    return driven(per_edge, law or mortar(cap_strength=F_M, cap_fracture_energy=G_C), -1e-3, depth_steps)
 
 
 @pytest.mark.parametrize("per_edge", [5, 15])
