@@ -63,6 +63,10 @@ fn static_summary(r: &StaticResult, convergence: Option<&Convergence>) -> Value 
         "rate_m_per_s": c.rate,
         "mode": if c.mode == DisplacementMode::Large { "large" } else { "small" },
         "width_m": c.width,
+        "plate": match c.plate_support {
+            statics::PlateSupport::Rolling => "rolling",
+            statics::PlateSupport::Held => "held",
+        },
         "peak_load_kn": r.peak_load / 1e3,
         "peak_load_kn_per_m": r.peak_load / 1e3 / c.width,
         "raw_peak_load_kn": r.raw_peak_load / 1e3,
@@ -105,11 +109,13 @@ fn static_summary(r: &StaticResult, convergence: Option<&Convergence>) -> Value 
 /// or half the peak). ``ks`` None scales with ``kn`` as the command line does; ``rate`` (m/s)
 /// loads at that speed as the paper's rate study instead of the servo; ``convergence_check``
 /// also runs the refined case (half the increment and threshold), in parallel, and fills
-/// ``rate_convergence``.
+/// ``rate_convergence``. ``plate`` is ``"rolling"`` (only its vertical velocity prescribed, the
+/// adopted baseline) or ``"held"`` (its whole velocity prescribed: straight down without
+/// turning, as the paper's "fix velocity").
 #[pyfunction]
 #[pyo3(signature = (*, friction_deg=30.5, kn=4e9, ks=None, width=0.15, mode="large", per_edge=15,
     servo_increment=2e-5, servo_ratio=1e-3, rate=None, max_displacement=0.012, stop_fraction=0.5,
-    local_damping=0.8, convergence_check=false, label=None))]
+    local_damping=0.8, convergence_check=false, label=None, plate="rolling"))]
 #[allow(clippy::too_many_arguments)]
 pub fn arch_static<'py>(
     py: Python<'py>,
@@ -127,8 +133,14 @@ pub fn arch_static<'py>(
     local_damping: f64,
     convergence_check: bool,
     label: Option<String>,
+    plate: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let per_edge = crate::convert::whole(per_edge, "per_edge", u64::from(u16::MAX))? as u16;
+    let plate_support = match plate.to_ascii_lowercase().as_str() {
+        "rolling" => statics::PlateSupport::Rolling,
+        "held" => statics::PlateSupport::Held,
+        other => return Err(bad(format!("plate {other:?}: expected \"rolling\" or \"held\""))),
+    };
     let base = StaticCase::baseline();
     let mut case = match rate {
         Some(r) => {
@@ -166,6 +178,7 @@ pub fn arch_static<'py>(
     case.max_displacement = voussoir::error::positive("max_displacement", max_displacement).py()?;
     case.stop_fraction = stop_fraction;
     case.local_damping = local_damping;
+    case.plate_support = plate_support;
     if let Some(l) = label {
         case.label = l;
     }

@@ -535,6 +535,7 @@ def arch_static(
     local_damping: float = 0.8,
     convergence_check: bool = False,
     label: Optional[str] = None,
+    plate: Literal["rolling", "held"] = "rolling",
 ) -> Dict[str, Any]: ...
 def arch_impact(
     setup: str = "M60H20",

@@ -27,7 +27,7 @@ use voussoir::contact::DisplacementMode;
 use super::args::Interval;
 use super::{BoxError, Outputs, Run};
 use crate::plot::{Curve, LinePlot, Reference};
-use crate::scenarios::arch_static::{run, run_converged, ServoLoading, StaticCase, StaticResult};
+use crate::scenarios::arch_static::{run, run_converged, PlateSupport, ServoLoading, StaticCase, StaticResult};
 use voussoir::loading::Convergence;
 
 /// Peak load of the test (kN).
@@ -82,6 +82,19 @@ pub struct StaticOptions {
     /// Skip the refined runs of the convergence check (about halves the run time)
     #[arg(long)]
     pub no_convergence_check: bool,
+    /// How the loading plate is held: rolling (only its vertical velocity prescribed; the
+    /// adopted baseline) or held (its whole velocity prescribed, the paper's "fix velocity")
+    #[arg(long, value_enum, default_value = "rolling")]
+    pub plate: PlateArg,
+}
+
+/// `--plate`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PlateArg {
+    /// Only the vertical velocity prescribed: free to slide and turn.
+    Rolling,
+    /// The whole velocity prescribed: straight down, without turning.
+    Held,
 }
 
 /// Range of `--friction` (°).
@@ -144,6 +157,10 @@ fn cases(o: &StaticOptions) -> Result<Vec<StaticCase>, BoxError> {
     )?;
     let base = StaticCase {
         servo: Some(servo),
+        plate_support: match o.plate {
+            PlateArg::Rolling => PlateSupport::Rolling,
+            PlateArg::Held => PlateSupport::Held,
+        },
         ..StaticCase::baseline()
     };
     Ok(paper_cases(o, base))
@@ -205,6 +222,8 @@ struct CaseSummary {
     rate_m_per_s: f64,
     mode: &'static str,
     width_m: f64,
+    /// How the plate is held: "rolling" or "held" (`--plate`).
+    plate: &'static str,
     peak_load_kn: f64,
     peak_load_kn_per_m: f64,
     raw_peak_load_kn: f64,
@@ -283,6 +302,10 @@ fn summarise(r: &StaticResult, convergence: Option<&Convergence>) -> CaseSummary
             "small"
         },
         width_m: c.width,
+        plate: match c.plate_support {
+            PlateSupport::Rolling => "rolling",
+            PlateSupport::Held => "held",
+        },
         peak_load_kn: r.peak_load / 1e3,
         peak_load_kn_per_m: r.peak_load / 1e3 / c.width,
         raw_peak_load_kn: r.raw_peak_load / 1e3,

@@ -87,6 +87,24 @@ pub struct StaticCase {
     /// study.
     #[serde(default = "default_safety")]
     pub time_step_safety: Real,
+    /// How the loading plate is held ([`PlateSupport::Rolling`], the adopted baseline, by
+    /// default).
+    #[serde(default)]
+    pub plate_support: PlateSupport,
+}
+
+/// How the loading plate is held while it is driven down.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum PlateSupport {
+    /// Only its vertical velocity is prescribed: it slides horizontally and turns in the plane
+    /// of the arch freely, so the load it transmits is vertical (the test's roller and bearing;
+    /// the adopted baseline).
+    #[default]
+    Rolling,
+    /// Its whole velocity is prescribed, as the paper's "fix velocity to the block" does in
+    /// 3DEC: it moves straight down without turning, and holds voussoir 5 horizontally through
+    /// the friction of their joint.
+    Held,
 }
 
 fn default_safety() -> Real {
@@ -136,6 +154,7 @@ impl StaticCase {
             smoothing_window: 0.0,
             servo: Some(ServoLoading::DEFAULT),
             time_step_safety: 0.9,
+            plate_support: PlateSupport::Rolling,
         }
     }
 
@@ -346,7 +365,7 @@ pub fn build(case: &StaticCase) -> Result<StaticModel> {
         local
             .transformed(pose)
             .with_material(super::STEEL)
-            .with_fixity(plate_fixity(0.0)),
+            .with_fixity(plate_fixity(case.plate_support, 0.0)),
     )?;
     let joints = arch.joint_refs();
     Ok(StaticModel {
@@ -358,12 +377,18 @@ pub fn build(case: &StaticCase) -> Result<StaticModel> {
     })
 }
 
-/// Only the vertical velocity of the plate is prescribed; it may slide horizontally and turn in
-/// the plane of the arch; out-of-plane motions are fixed.
-fn plate_fixity(vy: Real) -> Fixity {
-    Fixity {
-        translation: [Dof::Free, Dof::Velocity(vy), Dof::Fixed],
-        rotation: [Dof::Fixed, Dof::Fixed, Dof::Free],
+/// The plate's vertical velocity `vy` prescribed; rolling, it may slide horizontally and turn in
+/// the plane of the arch; held, neither. Out-of-plane motions are fixed.
+fn plate_fixity(support: PlateSupport, vy: Real) -> Fixity {
+    match support {
+        PlateSupport::Rolling => Fixity {
+            translation: [Dof::Free, Dof::Velocity(vy), Dof::Fixed],
+            rotation: [Dof::Fixed, Dof::Fixed, Dof::Free],
+        },
+        PlateSupport::Held => Fixity {
+            translation: [Dof::Velocity(0.0), Dof::Velocity(vy), Dof::Fixed],
+            rotation: [Dof::Fixed; 3],
+        },
     }
 }
 
@@ -494,7 +519,7 @@ pub fn run(
     // The limit analysis of the settled arch, once, before loading.
     let (limit, _) = limit_analysis(&model, plate, &joints)?;
     if case.servo.is_none() {
-        model.set_fixity(plate, plate_fixity(-case.rate))?;
+        model.set_fixity(plate, plate_fixity(case.plate_support, -case.rate))?;
     }
     let criteria = MechanismCriteria::default();
     let left = arch.extrados_midpoint(1);
