@@ -222,6 +222,8 @@ impl ConstitutiveLaw for CoulombSlip {
             cohesion: self.cohesion,
             tan_friction: self.tan_friction,
             slides: self.cohesion == 0.0 && self.tensile_strength == 0.0 && self.tan_residual == self.tan_friction,
+            // Compression only: a bonded joint in tension goes through `update`.
+            tensile_strength: 0.0,
         })
     }
 

@@ -44,6 +44,7 @@ impl ConstitutiveLaw for LinearElastic {
             cohesion: 0.0,
             tan_friction: f64::INFINITY,
             slides: false,
+            tensile_strength: 0.0,
         })
     }
 

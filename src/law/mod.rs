@@ -126,8 +126,10 @@ pub struct JointForce {
 /// [`ConstitutiveLaw::elastic_regime`].
 ///
 /// The trial forces are `F_n = −k_n·u_n·A` and `F_s = F_s⁻ − Δu_s·(k_s·A)`; they stand when the
-/// joint is in compression (`F_n > 0`) and within its strength, `|F_s|² ≤ L²` with
-/// `L = c·A + F_n·tan φ ≥ 0`, computed in exactly this order ([`ElasticRegime::trial`]).
+/// joint is in compression (`F_n > 0`), or in tension below the regime's tensile strength
+/// (`F_n > −f_t·A`), and within its strength, `|F_s| ≤ max(L, 0)` with `L = c·A + F_n·tan φ`
+/// (tested as `|F_s|² ≤ L²` for `L ≥ 0`; a trial of no shear stands at `L < 0`), computed in
+/// exactly this order ([`ElasticRegime::trial`]).
 ///
 /// ```
 /// use voussoir::law::{ConstitutiveLaw, CoulombSlip, ElasticRegime};
@@ -156,13 +158,17 @@ pub struct ElasticRegime {
     /// as it is (no cohesion, tensile strength or peak friction to lose), returning
     /// [`JointStatus::Sliding`] ([`ElasticRegime::step`]). `false` promises nothing.
     pub slides: bool,
+    /// Tensile strength `f_t` (Pa) down to which the regime covers tension: the trial stands
+    /// for `F_n > −f_t·A` (a bonded joint below its strength). 0: compression only (`F_n > 0`).
+    pub tensile_strength: Real,
 }
 
 impl ElasticRegime {
     /// The forces after a step with total normal displacement `normal_displacement` (m) and
     /// shear increment `shear_increment` (tangent components, m) on area `area` (m²) from the
     /// shear force `shear` (tangent components, N), if they stay in the regime: in compression
-    /// and within the strength. `None` otherwise (then the law's own update decides).
+    /// (or tension below the regime's tensile strength) and within the strength. `None`
+    /// otherwise (then the law's own update decides).
     #[inline(always)]
     pub fn trial(
         &self,
@@ -174,7 +180,8 @@ impl ElasticRegime {
         let normal = -self.normal_stiffness * normal_displacement * area;
         let shear = shear - shear_increment * (self.shear_stiffness * area);
         let limit = self.cohesion * area + normal * self.tan_friction;
-        let stands = normal > 0.0 && !(limit < 0.0 || shear.length_squared() > limit * limit);
+        let trial_squared = shear.length_squared();
+        let stands = normal > -self.tensile_strength * area && !beyond_limit(limit, trial_squared);
         stands.then_some(JointForce { normal, shear })
     }
 
@@ -204,11 +211,12 @@ impl ElasticRegime {
         let normal = -self.normal_stiffness * normal_displacement * area;
         let shear = shear - shear_increment * (self.shear_stiffness * area);
         let limit = self.cohesion * area + normal * self.tan_friction;
-        if normal <= 0.0 || normal.is_nan() {
+        // Beyond the tensile strength (no tension at all without one), or NaN: the law decides.
+        if !(normal > -self.tensile_strength * area) {
             return None;
         }
         let trial_squared = shear.length_squared();
-        if !(limit < 0.0 || trial_squared > limit * limit) {
+        if !beyond_limit(limit, trial_squared) {
             return Some((JointForce { normal, shear }, JointStatus::Elastic));
         }
         if !self.slides {
@@ -218,6 +226,14 @@ impl ElasticRegime {
         let shear = shear * if trial > 0.0 { limit.max(0.0) / trial } else { 0.0 };
         Some((JointForce { normal, shear }, JointStatus::Sliding))
     }
+}
+
+/// Whether a trial shear of squared length `trial_squared` passes the limit `limit`:
+/// `|F_s| > max(L, 0)`, so that a trial of no shear stands at a negative limit (in tension
+/// beyond the apex of the Coulomb line) and slides nowhere.
+#[inline(always)]
+fn beyond_limit(limit: Real, trial_squared: Real) -> bool {
+    (limit < 0.0 && trial_squared > 0.0) || trial_squared > limit * limit
 }
 
 /// State of a sub-contact after an update, for monitors and output.

@@ -605,8 +605,9 @@ impl ConstitutiveLaw for MortarJoint {
         self.tensile_strength * r == 0.0 && normal <= 0.0
     }
 
-    /// The intact joint in compression below its strength: `c₀` and `tan φ₀`; sliding too when
-    /// nothing softens as it slides (no cohesion, no dilatancy). None with a cap.
+    /// The intact joint in compression, or in tension below `f_t0`, within its strength: `c₀` and
+    /// `tan φ₀`; sliding too when nothing softens as it slides (no cohesion, no dilatancy). None
+    /// with a cap.
     #[inline]
     fn elastic_regime(&self) -> Option<ElasticRegime> {
         if self.cap.is_some() {
@@ -618,6 +619,7 @@ impl ConstitutiveLaw for MortarJoint {
             cohesion: self.cohesion,
             tan_friction: self.tan_friction,
             slides: self.cohesion == 0.0 && self.tan_dilatancy == 0.0,
+            tensile_strength: self.tensile_strength,
         })
     }
 
