@@ -212,7 +212,8 @@ impl ElasticRegime {
         let shear = shear - shear_increment * (self.shear_stiffness * area);
         let limit = self.cohesion * area + normal * self.tan_friction;
         // Beyond the tensile strength (no tension at all without one), or NaN: the law decides.
-        if !(normal > -self.tensile_strength * area) {
+        let within = normal > -self.tensile_strength * area;
+        if !within {
             return None;
         }
         let trial_squared = shear.length_squared();
