@@ -232,8 +232,9 @@ impl ElasticRegime {
 /// Whether a trial shear of squared length `trial_squared` passes the limit `limit`:
 /// `|F_s| > max(L, 0)`, so that a trial of no shear stands at a negative limit (in tension
 /// beyond the apex of the Coulomb line) and slides nowhere.
+/// [`MortarJoint`]'s update uses the same test, so that its regime and its update agree.
 #[inline(always)]
-fn beyond_limit(limit: Real, trial_squared: Real) -> bool {
+pub(crate) fn beyond_limit(limit: Real, trial_squared: Real) -> bool {
     (limit < 0.0 && trial_squared > 0.0) || trial_squared > limit * limit
 }
 

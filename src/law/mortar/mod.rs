@@ -565,7 +565,7 @@ impl ConstitutiveLaw for MortarJoint {
         let trial_squared = f.shear.length_squared();
         // `|F_s| > max(limit, 0)`, without a square root while the joint holds. A trial of no
         // shear beyond the apex of the Coulomb line (`limit < 0`) has nothing to slip.
-        let shear_beyond = (limit < 0.0 && trial_squared > 0.0) || trial_squared > limit * limit;
+        let shear_beyond = super::beyond_limit(limit, trial_squared);
         let cap_beyond = match &self.cap {
             Some(cap) => cap.exceeded(f.normal / a, trial_squared.sqrt() / a, state.crushing),
             None => false,
