@@ -43,6 +43,7 @@ use std::time::Instant;
 
 use clap::{Parser, ValueEnum};
 use serde_json::json;
+use voussoir::geometry::ContactKind;
 use voussoir::io::viewer::Viewer;
 use voussoir::law::{CompressionCap, MortarJoint};
 use voussoir::loading::{PushOver, PushOverResult, Servo};
@@ -474,6 +475,10 @@ fn joint_damage(wall: &Wall) -> Result<Vec<JointDamage>> {
     };
     let mut out = Vec::new();
     for contact in wall.model.contacts() {
+        // Node contacts (where blocks meet at an edge) are no joints, and start unbonded.
+        if matches!(contact.kind(), ContactKind::Nodes) {
+            continue;
+        }
         let (a, b) = contact.blocks();
         let n = contact.normal();
         let law = law_of(a, b)?;

@@ -37,5 +37,6 @@ mod scene;
 mod sharp_contacts;
 mod shear_wall;
 mod statics;
+mod unbonded_nodes;
 mod viewer;
 mod vtk_output;

@@ -238,6 +238,9 @@ pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> R
     let (mut state, mut contact) = (Vec::with_capacity(n), Vec::with_capacity(n));
     for (ci, c) in model.contacts().enumerate() {
         let l = &law[c.law_index()];
+        // A node contact starts unbonded (`ConstitutiveLaw::unbonded_state`): failed only
+        // when it has lost more.
+        let unbonded = matches!(c.kind(), crate::geometry::ContactKind::Nodes).then(|| l.unbonded_state());
         for s in c.subcontacts() {
             points.extend(s.point().to_array());
             shear.extend(s.shear_force().to_array());
@@ -246,7 +249,8 @@ pub fn write_subcontacts<L: ConstitutiveLaw>(path: &Path, model: &Model<L>) -> R
             area.push(s.area());
             gap.push(s.normal_displacement());
             slip.push(s.slip());
-            state.push(if l.is_failed(s.law_state()) && s.status() != JointStatus::Sliding {
+            let failed = l.is_failed(s.law_state()) && unbonded.as_ref() != Some(s.law_state());
+            state.push(if failed && s.status() != JointStatus::Sliding {
                 3u8
             } else {
                 match s.status() {

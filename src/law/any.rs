@@ -177,6 +177,20 @@ impl ConstitutiveLaw for AnyLaw {
         }
     }
 
+    fn unbonded_state(&self) -> AnyState {
+        match self {
+            AnyLaw::Coulomb(law) => AnyState {
+                coulomb: law.unbonded_state(),
+                ..AnyState::default()
+            },
+            AnyLaw::Mortar(law) => AnyState {
+                mortar: law.unbonded_state(),
+                ..AnyState::default()
+            },
+            AnyLaw::Elastic(_) => AnyState::default(),
+        }
+    }
+
     fn is_failed(&self, state: &AnyState) -> bool {
         match self {
             AnyLaw::Coulomb(law) => law.is_failed(&state.coulomb),
@@ -217,7 +231,7 @@ mod tests {
 
     /// Every method gives what the inner law gives, bit for bit, over a grid of steps and
     /// states: the shortcuts (`elastic_regime`, `stays_open`), the update (forces, state,
-    /// status), the energy, `is_failed`, `stiffness` and `validate`.
+    /// status), the energy, `is_failed`, `unbonded_state`, `stiffness` and `validate`.
     #[test]
     fn every_method_is_forwarded() {
         let gaps = [-1e-3, -2.5e-5, -1e-9, -0.0, 0.0, 1e-12, 4e-5, 6e-5, 1.0];
@@ -229,6 +243,7 @@ mod tests {
             assert_eq!(any.stiffness(), inner.stiffness());
             assert_eq!(any.elastic_regime(), inner.elastic_regime());
             assert!(any.elastic_regime().is_some());
+            assert_eq!(any.unbonded_state().coulomb, inner.unbonded_state());
             assert!(any.validate().is_ok());
             for failed in [false, true] {
                 let state = CoulombState { failed };
@@ -395,6 +410,7 @@ mod tests {
         for inner in mortar_laws() {
             let any = AnyLaw::from(inner);
             assert_eq!(any.stiffness(), inner.stiffness());
+            assert_eq!(any.unbonded_state().mortar, inner.unbonded_state());
             assert_eq!(any.elastic_regime(), inner.elastic_regime());
             assert!(any.validate().is_ok());
             let (mut f, mut s) = (JointForce::default(), MortarState::default());

@@ -227,6 +227,14 @@ impl ConstitutiveLaw for CoulombSlip {
         })
     }
 
+    /// Failed, for a bonded joint (with cohesion or tensile strength): residual friction, no
+    /// tension, no cohesion. A dry joint's virgin state.
+    fn unbonded_state(&self) -> CoulombState {
+        CoulombState {
+            failed: self.cohesion > 0.0 || self.tensile_strength > 0.0,
+        }
+    }
+
     fn is_failed(&self, state: &CoulombState) -> bool {
         state.failed
     }

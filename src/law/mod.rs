@@ -366,6 +366,22 @@ pub trait ConstitutiveLaw: Clone + Send + Sync + std::fmt::Debug {
         0.0
     }
 
+    /// The state a node of a node contact (vertex–face, edge–edge, edge–face, tilted faces)
+    /// starts from. The bond of a mortared or cemented joint (tensile strength, cohesion) acts
+    /// across the faces of a joint; a node contact is a touch at a vertex or an edge, whose
+    /// nodes stand for a share of the faces only to make a penalty, so it starts unbonded:
+    /// compression and the residual friction, no tension, no cohesion (`docs/theory.md` §2.2,
+    /// "Node contacts"). A bond across the common edge of two blocks that meet only there (the
+    /// diagonal neighbours where four blocks of a stack-bonded wall meet) would hold them
+    /// together by a force whose direction flips between the other block's two faces at that
+    /// edge.
+    ///
+    /// The default, `State::default()`, is right for laws without a bond; a law with one
+    /// returns its fully debonded state.
+    fn unbonded_state(&self) -> Self::State {
+        Self::State::default()
+    }
+
     /// Whether the sub-contact has failed (lost cohesion or tensile strength), for output.
     fn is_failed(&self, _state: &Self::State) -> bool {
         false

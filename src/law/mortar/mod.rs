@@ -7,67 +7,17 @@
 use serde::{Deserialize, Serialize};
 
 mod cap;
+mod softening;
 mod spec;
 
 pub use cap::{CompressionCap, LOURENCO_SHEAR_FACTOR};
+pub use softening::Softening;
+#[cfg(test)]
+use softening::EXPONENTIAL_END;
 
 use super::{ConstitutiveLaw, ElasticRegime, JointForce, JointStatus, JointStep, JointStiffness};
 use crate::error::{in_range, non_negative, positive, Error, Result};
 use crate::math::{Real, Vector2};
-
-/// How the strengths of a [`MortarJoint`] fall with its softening parameter `D` (see there):
-/// the fraction left, `r(D)`, whose integral over `D ≥ 0` is 1 for both shapes, so that a
-/// crack dissipates its fracture energy whichever is chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
-pub enum Softening {
-    /// `r = e^{−D}` (the default; Lourenço–Rots'), cut to zero where it falls below the
-    /// machine epsilon (`D = 52 ln 2 ≈ 36.04`): the fracture energy left beyond is below
-    /// `2.2e-16` of the whole.
-    #[default]
-    Exponential,
-    /// `r = max(0, 1 − D/2)`: the strengths reach zero at `D = 2`, when the crack has opened
-    /// (or slipped) by `2 G_f / f` (`f` the tensile strength or the cohesion).
-    Linear,
-}
-
-/// Where [`Softening::Exponential`] is cut: `−ln ε`, so that `e^{−D}` below it is at least
-/// the machine epsilon.
-const EXPONENTIAL_END: Real = 52.0 * std::f64::consts::LN_2;
-
-impl Softening {
-    /// The fraction of the strengths left, `r(D)`, for `D ≥ 0`; exactly 1 at `D = 0` and
-    /// exactly 0 from the end of the curve on (`52 ln 2`, or 2).
-    #[inline]
-    fn remaining(self, d: Real) -> Real {
-        // The intact joint (most sub-contacts) without the exponential: `e^{−0} = 1` exactly.
-        if d == 0.0 {
-            return 1.0;
-        }
-        match self {
-            Softening::Exponential if d < EXPONENTIAL_END => (-d).exp(),
-            Softening::Linear if d < 2.0 => 1.0 - 0.5 * d,
-            _ => 0.0,
-        }
-    }
-
-    /// `∫ r(D) dD` from `d0` to `d0 + dd` (`d0 ≥ 0`, `dd ≥ 0`), without cancellation for a
-    /// small `dd`.
-    #[inline]
-    fn integral(self, d0: Real, dd: Real) -> Real {
-        match self {
-            Softening::Exponential => {
-                let (a, b) = (d0.min(EXPONENTIAL_END), (d0 + dd).min(EXPONENTIAL_END));
-                // e^{−a} − e^{−b} = e^{−a} (1 − e^{−(b − a)}).
-                -(-a).exp() * (a - b).exp_m1()
-            }
-            Softening::Linear => {
-                let (a, b) = (d0.min(2.0), (d0 + dd).min(2.0));
-                (b - a) * (1.0 - 0.25 * (a + b))
-            }
-        }
-    }
-}
 
 /// A mortared masonry joint that cracks and softens by its fracture energies: tension cut-off,
 /// Coulomb friction with cohesion, both softening with the crack's opening and slip so that a
@@ -654,6 +604,41 @@ impl ConstitutiveLaw for MortarJoint {
         }
         let work = self.tensile_strength * dt + self.cohesion * ds;
         area * work * (self.softening.integral(d0, dd) / dd) + crushing
+    }
+
+    /// Cracked through: the crack opened to the end of the softening curve, so that the
+    /// tensile strength and the cohesion are exactly zero and the friction is the residual one
+    /// (by slip instead for a joint with cohesion and no tensile strength; such a joint with
+    /// dilatancy keeps the virgin state, whose fully slipped state would push its nodes out by
+    /// the whole dilatant opening). A joint without a bond: the virgin state.
+    fn unbonded_state(&self) -> MortarState {
+        // The smallest κ at which `damage(κ)` reaches the curve's end (no rounding short).
+        let through = |strength: Real, energy: Real, damage: &dyn Fn(Real) -> Real| {
+            let mut k = if energy == 0.0 {
+                Real::MIN_POSITIVE
+            } else {
+                self.softening.end() * energy / strength
+            };
+            while damage(k) < self.softening.end() {
+                k *= 1.0 + Real::EPSILON;
+            }
+            k
+        };
+        if self.tensile_strength > 0.0 {
+            MortarState {
+                crack_opening: through(self.tensile_strength, self.mode_i_fracture_energy, &|k| {
+                    self.tension_damage(k)
+                }),
+                ..MortarState::default()
+            }
+        } else if self.cohesion > 0.0 && self.tan_dilatancy == 0.0 {
+            MortarState {
+                plastic_slip: through(self.cohesion, self.mode_ii_fracture_energy, &|k| self.shear_damage(k)),
+                ..MortarState::default()
+            }
+        } else {
+            MortarState::default()
+        }
     }
 
     /// Cracked, softened or crushed at all.

@@ -691,3 +691,82 @@ fn conforms_to_the_law_contract() {
         assert_eq!(conformance::check(&crate::law::AnyLaw::from(law)), Ok(report));
     }
 }
+
+/// A node contact starts unbonded (`ConstitutiveLaw::unbonded_state`): no tensile strength, no
+/// cohesion, the residual friction, exactly, for every shape and a brittle joint; by slip for a
+/// joint with cohesion alone; the virgin state for a dry joint and for cohesion with dilatancy
+/// (whose slipped state would carry the dilatant opening).
+#[test]
+fn the_unbonded_state_has_no_bond_left() {
+    let brittle = MortarJoint::builder(1e11, 4e10, 35.0)
+        .residual_friction(30.0)
+        .tension(2e5, 0.0)
+        .cohesion(3e5, 0.0)
+        .build()
+        .unwrap();
+    let cohesive = MortarJoint::builder(1e11, 4e10, 35.0)
+        .residual_friction(30.0)
+        .cohesion(3e5, 50.0)
+        .build()
+        .unwrap();
+    for law in [
+        mortar(Softening::Exponential),
+        mortar(Softening::Linear),
+        brittle,
+        cohesive,
+    ] {
+        let state = law.unbonded_state();
+        let s = law.strengths(&state);
+        assert_eq!((s.remaining, s.tensile, s.cohesion), (0.0, 0.0, 0.0), "{law:?}");
+        assert_eq!(s.tan_friction, 30f64.to_radians().tan(), "{law:?}");
+        assert_eq!(law.dilatant_opening(&state), 0.0);
+        assert_eq!(state.crushing, 0.0);
+        // The crack is opened just to the end of the curve, no further.
+        let d = law.softening_parameter(&state);
+        assert!(
+            d.is_infinite() || d <= law.softening().end() * (1.0 + 4.0 * Real::EPSILON),
+            "{d}"
+        );
+        // Pressed, it carries compression and friction; pulled, nothing.
+        let step = |u: Real, du: Vector2| JointStep {
+            normal_displacement: u,
+            normal_increment: 0.0,
+            shear_increment: du,
+            area: 1e-2,
+            axes: JointAxes::from_normal(Vector::Z),
+            dt: 1e-5,
+        };
+        let (mut f, mut st) = (JointForce::default(), state);
+        assert_eq!(
+            law.update(&step(-1e-6, Vector2::ZERO), &mut f, &mut st),
+            JointStatus::Elastic
+        );
+        assert_eq!(f.normal, 1e11 * 1e-6 * 1e-2);
+        assert_eq!(
+            law.update(&step(-1e-6, Vector2::new(1e-4, 0.0)), &mut f, &mut st),
+            JointStatus::Sliding
+        );
+        assert!((f.shear.length() - 30f64.to_radians().tan() * f.normal).abs() < 1e-12 * f.normal);
+        let mut f = JointForce::default();
+        assert_eq!(
+            law.update(&step(1e-9, Vector2::ZERO), &mut f, &mut st),
+            JointStatus::Open
+        );
+        assert_eq!(f, JointForce::default());
+    }
+    let dry = MortarJoint::builder(1e11, 4e10, 35.0).build().unwrap();
+    assert_eq!(dry.unbonded_state(), MortarState::default());
+    let dilatant = MortarJoint::builder(1e11, 4e10, 35.0)
+        .cohesion(3e5, 50.0)
+        .dilatancy(10.0)
+        .build()
+        .unwrap();
+    assert_eq!(dilatant.unbonded_state(), MortarState::default());
+    // CoulombSlip: failed when bonded, virgin when dry.
+    let bonded = CoulombSlip::new(1e11, 4e10, 35.0, 30.0, 3e5, 2e5).unwrap();
+    assert_eq!(bonded.unbonded_state(), CoulombState { failed: true });
+    assert_eq!(
+        CoulombSlip::dry(1e11, 4e10, 35.0).unwrap().unbonded_state(),
+        CoulombState::default()
+    );
+}

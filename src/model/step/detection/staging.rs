@@ -258,7 +258,12 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 slip: 0.0,
                 half: [seed.half.x as f32, seed.half.y as f32],
                 status: JointStatus::Open,
-                state: S::default(),
+                // A node contact is unbonded (`ConstitutiveLaw::unbonded_state`).
+                state: if nodes {
+                    joint_law.unbonded_state()
+                } else {
+                    S::default()
+                },
             };
             let mut record = SubContactRecord::new(seed.key);
             if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
