@@ -88,6 +88,19 @@ fn duplicated_setups_and_offsets_are_refused() {
 }
 
 #[test]
+fn settled_states_are_one_to_sixteen() {
+    assert_eq!(impact(&[]).expect("parses").1.settled_states, 1);
+    assert_eq!(
+        impact(&["--settled-states", "16"]).expect("parses").1.settled_states,
+        16
+    );
+    for bad in ["0", "17", "two"] {
+        let message = refused(impact(&["--settled-states", bad]));
+        assert!(message.contains("--settled-states"), "{bad}: {message}");
+    }
+}
+
+#[test]
 fn the_setup_names_are_the_scenarios() {
     let mut names: Vec<String> = voussoir_arch::scenarios::arch_impact::setups()
         .into_iter()

@@ -241,12 +241,16 @@ fn impact_summary(label: &str, kind: &str, runs: &[ImpactResult]) -> PyResult<Va
 /// ``setup``: one of M80H45, M75H45, M75H20, M60H20, M60H25, M60H30 (``impact_setups()``).
 /// Every drop-height offset in ``offsets_mm`` is run (in parallel), the smallest in magnitude
 /// being the central run; the default runs the central one only (the command line's default is
-/// ``(-0.5, -0.25, 0, 0.25, 0.5)``). ``ks`` scales with ``kn``; ``damping`` is the
+/// ``(-0.5, -0.25, 0, 0.25, 0.5)``). ``settled_states`` (1 to 16) runs each drop height from
+/// that many settled states, the k-th settled under gravity changed by ``k·1e-12`` of itself
+/// (a state that differs from the test's at round-off level); ``median_max_disp_m`` is the
+/// median of the largest displacement over all the runs, the result to compare where the
+/// central run's moves with round-off. ``ks`` scales with ``kn``; ``damping`` is the
 /// stiffness-proportional Rayleigh ratio at 25 Hz; ``guide`` ``"frame"`` or ``"seat"``,
 /// ``base`` ``"sloped"`` or ``"flat"``, ``release`` ``"above"`` or ``"full"``.
 #[pyfunction]
 #[pyo3(signature = (setup="M60H20", *, kn=4e9, damping=0.01, width=0.15, duration=1.0, friction_deg=30.5,
-    per_edge=15, guide="frame", base="sloped", release="above", offsets_mm=vec![0.0]))]
+    per_edge=15, guide="frame", base="sloped", release="above", offsets_mm=vec![0.0], settled_states=1))]
 #[allow(clippy::too_many_arguments)]
 pub fn arch_impact<'py>(
     py: Python<'py>,
@@ -261,6 +265,7 @@ pub fn arch_impact<'py>(
     base: &str,
     release: &str,
     offsets_mm: Vec<f64>,
+    settled_states: i64,
 ) -> PyResult<Bound<'py, PyAny>> {
     let per_edge = crate::convert::whole(per_edge, "per_edge", u64::from(u16::MAX))? as u16;
     let all = impact::setups();
@@ -272,6 +277,11 @@ pub fn arch_impact<'py>(
     })?;
     if offsets_mm.is_empty() {
         return Err(bad("offsets_mm: give at least one drop-height offset"));
+    }
+    if !(1..=16).contains(&settled_states) {
+        return Err(bad(format!(
+            "settled_states {settled_states}: expected 1 to 16 settled states per drop height"
+        )));
     }
     let mut c = ImpactCase::baseline(chosen);
     c.ks = kn * c.ks / c.kn;
@@ -288,8 +298,10 @@ pub fn arch_impact<'py>(
     offsets.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
     let cases: Vec<ImpactCase> = offsets
         .iter()
-        .map(|&dh| ImpactCase {
+        .flat_map(|&dh| (0..settled_states).map(move |state| (dh, state as f64 * 1e-12)))
+        .map(|(dh, perturbation)| ImpactCase {
             height_offset: dh,
+            settle_perturbation: perturbation,
             ..c.clone()
         })
         .collect();

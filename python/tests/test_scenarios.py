@@ -18,7 +18,7 @@ STATIC_KEYS = {
 IMPACT_KEYS = {
     "name", "label", "kind", "guide", "base", "release", "mass_kg", "height_m", "v0_m_per_s",
     "contact_speed_m_per_s", "impact_energy_j", "kn_pa_per_m", "damping_ratio", "width_m",
-    "first_peak_disp_m", "max_disp_m", "spread_max_disp_m", "spread_first_peak_disp_m",
+    "first_peak_disp_m", "max_disp_m", "spread_max_disp_m", "median_max_disp_m", "spread_first_peak_disp_m",
     "max_rise_m", "max_rise_time_s", "max_velocity_m_per_s", "max_accel_m_per_s2",
     "max_impact_force_n", "max_impactor_drift_m", "max_impactor_rotation_rad", "collapsed",
     "collapsed_runs", "runs_count", "collapse_time_s", "energy", "steps", "dt_s", "wall_s",
@@ -84,3 +84,20 @@ def test_arch_impact_cheap():
         "M80H45", "M75H45", "M75H20", "M60H20", "M60H25", "M60H30"]
     with pytest.raises(vs.VoussoirError, match="setup \"M1\""):
         vs.scenarios.arch_impact("M1")
+
+
+def test_arch_impact_settled_states_perturb_at_round_off():
+    # Two settled states at the test's drop height: the second settled under gravity changed by
+    # 1e-12 of itself; the median of two is their mean.
+    r = vs.scenarios.arch_impact("M60H20", duration=0.02, per_edge=5, settled_states=2)
+    assert r["runs_count"] == 2
+    assert [x["settle_perturbation"] for x in r["runs"]] == [0.0, 1e-12]
+    assert [x["height_offset_m"] for x in r["runs"]] == [0.0, 0.0]
+    a, b = (x["max_disp_m"] for x in r["runs"])
+    assert r["median_max_disp_m"] == pytest.approx(0.5 * (a + b), rel=1e-12)
+    assert r["max_disp_m"] == a
+    # At round-off level: the first impact agrees to far better than a micrometre.
+    assert abs(a - b) < 1e-6
+    for bad in (0, 17):
+        with pytest.raises(vs.VoussoirError, match="settled_states"):
+            vs.scenarios.arch_impact("M60H20", duration=0.02, settled_states=bad)

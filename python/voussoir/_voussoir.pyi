@@ -550,6 +550,7 @@ def arch_impact(
     base: Literal["sloped", "flat"] = "sloped",
     release: Literal["above", "full"] = "above",
     offsets_mm: Sequence[float] = (0.0,),
+    settled_states: int = 1,
 ) -> Dict[str, Any]: ...
 def impact_setups() -> List[Dict[str, Any]]: ...
 

@@ -39,6 +39,7 @@ use voussoir::integrate::Damping;
 use voussoir::law::CoulombSlip;
 use voussoir::math::{Real, Vector};
 use voussoir::model::Model;
+use voussoir::model::ModelParameters;
 
 /// Gravitational acceleration of the scenario (m/s², along −y).
 pub const GRAVITY: Real = 9.81;
@@ -517,7 +518,18 @@ pub fn run(
 ) -> Result<ImpactResult> {
     let started = Instant::now();
     let mut im = build(case)?;
-    im.model.run_to_equilibrium(1e-5, 200_000)?;
+    if case.settle_perturbation == 0.0 {
+        im.model.run_to_equilibrium(1e-5, 200_000)?;
+    } else {
+        // Settled under gravity changed at round-off level, then released under the test's.
+        let params = *im.model.parameters();
+        im.model.set_parameters(ModelParameters {
+            gravity: params.gravity * (1.0 + case.settle_perturbation),
+            ..params
+        })?;
+        im.model.run_to_equilibrium(1e-5, 200_000)?;
+        im.model.set_parameters(params)?;
+    }
     let arch = im.arch.clone();
     let impactor = im.impactor;
     let settled: Vec<Vector> = (1..=arch.spec.voussoirs)

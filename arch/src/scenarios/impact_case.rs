@@ -164,6 +164,10 @@ pub struct ImpactCase {
     pub release: Release,
     /// Change of the drop height from the test's (m): the perturbation of the robustness runs.
     pub height_offset: Real,
+    /// Relative change of gravity while the arch settles, restored before the release (0 for
+    /// the test): a settled state that differs from the test's at round-off level, for the
+    /// ensembles that say how far a result moves with round-off (`k·1e-12`, issue 43, item 5).
+    pub settle_perturbation: Real,
     /// Impactor footprint along the span (m).
     pub impactor_length: Real,
     /// Impactor height (m, at mid-footprint); its density is set to give the test's mass.
@@ -206,6 +210,7 @@ impl ImpactCase {
             base: ImpactorBase::Sloped,
             release: Release::JustAbove,
             height_offset: 0.0,
+            settle_perturbation: 0.0,
             impactor_length: 0.10,
             impactor_height: 0.20,
             guide_clearance: 5e-4,
@@ -262,6 +267,13 @@ impl ImpactCase {
             "must lie in [0°, 90°)",
         )?;
         non_negative("impact.release_gap", self.release_gap)?;
+        in_range(
+            "impact.settle_perturbation",
+            self.settle_perturbation,
+            -1e-6,
+            1e-6,
+            "a round-off perturbation, within ±1e-6",
+        )?;
         if self.release == Release::JustAbove && self.release_gap >= self.drop_height() {
             return Err(Error::InvalidParameter {
                 name: "impact.release_gap".into(),

@@ -23,6 +23,8 @@ pub struct Experiment {
 pub struct RunSummary {
     /// The drop height's offset from the test's (m).
     pub height_offset_m: f64,
+    /// The relative change of gravity its arch settled under (0: the test's settled state).
+    pub settle_perturbation: f64,
     /// The quarter-span displacement at its first peak (m).
     pub first_peak_disp_m: f64,
     /// The largest quarter-span displacement (m).
@@ -101,6 +103,9 @@ pub struct ImpactSummary {
     pub max_disp_m: f64,
     /// The least and largest maximum displacement over the group (m).
     pub spread_max_disp_m: [f64; 2],
+    /// The median of the runs' largest quarter-span displacements (m): the group's result, where
+    /// the central run's moves with round-off (issue 43, item 5).
+    pub median_max_disp_m: f64,
     /// The least and largest first-peak displacement over the group (m).
     pub spread_first_peak_disp_m: [f64; 2],
     /// The largest upward quarter-span displacement (m).
@@ -174,6 +179,7 @@ impl ImpactSummary {
             first_peak_disp_m: r.first_peak_disp,
             max_disp_m: r.max_disp,
             spread_max_disp_m: spread(&|r| r.max_disp),
+            median_max_disp_m: median(runs.iter().map(|r| r.max_disp).collect()),
             spread_first_peak_disp_m: spread(&|r| r.first_peak_disp),
             max_rise_m: r.max_rise,
             max_rise_time_s: r.max_rise_time,
@@ -204,6 +210,7 @@ impl ImpactSummary {
                 .iter()
                 .map(|x| RunSummary {
                     height_offset_m: x.case.height_offset,
+                    settle_perturbation: x.case.settle_perturbation,
                     first_peak_disp_m: x.first_peak_disp,
                     max_disp_m: x.max_disp,
                     max_velocity_m_per_s: x.max_velocity,
@@ -220,5 +227,15 @@ impl ImpactSummary {
                 max_accel_m_per_s2: s.max_accel,
             },
         }
+    }
+}
+
+/// The median of `v` (the mean of the middle two for an even count; NaN for none).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    match v.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => v[n / 2],
+        n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
     }
 }
