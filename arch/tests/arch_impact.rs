@@ -6,6 +6,14 @@ use voussoir_arch::scenarios::arch_impact::{
     build, run, setups, ImpactCase, ImpactResult, ImpactorGuide, Release, GRAVITY,
 };
 
+/// Two cases run side by side, without frames.
+fn run_both(cases: [ImpactCase; 2]) -> Vec<ImpactResult> {
+    cases
+        .par_iter()
+        .map(|c| run(c, None, |_| Ok(())).expect("run"))
+        .collect()
+}
+
 fn pick(name: &str) -> ImpactCase {
     ImpactCase::baseline(setups().into_iter().find(|s| s.name == name).expect("setup"))
 }
@@ -173,10 +181,7 @@ fn release_just_above_equals_full_drop() {
         duration: above.duration + (2.0 * above.drop_height() / GRAVITY).sqrt(),
         ..above.clone()
     };
-    let r: Vec<ImpactResult> = [above, full]
-        .par_iter()
-        .map(|c| run(c, None, |_| Ok(())).expect("run"))
-        .collect();
+    let r = run_both([above, full]);
     let (a, f) = (&r[0], &r[1]);
     println!(
         "just above: strikes at {:.4} m/s, first peak {:.3} mm, max over 30 ms {:.3} mm; full height: released {:.4} m above, \
@@ -216,10 +221,7 @@ fn a_settled_state_perturbed_at_round_off_gives_the_same_first_impact() {
         settle_perturbation: 1e-12,
         ..base.clone()
     };
-    let r: Vec<ImpactResult> = [base, perturbed]
-        .par_iter()
-        .map(|c| run(c, None, |_| Ok(())).expect("run"))
-        .collect();
+    let r = run_both([base, perturbed]);
     let (a, b) = (&r[0], &r[1]);
     println!(
         "first peak {:.6} / {:.6} mm, impact energy {} / {} J",
