@@ -1,4 +1,4 @@
-//! The shear wall of `examples/shear_wall.rs` (J4D, `docs/benchmarks/shear-wall.md`) before it
+//! The shear wall of `examples/shear_wall/` (J4D, `docs/benchmarks/shear-wall.md`) before it
 //! cracks: its initial horizontal stiffness against the closed form of a stack of rigid courses
 //! on joint springs.
 //!
