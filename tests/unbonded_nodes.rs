@@ -144,10 +144,11 @@ fn settles<L: ConstitutiveLaw>(law: L, unit_law: L, what: &str) {
         (reaction - load).abs() <= 1e-4 * load,
         "{what}: the base carries {reaction} N of {load} N"
     );
-    // What the diagonal nodes press is the overlap of soft joints' corners: small against the
-    // load the panel carries.
+    // What the diagonal nodes press is the overlap of soft joints' corners, which under a
+    // vertical load barely move into each other: 0.04 N (MortarJoint) and 0.08 N (CoulombSlip)
+    // of the 56 kN the panel carries, measured; the faces carry the load.
     assert!(
-        node_force < 1e-2 * load,
+        node_force < 1e-4 * load,
         "{what}: the node contacts carry {node_force} N of {load} N"
     );
 }

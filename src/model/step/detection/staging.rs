@@ -223,6 +223,13 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             &mut self.records[at..at + seeds.len()],
         );
         let nodes = matches!(dc.kind, ContactKind::Nodes);
+        // The state a new sub-contact starts from: a node contact is unbonded
+        // (`ConstitutiveLaw::unbonded_state`), a face joint's cell virgin.
+        let fresh = if nodes {
+            joint_law.unbonded_state()
+        } else {
+            S::default()
+        };
         // Faces tilted beyond `PARALLEL_ANGLE` meet along the edge that digs in, where the
         // loaded cells are and their gaps vary steeply.
         let tilted = match dc.kind {
@@ -258,12 +265,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 slip: 0.0,
                 half: [seed.half.x as f32, seed.half.y as f32],
                 status: JointStatus::Open,
-                // A node contact is unbonded (`ConstitutiveLaw::unbonded_state`).
-                state: if nodes {
-                    joint_law.unbonded_state()
-                } else {
-                    S::default()
-                },
+                state: fresh.clone(),
             };
             let mut record = SubContactRecord::new(seed.key);
             if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
