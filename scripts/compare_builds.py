@@ -23,6 +23,10 @@ What it does:
 Scenes:
 - ``rest``: ``benchmark_wall`` settling with local damping, steps 20-70 timed (as
   ``cargo bench --bench wall -- settle_step``);
+- ``rested``: the same wall once it has come to rest, steps REST_WARMUP to REST_WARMUP + 50
+  (its joints closed and sticking: what joint-level stepping, issue 45, is for);
+- ``tilt``: the same wall under gravity tilted past the joints' friction (0.7 g sideways against
+  tan 30°), its courses sliding: steps 20-70;
 - ``shake``: ``shaking_wall``, undamped, the base shaken at 0.3 g, 3 Hz: steps 20-220;
 - ``shake_fast``: the same at full table speed, steps 700-900 (not at 100k: 700 steps there
   take minutes).
@@ -90,7 +94,15 @@ fn main() {
     let (scene, blocks): (&str, usize) = (&args[1], args[2].parse().unwrap());
     let (warmup, steps): (u64, u64) = (args[3].parse().unwrap(), args[4].parse().unwrap());
     let mut model = match scene {
-        "rest" => WALL(blocks).unwrap(),
+        "rest" | "rested" => WALL(blocks).unwrap(),
+        "tilt" => {
+            // Gravity tilted past the joints' friction (tan 35° > tan 30°): the courses slide.
+            let mut model = WALL(blocks).unwrap();
+            let mut params = *model.parameters();
+            params.gravity.x = 0.7 * 9.81;
+            model.set_parameters(params).unwrap();
+            model
+        }
         _ => SHAKE,
     };
     let t = Instant::now();
@@ -113,9 +125,15 @@ fn main() {
 }
 """
 
+# Warm-up of the `rested` scene: the benchmark wall at 10k and 100k blocks has come to rest by
+# then (its joints stepped as a whole stop changing in number; `docs/performance.md`).
+REST_WARMUP = 400
+
 SCENES = {
     # name: (warm-up steps including the first, timed steps)
     "rest": (20, 50),
+    "rested": (REST_WARMUP, 50),
+    "tilt": (20, 50),
     "shake": (20, 200),
     "shake_fast": (700, 200),
 }

@@ -164,7 +164,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads version 13"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads versions 13 to 14"),
         "{err}"
     );
     // The tested pairs: in order, with finite unit poses and slacks, one for every contact.
@@ -246,7 +246,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 13);
+    assert_eq!(json["version"], 14);
     assert_eq!(json["law_type"], "CoulombSlip");
     assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
@@ -310,6 +310,69 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         keys(&contact["subcontacts"][0]),
         ["area", "dashpot", "force", "gap", "half", "key", "plane", "slip", "state", "status"]
     );
+    // A joint stepped as a whole (a wall at rest) adds its record and its cells' held shear.
+    let mut wall = voussoir::scenes::benchmark_wall(300)?;
+    wall.run_steps(400)?;
+    let json: serde_json::Value = serde_json::from_str(&wall.to_checkpoint_string()?).expect("json");
+    let whole: Vec<&serde_json::Value> = json["contacts"]
+        .as_array()
+        .expect("contacts")
+        .iter()
+        .filter(|c| c.get("joint").is_some())
+        .collect();
+    assert_eq!(whole.len(), wall.whole_joint_count());
+    assert_eq!(keys(&whole[0]["joint"]), ["held_shear", "level"]);
+    assert_eq!(
+        keys(&whole[0]["joint"]["level"]),
+        ["active", "field", "gap", "held", "held_stress", "stiffness"]
+    );
+    Ok(())
+}
+
+/// A joint stepped as a whole whose stored forces are not those its record gives (an edited
+/// held shear, a record without its cells) is refused, naming the contact.
+#[test]
+fn an_edited_whole_joint_is_refused() -> Result<()> {
+    let mut wall = voussoir::scenes::benchmark_wall(300)?;
+    wall.run_steps(400)?;
+    let text = wall.to_checkpoint_string()?;
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    let k = json["contacts"]
+        .as_array()
+        .expect("contacts")
+        .iter()
+        .position(|c| c.get("joint").is_some())
+        .expect("a joint stepped as a whole");
+    let mut edited = json.clone();
+    let held = &mut edited["contacts"][k]["joint"]["held_shear"][0][0];
+    *held = serde_json::json!(held.as_f64().expect("a number") * 1.5 + 1.0);
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("edited held shear");
+    assert!(
+        err.to_string().contains(&format!("contacts[{k}].subcontacts[0]")),
+        "{err}"
+    );
+    let mut edited = json.clone();
+    edited["contacts"][k]["joint"]["held_shear"]
+        .as_array_mut()
+        .expect("held shear")
+        .pop();
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("one short");
+    assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
+    // Unedited, it loads; as version 13 wrote it (no joints stepped as a whole: the cells as
+    // they stand), it loads too, its joints stepped cell by cell until they enter again.
+    assert_eq!(
+        Model::<CoulombSlip>::from_checkpoint_str(&text)?.whole_joint_count(),
+        wall.whole_joint_count()
+    );
+    let mut old = json.clone();
+    old["version"] = serde_json::json!(13);
+    for c in old["contacts"].as_array_mut().expect("contacts") {
+        c.as_object_mut().expect("an object").remove("joint");
+    }
+    let mut restored = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&old)?)?;
+    assert_eq!(restored.whole_joint_count(), 0);
+    restored.run_steps(1)?;
+    assert!(restored.whole_joint_count() > 0);
     Ok(())
 }
 

@@ -24,6 +24,7 @@ mod hostile_answers;
 mod hostile_files;
 mod hostile_input;
 mod inertia;
+mod joint_stepping;
 mod limit_analysis;
 mod load_history;
 mod mixed_laws;

@@ -658,3 +658,24 @@ def test_constructor_defaults_come_from_the_library_and_the_stub_agrees():
     spelt = {k: v for k, v in d.items() if k != "mode"}
     assert vs.Model().to_scene_json() == vs.Model(**spelt).to_scene_json()
     assert vs.Model().to_scene_json() != vs.Model(contact_tolerance=2e-3).to_scene_json()
+
+
+def test_joint_stepping_whole_or_cells(model):
+    """A block resting on its base: its joint, closed and sticking, is stepped as a whole by
+    default, and gives the forces of the cell-by-cell step to round-off (the sub-contacts read
+    as they stand); bad names are refused."""
+    assert model.joint_stepping == "whole"
+    cells = block_on_base()
+    cells.set_joint_stepping("cells")
+    assert cells.joint_stepping == "cells"
+    for m in (model, cells):
+        m.set_load(1, force=(PUSH, 0, 0))
+        m.run_steps(3000)
+    assert model.whole_joint_count() == 1 and cells.whole_joint_count() == 0
+    a, b = model.contacts(), cells.contacts()
+    assert np.allclose(a["force"], b["force"], rtol=1e-9, atol=1e-9 * WEIGHT)
+    sa, sb = model.subcontacts(), cells.subcontacts()
+    for key in ("normal_force", "shear_force"):
+        assert np.allclose(sa[key], sb[key], rtol=1e-9, atol=1e-9 * WEIGHT), key
+    with pytest.raises(vs.VoussoirError, match="joint stepping"):
+        model.set_joint_stepping("joints")

@@ -315,6 +315,7 @@ mod tests {
             lo: Vector2::new(-0.2, -0.05),
             hi: Vector2::new(0.2, 0.05),
             closed_moments: Vector2::ZERO,
+            area_moments: [0.0; 6],
         };
         let cell_closed = |g: (Real, Real, Real), (c, h): (Vector2, Vector2)| {
             let anchor_gap = face_gap(g, c.x, c.y);

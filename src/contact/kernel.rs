@@ -7,7 +7,7 @@ use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, 
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
 use super::spread::{CellResponse, CellRule, ExactCells};
-use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
+use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, JointLevel, SubContact, SubContactRecord};
 use crate::block::BlockState;
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{Matrix, Pose, Real, Vector, Vector2};
@@ -51,6 +51,8 @@ pub(crate) struct KernelContext {
     pub mode: DisplacementMode,
     /// How the all-closed joints' cells are computed (the same bits either way).
     pub lanes: super::LaneBuild,
+    /// Whether closed, sticking joints are stepped as a whole (`joint_level.rs`).
+    pub joint_level: bool,
 }
 
 impl KernelContext {
@@ -170,12 +172,30 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let mut dissipated = 0.0;
     let mut fracture = 0.0;
     let elastic_regime = if dashpots { None } else { law.elastic_regime() };
-    if let Some(regime) = elastic_regime {
+    // A joint stepped as a whole (`joint_level.rs`) takes the joint-level step while it stays
+    // closed and sticking; otherwise its cells are written and stepped one by one below.
+    let mut whole_joint = false;
+    if pair.joint.active {
+        if let (true, Some(regime), Some(g)) = (ctx.joint_level, elastic_regime.as_ref(), face_gap_coefficients) {
+            if let WholeContact::Closed(cells) = WholeContact::of(g, &pair.cells) {
+                if let Some(step) = pair.joint.step(cells, regime, &kinematics, g, exact) {
+                    (sums, spread_energy) = step;
+                    whole_joint = true;
+                }
+            }
+        }
+        if !whole_joint {
+            pair.joint.write_cells(subs);
+        }
+    }
+    if whole_joint {
+        done = subs.len();
+    } else if let Some(regime) = elastic_regime {
         // Two call sites, so that each is compiled for its kind of gap.
         (sums, dissipated, spread_energy, fracture) = match face_gap_coefficients {
             Some(g) => {
                 let whole = WholeContact::of(g, &pair.cells);
-                update_elastic_first(
+                let step = update_elastic_first(
                     subs,
                     law,
                     &regime,
@@ -186,7 +206,18 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                     axes,
                     dt,
                     ctx.lanes,
-                )
+                );
+                // A joint closed all over whose cells all stuck in the elastic regime is
+                // stepped as a whole from the next step on.
+                let (s, lost, _, consumed) = step;
+                if ctx.joint_level && matches!(whole, WholeContact::Closed(_)) && lost == 0.0 && consumed == 0.0 {
+                    let shear = |v: Vector| Vector2::new(v.y, v.z);
+                    let held = [shear(s.force), shear(s.per_x), shear(s.per_y)];
+                    if let Some(joint) = JointLevel::enter(subs, &regime, g, held) {
+                        pair.joint = joint;
+                    }
+                }
+                step
             }
             None => update_elastic_first(
                 subs,

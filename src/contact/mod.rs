@@ -3,6 +3,7 @@
 
 mod closed_lanes;
 mod elastic_step;
+mod joint_level;
 mod kernel;
 mod lanes;
 mod law_update;
@@ -16,6 +17,7 @@ mod view;
 use serde::{Deserialize, Serialize};
 
 pub(crate) use closed_lanes::LaneBuild;
+pub(crate) use joint_level::JointLevel;
 pub(crate) use kernel::{face_gap_coefficients, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
 pub(crate) use node_step::{node_frame, stored_node_frame, update_nodes};
@@ -94,6 +96,9 @@ pub(crate) struct ContactPair {
     /// What the step needs of the cells as a whole (see [`CellSummary`]): derived from the
     /// sub-contacts whenever they are set (detection, checkpoint load), not stored.
     pub(crate) cells: CellSummary,
+    /// The joint stepped as a whole while it is closed and sticking (`contact/joint_level.rs`);
+    /// inactive otherwise. Checkpointed.
+    pub(crate) joint: JointLevel,
 }
 
 /// A face-face contact's cells as a whole: the box on the anchor plane that they cover, and
@@ -108,6 +113,10 @@ pub(crate) struct CellSummary {
     pub(crate) hi: Vector2,
     /// `Σ A h_x²/3`, `Σ A h_y²/3` (m⁴).
     pub(crate) closed_moments: Vector2,
+    /// The cells' area moments about the plane's origin, taken at their anchors:
+    /// `Σ A`, `Σ A x`, `Σ A y`, `Σ A x²`, `Σ A x y`, `Σ A y²` (m², m³, m³, m⁴, m⁴, m⁴), for
+    /// joint-level stepping (`contact/joint_level.rs`).
+    pub(crate) area_moments: [Real; 6],
 }
 
 impl CellSummary {
@@ -117,12 +126,21 @@ impl CellSummary {
             lo: Vector2::splat(Real::INFINITY),
             hi: Vector2::splat(Real::NEG_INFINITY),
             closed_moments: Vector2::ZERO,
+            area_moments: [0.0; 6],
         };
         for sub in own {
             let half = sub.half();
             s.lo = s.lo.min(sub.plane - half);
             s.hi = s.hi.max(sub.plane + half);
             s.closed_moments += elastic_step::cell_moments(sub.area, half);
+            let (a, x, y) = (sub.area, sub.plane.x, sub.plane.y);
+            for (m, add) in s
+                .area_moments
+                .iter_mut()
+                .zip([a, a * x, a * y, a * x * x, a * x * y, a * y * y])
+            {
+                *m += add;
+            }
         }
         s
     }

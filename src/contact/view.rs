@@ -12,7 +12,7 @@ use super::{stored_node_frame, AnchorPlane, ContactPair, ContactWrench, SubConta
 use crate::block::BlockState;
 use crate::geometry::{ContactKind, NodeId, Polyhedron, SubKey};
 use crate::ids::BlockId;
-use crate::law::{JointAxes, JointStatus};
+use crate::law::{JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Pose, Real, Vector, Vector2};
 
 /// The two blocks of a node contact as its views need them: a node's point and axes follow
@@ -231,6 +231,7 @@ impl<'a, S> ContactView<'a, S> {
                 pair,
                 frame,
                 sub,
+                live: pair.joint.live(sub),
                 record,
                 nodes,
                 cells,
@@ -238,10 +239,12 @@ impl<'a, S> ContactView<'a, S> {
     }
     /// The sub-contact at `index`, if any.
     pub fn subcontact(&self, index: usize) -> Option<SubContactView<'a, S>> {
+        let sub = self.subs.get(index)?;
         Some(SubContactView {
             pair: self.pair,
             frame: self.frame,
-            sub: self.subs.get(index)?,
+            sub,
+            live: self.pair.joint.live(sub),
             record: &self.records[index],
             nodes: self.nodes,
             cells: self.cells,
@@ -305,6 +308,9 @@ pub struct SubContactView<'a, S> {
     pair: &'a ContactPair,
     frame: Pose,
     sub: &'a SubContact<S>,
+    /// The sub-contact's force, gap and status as they stand: its own, or those of its joint
+    /// while the joint is stepped as a whole (`joint_level.rs`).
+    live: (JointForce, Real, JointStatus),
     record: &'a SubContactRecord,
     nodes: Option<NodeGeometry<'a>>,
     cells: Option<CellGeometry<'a, S>>,
@@ -360,7 +366,7 @@ impl<'a, S> SubContactView<'a, S> {
     /// displacements), [`SubContactView::point`].
     pub fn normal_force_point(&self) -> Vector {
         match &self.cells {
-            Some(c) if self.sub.force.normal > 0.0 && c.law.tension_free(&self.sub.state) => {
+            Some(c) if self.live.0.normal > 0.0 && c.law.tension_free(&self.sub.state) => {
                 let plane = self.sub.plane;
                 let gap = face_gap(c.coefficients, plane.x, plane.y);
                 let slope = Vector2::new(-c.coefficients.1, -c.coefficients.2);
@@ -376,24 +382,24 @@ impl<'a, S> SubContactView<'a, S> {
     }
     /// Normal displacement `u_n` (m, positive = open).
     pub fn normal_displacement(&self) -> Real {
-        self.sub.gap
+        self.live.1
     }
     /// Normal force (N, compression positive).
     pub fn normal_force(&self) -> Real {
-        self.sub.force.normal
+        self.live.0.normal
     }
     /// Normal stress (Pa, compression positive).
     pub fn normal_stress(&self) -> Real {
-        self.sub.force.normal / self.sub.area
+        self.live.0.normal / self.sub.area
     }
     /// Shear spring force on block `b` as components along the joint's tangents
     /// ([`ContactView::axes`]) (N).
     pub fn shear_components(&self) -> Vector2 {
-        self.sub.force.shear
+        self.live.0.shear
     }
     /// Shear spring force on block `b` (N, world, in the joint plane).
     pub fn shear_force(&self) -> Vector {
-        self.axes().shear(self.sub.force.shear)
+        self.axes().shear(self.live.0.shear)
     }
     /// Stiffness-proportional (Rayleigh) dashpot force on block `b` (N, world); zero without
     /// Rayleigh damping.
@@ -402,7 +408,7 @@ impl<'a, S> SubContactView<'a, S> {
     }
     /// Spring plus dashpot force on block `b` (N, world).
     pub fn total_force(&self) -> Vector {
-        self.axes().force(&self.sub.force) + self.record.dashpot
+        self.axes().force(&self.live.0) + self.record.dashpot
     }
     /// Slip accumulated while sliding (m): the sum of the shear displacement increments of the
     /// steps that ended sliding.
@@ -411,7 +417,7 @@ impl<'a, S> SubContactView<'a, S> {
     }
     /// Status after the last update.
     pub fn status(&self) -> JointStatus {
-        self.sub.status
+        self.live.2
     }
     /// The law's own state ([`crate::ConstitutiveLaw::State`]).
     pub fn law_state(&self) -> &'a S {

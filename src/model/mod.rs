@@ -42,7 +42,7 @@ impl std::fmt::Debug for InterruptCheck {
 }
 pub use energy::Energies;
 pub use observe::Observer;
-pub use parameters::ModelParameters;
+pub use parameters::{JointStepping, ModelParameters};
 
 use crate::block::RigidBlock;
 use crate::contact::ContactStore;
@@ -104,6 +104,8 @@ pub(super) struct ModelState<L: ConstitutiveLaw> {
     pub unbalanced_ratio: Real,
     /// Base motions and load histories, by block.
     pub excitations: Excitations,
+    /// How closed, sticking joints are stepped ([`Model::set_joint_stepping`]).
+    pub joint_stepping: JointStepping,
 }
 
 /// What detection keeps from one detection to the next.

@@ -80,6 +80,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
         stiffness_damping: 0.0,
         mode: model.state.params.mode,
         lanes: crate::contact::LaneBuild::Portable,
+        joint_level: false,
     };
     let (mut grouped_subs, mut single_subs) = (model.state.contacts.subs.clone(), model.state.contacts.subs.clone());
     let (mut grouped_records, mut single_records) = (

@@ -31,6 +31,23 @@ pub struct ModelParameters {
     pub impact_step: Option<Real>,
 }
 
+/// How the step advances a face-face joint that is closed all over and sticks (every cell in
+/// its law's elastic regime, none sliding): as a whole, or cell by cell
+/// ([`Model::set_joint_stepping`](crate::Model::set_joint_stepping), `docs/theory.md` §3.1).
+///
+/// Both give the same forces and poses to round-off; as a whole, such a joint costs a few dozen
+/// operations a step whatever its number of sub-contacts, and its sub-contacts are not read or
+/// written until it opens or slips (or a reader, an output or a checkpoint asks for them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+pub enum JointStepping {
+    /// A closed, sticking joint is stepped as a whole (the default).
+    #[default]
+    Whole,
+    /// Every sub-contact is stepped by itself, every step (for comparison).
+    Cells,
+}
+
 impl Default for ModelParameters {
     fn default() -> Self {
         Self {

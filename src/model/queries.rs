@@ -136,9 +136,20 @@ impl<L: ConstitutiveLaw> Model<L> {
         )
     }
 
+    /// How many joints are stepped as a whole after the last step: face-face joints closed all
+    /// over whose sub-contacts all stick ([`Model::set_joint_stepping`]).
+    pub fn whole_joint_count(&self) -> usize {
+        self.state.contacts.pairs.iter().filter(|p| p.joint.active).count()
+    }
+
     /// Total number of sub-contacts.
     pub fn subcontact_count(&self) -> usize {
         self.state.contacts.pairs.iter().map(|p| p.count as usize).sum()
+    }
+
+    /// How closed, sticking joints are stepped ([`Model::set_joint_stepping`]).
+    pub fn joint_stepping(&self) -> super::JointStepping {
+        self.state.joint_stepping
     }
 
     /// Steps taken.
@@ -197,7 +208,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                         let law = &laws[p.law as usize];
                         self.state.contacts.subs[p.range()]
                             .iter()
-                            .map(|s| law.elastic_energy(s.area, &s.force, &s.state))
+                            .map(|s| law.elastic_energy(s.area, &p.joint.live(s).0, &s.state))
                             .sum::<Real>()
                             + p.spread_energy
                     })

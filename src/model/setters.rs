@@ -4,7 +4,9 @@
 
 use super::changes::Changes;
 use super::Pipeline;
-use super::{Energies, Excitations, Found, InterruptCheck, Model, ModelParameters, ModelState, StepClock};
+use super::{
+    Energies, Excitations, Found, InterruptCheck, JointStepping, Model, ModelParameters, ModelState, StepClock,
+};
 use crate::block::{Block, BlockId, Fixity, RigidBlock, Wrench};
 use crate::contact::ContactStore;
 use crate::error::{Error, Result};
@@ -34,6 +36,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 refixed: Vec::new(),
                 unbalanced_ratio: Real::INFINITY,
                 excitations: Excitations::default(),
+                joint_stepping: JointStepping::default(),
             },
             pipeline: Pipeline::default(),
         })
@@ -133,6 +136,25 @@ impl<L: ConstitutiveLaw> Model<L> {
         self.state.laws.insert_interface(a, b, law)?;
         self.state.changes.insert(Changes::LAWS);
         Ok(())
+    }
+
+    /// Sets how the step advances a face-face joint that is closed all over and sticks
+    /// ([`JointStepping`]): as a whole (the default) or cell by cell. The answers agree to
+    /// round-off; cell by cell is there to compare with. Takes effect at the next step (a joint
+    /// stepped as a whole has its sub-contacts written first). Not stored in checkpoints: a
+    /// loaded model steps joints as a whole.
+    ///
+    /// ```
+    /// use voussoir::prelude::*;
+    /// use voussoir::model::JointStepping;
+    ///
+    /// let mut model: Model = Model::new(ModelParameters::default())?;
+    /// model.set_joint_stepping(JointStepping::Cells);
+    /// assert_eq!(model.joint_stepping(), JointStepping::Cells);
+    /// # Ok::<(), voussoir::Error>(())
+    /// ```
+    pub fn set_joint_stepping(&mut self, stepping: JointStepping) {
+        self.state.joint_stepping = stepping;
     }
 
     /// Replaces the integrator.

@@ -20,7 +20,7 @@ use voussoir::contact::DisplacementMode;
 use voussoir::geometry::SubContactDensity;
 use voussoir::integrate::{Damping, TimeStep};
 use voussoir::law::{AnyLaw, MaterialId};
-use voussoir::model::{InterruptCheck, Model, ModelParameters};
+use voussoir::model::{InterruptCheck, JointStepping, Model, ModelParameters};
 
 use crate::blocks::PyBlock;
 use crate::convert::{array1, vec3, vec3_or_zero, vector, Int};
@@ -310,6 +310,39 @@ impl PyModel {
             }
         };
         this.model.set_damping(damping).py()
+    }
+
+    /// Sets how a face-face joint that is closed all over and sticks is stepped: ``"whole"``
+    /// (the default: a few dozen operations a step, whatever its sub-contacts; they are written
+    /// when it opens or slips, or when they are read) or ``"cells"`` (every sub-contact every
+    /// step, to compare with). Both give the same answers to round-off.
+    fn set_joint_stepping(&self, py: Python<'_>, stepping: &str) -> PyResult<()> {
+        let mut this = self.lock(py);
+        let stepping = match stepping.to_ascii_lowercase().as_str() {
+            "whole" => JointStepping::Whole,
+            "cells" => JointStepping::Cells,
+            other => {
+                return Err(bad(format!(
+                    "joint stepping {other:?}: expected \"whole\" or \"cells\""
+                )))
+            }
+        };
+        this.model.set_joint_stepping(stepping);
+        Ok(())
+    }
+
+    /// How closed, sticking joints are stepped: ``"whole"`` or ``"cells"``.
+    #[getter]
+    fn joint_stepping(&self, py: Python<'_>) -> &'static str {
+        match self.lock(py).model.joint_stepping() {
+            JointStepping::Whole => "whole",
+            JointStepping::Cells => "cells",
+        }
+    }
+
+    /// How many joints were stepped as a whole in the last step (closed all over, sticking).
+    fn whole_joint_count(&self, py: Python<'_>) -> usize {
+        self.lock(py).model.whole_joint_count()
     }
 
     /// The damping as a dict: ``{"kind": "none"}``, ``{"kind": "local", "alpha": α}`` or

@@ -40,7 +40,10 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// re-detection depends, and the blocks' stability bounds, which are re-evaluated block by block.
 /// Version 12 has node contacts (`"Nodes"`) where 11 had point contacts (`"Point"`, with a
 /// plane), and the refinement's travel cap (`refine_travel`).
-const VERSION: u32 = 13;
+const VERSION: u32 = 14;
+/// The oldest version this build reads: 13 differs from 14 only in having no joints stepped
+/// as a whole ([`JointEntry`]).
+const OLDEST_VERSION: u32 = 13;
 /// The checksum's field: `"crc32:"` and eight hexadecimal digits.
 const CHECKSUM: &str = "checksum";
 /// The largest step count (or detection count) a checkpoint may hold: 2⁵³, where `f64` stops
@@ -148,7 +151,22 @@ struct ContactEntry<S> {
     bound_area: Real,
     /// Resultant and moments as of the last step.
     wrench: ContactWrench,
+    /// The sub-contacts, with their forces as they stand (also those of a joint stepped as a
+    /// whole).
     subcontacts: Vec<SubContactEntry<S>>,
+    /// A joint stepped as a whole (`contact/joint_level.rs`): what the step continues from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    joint: Option<JointEntry>,
+}
+
+/// A joint stepped as a whole, as checkpoints store it: the joint's record and the shear
+/// forces its cells hold (`F⁰ᵢ`, in sub-contact order), from which the forces stored in the
+/// sub-contacts follow, to the bit, as the step would write them.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JointEntry {
+    level: crate::contact::JointLevel,
+    held_shear: Vec<Vector2>,
 }
 
 /// A sub-contact as checkpoints store it.

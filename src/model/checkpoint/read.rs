@@ -9,10 +9,13 @@ use serde::{Deserialize, Serialize};
 
 use super::tested::{check_slacks, tested_pairs};
 use super::{
-    checksum_of, law_type_name, ContactEntry, Header, Snapshot, CHECKSUM, FORMAT, MAX_COUNT, MIN_STORED_BOUND, VERSION,
+    checksum_of, law_type_name, ContactEntry, Header, Snapshot, CHECKSUM, FORMAT, MAX_COUNT, MIN_STORED_BOUND,
+    OLDEST_VERSION, VERSION,
 };
 use crate::block::Block;
-use crate::contact::{ContactPair, ContactReference, ContactStore, ForceMoments, SubContact, SubContactRecord};
+use crate::contact::{
+    ContactPair, ContactReference, ContactStore, ForceMoments, JointLevel, SubContact, SubContactRecord,
+};
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::integrate::{CentralDifference, CriticalStep, TimeStep};
@@ -21,8 +24,10 @@ use crate::math::is_unit_pose;
 use crate::math::{is_finite_vector, Real, Vector};
 use crate::model::{Model, ModelParameters};
 
-/// The step's storage rebuilt from checkpointed joints.
-fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> ContactStore<S> {
+/// The step's storage rebuilt from checkpointed joints. A joint stepped as a whole gets its
+/// cells' held shear forces back; its stored forces must be those its record gives them, to the
+/// bit (else the error names it).
+fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
     let total = entries.iter().map(|e| e.subcontacts.len()).sum();
     let (mut pairs, mut references, mut wrenches) = (
         Vec::with_capacity(entries.len()),
@@ -30,11 +35,21 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> ContactStore<S> {
         Vec::with_capacity(entries.len()),
     );
     let (mut subs, mut records) = (Vec::with_capacity(total), Vec::with_capacity(total));
-    for e in entries {
+    for (k, e) in entries.into_iter().enumerate() {
         let first = subs.len() as u32;
         let count = e.subcontacts.len() as u32;
-        for s in e.subcontacts {
-            subs.push(SubContact {
+        let joint = match &e.joint {
+            None => JointLevel::default(),
+            Some(j) if j.level.active && j.held_shear.len() == e.subcontacts.len() => j.level,
+            Some(_) => {
+                return Err(corrupt(
+                    &format!("contacts[{k}].joint"),
+                    "must be active and hold one shear force per sub-contact",
+                ))
+            }
+        };
+        for (j, s) in e.subcontacts.into_iter().enumerate() {
+            let mut sub = SubContact {
                 plane: s.plane,
                 area: s.area,
                 gap: s.gap,
@@ -43,7 +58,24 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> ContactStore<S> {
                 half: s.half,
                 status: s.status,
                 state: s.state,
-            });
+            };
+            if let Some(entry) = &e.joint {
+                sub.force.shear = entry.held_shear[j];
+                let (force, gap, status) = joint.live(&sub);
+                let same = |a: Real, b: Real| a.to_bits() == b.to_bits();
+                let matches = same(force.normal, s.force.normal)
+                    && same(force.shear.x, s.force.shear.x)
+                    && same(force.shear.y, s.force.shear.y)
+                    && same(gap, s.gap)
+                    && status == s.status;
+                if !matches {
+                    return Err(corrupt(
+                        &format!("contacts[{k}].subcontacts[{j}]"),
+                        "forces differ from those of the joint stepped as a whole",
+                    ));
+                }
+            }
+            subs.push(sub);
             records.push(SubContactRecord {
                 key: s.key,
                 dashpot: s.dashpot,
@@ -71,6 +103,7 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> ContactStore<S> {
             },
             spread_energy: e.spread_energy,
             cells: Default::default(),
+            joint,
         });
         references.push(ContactReference {
             ref_a: e.reference_centroids.0,
@@ -81,13 +114,13 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> ContactStore<S> {
         });
         wrenches.push(e.wrench);
     }
-    ContactStore {
+    Ok(ContactStore {
         pairs,
         references,
         wrenches,
         subs,
         sub_records: records,
-    }
+    })
 }
 
 impl<L> Model<L>
@@ -162,7 +195,7 @@ where
     pub fn from_checkpoint_str(text: &str) -> Result<Self> {
         let mut snap = parse_snapshot::<L>(text)?;
         let tested = check_snapshot(&snap)?;
-        let storage = into_storage(std::mem::take(&mut snap.contacts));
+        let storage = into_storage(std::mem::take(&mut snap.contacts))?;
         check_contacts(&snap, &storage, &tested)?;
         let pending_detection = snap.pending_detection;
         let mut model = restore_blocks(snap.params, std::mem::take(&mut snap.blocks), snap.dt.max(snap.drift))?;
@@ -235,11 +268,11 @@ where
     if header.format != FORMAT {
         return Err(corrupt("format", &format!("\"{}\" is not a {FORMAT}", header.format)));
     }
-    if header.version != VERSION {
+    if !(OLDEST_VERSION..=VERSION).contains(&header.version) {
         return Err(corrupt(
             "version",
             &format!(
-                "{FORMAT} version {}; this build reads version {VERSION}",
+                "{FORMAT} version {}; this build reads versions {OLDEST_VERSION} to {VERSION}",
                 header.version
             ),
         ));
@@ -263,7 +296,7 @@ where
         }
     }
     let snap: Snapshot<L> = serde_path_to_error::deserialize(value).map_err(typed_error)?;
-    if snap.format != FORMAT || snap.version != VERSION {
+    if snap.format != FORMAT || !(OLDEST_VERSION..=VERSION).contains(&snap.version) {
         return Err(corrupt("format", &format!("not a {FORMAT} version {VERSION}")));
     }
     Ok(snap)
@@ -500,6 +533,21 @@ fn restore_contacts<L: ConstitutiveLaw>(
         // `contact/spread.rs`, at the poses before the step's advance).
         let law = &model.state.laws.laws()[p.law as usize];
         let subs = &model.state.contacts.subs[p.range()];
+        // A joint stepped as a whole: its cells as they stand.
+        let live: Vec<SubContact<L::State>>;
+        let subs = if p.joint.active {
+            live = subs
+                .iter()
+                .map(|s| {
+                    let mut cell = s.clone();
+                    (cell.force, cell.gap, cell.status) = p.joint.live(s);
+                    cell
+                })
+                .collect();
+            &live[..]
+        } else {
+            subs
+        };
         let (anchored, _) = p.springs_of(subs, law, None);
         let reach = |k: usize| subs.iter().map(|s| s.force.normal.max(0.0) * s.half()[k]).sum::<Real>();
         let scale = 1e-9 * (anchored.force.length() + anchored.per_x.length() + anchored.per_y.length());
@@ -529,7 +577,7 @@ fn restore_contacts<L: ConstitutiveLaw>(
         let subs = &model.state.contacts.subs[p.range()];
         if let Some(j) = subs
             .iter()
-            .position(|s| !law.elastic_energy(s.area, &s.force, &s.state).is_finite())
+            .position(|s| !law.elastic_energy(s.area, &p.joint.live(s).0, &s.state).is_finite())
         {
             return Err(corrupt(
                 &format!("contacts[{k}].subcontacts[{j}]"),

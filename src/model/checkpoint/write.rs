@@ -7,7 +7,9 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use super::tested::TestedEntry;
-use super::{checksum_of, law_type_name, ContactEntry, Snapshot, SubContactEntry, CHECKSUM, FORMAT, VERSION};
+use super::{
+    checksum_of, law_type_name, ContactEntry, JointEntry, Snapshot, SubContactEntry, CHECKSUM, FORMAT, VERSION,
+};
 use crate::error::{Error, Result};
 use crate::law::ConstitutiveLaw;
 use crate::model::Model;
@@ -36,20 +38,27 @@ impl<L: ConstitutiveLaw> Model<L> {
             wrench: self.state.contacts.wrenches[k],
             subcontacts: self.state.contacts.subs[range.clone()]
                 .iter()
-                .zip(&self.state.contacts.sub_records[range])
-                .map(|(s, rec)| SubContactEntry {
-                    key: rec.key,
-                    plane: s.plane,
-                    area: s.area,
-                    gap: s.gap,
-                    force: s.force,
-                    slip: s.slip,
-                    half: s.half,
-                    status: s.status,
-                    state: s.state.clone(),
-                    dashpot: rec.dashpot,
+                .zip(&self.state.contacts.sub_records[range.clone()])
+                .map(|(s, rec)| {
+                    let (force, gap, status) = p.joint.live(s);
+                    SubContactEntry {
+                        key: rec.key,
+                        plane: s.plane,
+                        area: s.area,
+                        gap,
+                        force,
+                        slip: s.slip,
+                        half: s.half,
+                        status,
+                        state: s.state.clone(),
+                        dashpot: rec.dashpot,
+                    }
                 })
                 .collect(),
+            joint: p.joint.active.then(|| JointEntry {
+                level: p.joint,
+                held_shear: self.state.contacts.subs[range].iter().map(|s| s.force.shear).collect(),
+            }),
         }
     }
 }

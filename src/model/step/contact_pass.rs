@@ -201,6 +201,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             stiffness_damping: self.integrator.damping().stiffness_coefficient(),
             mode: self.params.mode,
             lanes: crate::contact::LaneBuild::Portable,
+            joint_level: self.joint_stepping == crate::model::JointStepping::Whole,
         };
         // The records run index for index with the sub-contacts (kept so by detection and
         // checkpoint load).

@@ -304,6 +304,15 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             sc.moved.clear();
             sc.moved.resize(n, true);
         }
+        // A joint stepped as a whole that detection may look at again (one of its blocks
+        // moved) has its cells written first: detection reads their history.
+        let store = &mut self.contacts;
+        for p in store.pairs.iter_mut() {
+            if p.joint.active && (sc.moved[p.a as usize] || sc.moved[p.b as usize]) {
+                let range = p.range();
+                p.joint.write_cells(&mut store.subs[range]);
+            }
+        }
         // The moved blocks take their current poses as reference poses, and their boxes.
         let reach = 0.5 * params.tolerance + trigger;
         let fresh_boxes = sc.boxes.len() != n;

@@ -272,6 +272,7 @@ pub(super) fn add_dropped_work<S>(
     owed: &mut (Real, Real),
 ) {
     let (p, reference) = (&old.pairs[k], &old.references[k]);
+    debug_assert!(!p.joint.active, "a joint stepped as a whole dropped unwritten");
     let carried = successor
         .filter(|(q, _)| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
         .map(|(q, records)| &records[q.range()]);

@@ -51,6 +51,7 @@ pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
         springs: ForceMoments::default(),
         spread_energy: 0.0,
         cells: Default::default(),
+        joint: Default::default(),
     };
     let reference = ContactReference {
         ref_a: Vector::ZERO,
@@ -190,6 +191,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
         let bound_area = k_old.map_or(0.0, |k| old.references[k].bound_area);
         let old_subs = k_old.map(|k| {
             let p = &old.pairs[k];
+            debug_assert!(!p.joint.active, "a joint stepped as a whole re-detected unwritten");
             (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
                 .then(|| (&old.subs[p.range()], &old.records[p.range()]))
         });
@@ -311,6 +313,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             springs: ForceMoments::default(),
             spread_energy: 0.0,
             cells: Default::default(),
+            joint: Default::default(),
         };
         pair.cache_local_faces(bi.shape(), bj.shape());
         pair.refresh_springs(subs, joint_law, large.then_some((&bi.state.pose, &bj.state.pose)));

@@ -1,0 +1,305 @@
+//! Joint-level stepping: a face-face joint whose cells are all closed, virgin and sticking is
+//! stepped as a whole, in a number of operations that does not depend on its cells, and its
+//! cells are written only when it leaves that state or a reader asks
+//! (`docs/theory.md` §3.1, "Joints that stick, stepped as a whole").
+//!
+//! While a joint sticks, each cell `i` (anchor `(xᵢ, yᵢ)`, area `Aᵢ`) follows its law's elastic
+//! regime ([`ElasticRegime`]):
+//! - its normal force is `Nᵢ = −k_n Aᵢ g(xᵢ, yᵢ)`, with the gap `g = g_o − g_x x − g_y y` of the
+//!   blocks' current poses: it has no history;
+//! - its shear force is `Fᵢ = F⁰ᵢ − k_s Aᵢ U(xᵢ, yᵢ)`, where `F⁰ᵢ` is what the cell held when it
+//!   was last written and `U = U_o + x U_x + y U_y` the sum of the steps' tangential
+//!   displacement increments since, an affine field because each increment is.
+//!
+//! So the joint's force and moments follow from the cells' area moments (`Σ A`, `Σ A x`, …,
+//! [`CellSummary::area_moments`]) and the sums `Σ F⁰ᵢ`, `Σ F⁰ᵢ xᵢ`, `Σ F⁰ᵢ yᵢ`, kept here. The
+//! Coulomb condition of a cell, `|Fᵢ| ≤ c Aᵢ + tan φ Nᵢ`, holds if
+//! `τ⁰ + k_s |U(xᵢ, yᵢ)| ≤ c + tan φ k_n (−g(xᵢ, yᵢ))` with `τ⁰ = maxᵢ |F⁰ᵢ|/Aᵢ`; the left side
+//! less the right is convex in `(x, y)` (a norm of an affine field plus an affine function), so
+//! it holds at every anchor if it holds at the four corners of the box the cells cover. When
+//! it fails at a corner, the joint's cells are written and the cell-by-cell step takes over.
+
+use super::lanes::{face_gap, Kinematics};
+use super::moments::ForceMoments;
+use super::spread::ExactCells;
+use super::{CellSummary, SubContact};
+use crate::law::{ElasticRegime, JointForce, JointStatus};
+use crate::math::{Real, Vector, Vector2};
+
+/// How much of the strength a corner's bound may reach and the joint still be stepped as a
+/// whole: a margin far above the round-off of the bound, so that a cell the joint-level step
+/// keeps sticking sticks by the cells' own test too.
+const STRENGTH_SHARE: Real = 1.0 - 1e-9;
+
+/// A face-face joint stepped as a whole while it is closed and sticking (see the module's
+/// documentation). Kept in its [`super::ContactPair`], so that it moves with it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub(crate) struct JointLevel {
+    /// Whether the joint is stepped as a whole: then its cells hold their shear forces as they
+    /// were when last written (`F⁰ᵢ`), and [`JointLevel::live`] gives their forces now.
+    pub(crate) active: bool,
+    /// `Σ F⁰ᵢ`, `Σ F⁰ᵢ xᵢ`, `Σ F⁰ᵢ yᵢ` of the shear forces the cells hold (tangent components;
+    /// N, N·m, N·m).
+    pub(crate) held: [Vector2; 3],
+    /// `maxᵢ |F⁰ᵢ|/Aᵢ` (Pa).
+    pub(crate) held_stress: Real,
+    /// `U_o`, `U_x`, `U_y`: the tangential displacement since the cells were written, as an
+    /// affine field over the anchor plane (m, m/m, m/m).
+    pub(crate) field: [Vector2; 3],
+    /// The normal and shear stiffnesses the joint is stepped with (Pa/m): its law's.
+    pub(crate) stiffness: (Real, Real),
+    /// The gap coefficients of the last step (`face_gap`), for the cells' gaps and normal forces.
+    pub(crate) gap: (Real, Real, Real),
+}
+
+impl JointLevel {
+    /// The joint as the cells `own` leave it after a step in which every one of them took its
+    /// law's elastic step (`regime`) as a virgin cell, all closed, and stayed
+    /// [`JointStatus::Elastic`], with gap coefficients `gap`; `shear_sums` are the step's sums of
+    /// their shear forces. `None` when a cell does not fit (a slide, a state, a zero area that
+    /// holds a force).
+    pub(super) fn enter<S: PartialEq + Default>(
+        own: &[SubContact<S>],
+        regime: &ElasticRegime,
+        gap: (Real, Real, Real),
+        shear_sums: [Vector2; 3],
+    ) -> Option<Self> {
+        let virgin = S::default();
+        let mut held_stress: Real = 0.0;
+        for sub in own {
+            if sub.status != JointStatus::Elastic || sub.state != virgin {
+                return None;
+            }
+            let shear = sub.force.shear.length();
+            let stress = if sub.area > 0.0 {
+                shear / sub.area
+            } else if shear == 0.0 {
+                0.0
+            } else {
+                return None;
+            };
+            held_stress = held_stress.max(stress);
+        }
+        held_stress.is_finite().then_some(Self {
+            active: true,
+            held: shear_sums,
+            held_stress,
+            field: [Vector2::ZERO; 3],
+            stiffness: (regime.normal_stiffness, regime.shear_stiffness),
+            gap,
+        })
+    }
+
+    /// One step of a joint whose cells are all closed at the gap coefficients `g`: adds the
+    /// step's tangential increments (`kinematics`) to the field and, if every cell still sticks
+    /// by the corner test, returns the spring-force sums in the joint axes and the spread
+    /// energy, as the cells would give them to round-off. `None` (and nothing changed) when a
+    /// corner fails, or the regime is not the one the joint was entered with: then the cells
+    /// must be written ([`JointLevel::write_cells`]) and stepped one by one.
+    #[inline]
+    pub(super) fn step(
+        &mut self,
+        cells: &CellSummary,
+        regime: &ElasticRegime,
+        kinematics: &Kinematics,
+        g: (Real, Real, Real),
+        exact: Option<ExactCells>,
+    ) -> Option<(ForceMoments, Real)> {
+        let (kn, ks) = self.stiffness;
+        if (kn, ks) != (regime.normal_stiffness, regime.shear_stiffness) {
+            return None;
+        }
+        let tangential = |v: Vector| Vector2::new(v.y, v.z);
+        let field = [
+            self.field[0] + tangential(kinematics.at_origin),
+            self.field[1] + tangential(kinematics.per_x),
+            self.field[2] + tangential(kinematics.per_y),
+        ];
+        // The corners of the box the cells cover; the caller found the gap negative over it.
+        let (lo, hi) = (cells.lo, cells.hi);
+        for (x, y) in [(lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y)] {
+            let compression = -kn * face_gap(g, x, y);
+            let strength = regime.cohesion + regime.tan_friction * compression;
+            let stress = self.held_stress + ks * (field[0] + field[1] * x + field[2] * y).length();
+            // NaN, or a strength not positive, fails too.
+            let sticks = stress <= STRENGTH_SHARE * strength;
+            if !sticks {
+                return None;
+            }
+        }
+        self.field = field;
+        self.gap = g;
+        let [a, ax, ay, axx, axy, ayy] = cells.area_moments;
+        // Σ Nᵢ (1, xᵢ, yᵢ) with Nᵢ = −k_n Aᵢ (g_o − g_x xᵢ − g_y yᵢ).
+        let normal = |m0: Real, mx: Real, my: Real| -kn * ((g.0 * m0 - g.1 * mx) - g.2 * my);
+        // Σ Fᵢ (1, xᵢ, yᵢ) with Fᵢ = F⁰ᵢ − k_s Aᵢ (U_o + U_x xᵢ + U_y yᵢ).
+        let shear =
+            |held: Vector2, m0: Real, mx: Real, my: Real| held - ((field[0] * m0 + field[1] * mx) + field[2] * my) * ks;
+        let joint = |n: Real, s: Vector2| Vector::new(n, s.x, s.y);
+        let mut sums = ForceMoments {
+            force: joint(normal(a, ax, ay), shear(self.held[0], a, ax, ay)),
+            per_x: joint(normal(ax, axx, axy), shear(self.held[1], ax, axx, axy)),
+            per_y: joint(normal(ay, axy, ayy), shear(self.held[2], ay, axy, ayy)),
+        };
+        // The cells' own second moments about their centres (`−k_n s Σ J` and
+        // `½ k_n (J_xx s_x² + J_yy s_y²)`), for a law whose virgin cells are integrated exactly,
+        // as the cell-by-cell step adds them (`elastic_step.rs`).
+        let mut spread_energy = 0.0;
+        if let Some(e) = exact.filter(|e| e.virgin_without_tension) {
+            let j = cells.closed_moments;
+            sums.per_x.x -= e.normal_stiffness * e.slope.x * j.x;
+            sums.per_y.x -= e.normal_stiffness * e.slope.y * j.y;
+            spread_energy = 0.5 * e.normal_stiffness * (j.x * e.slope.x * e.slope.x + j.y * e.slope.y * e.slope.y);
+        }
+        Some((sums, spread_energy))
+    }
+
+    /// A cell's force, gap and status as the joint stands (its own when the joint is not
+    /// stepped as a whole): what the cell-by-cell step would have left in it, to round-off.
+    #[inline]
+    pub(crate) fn live<S>(&self, sub: &SubContact<S>) -> (JointForce, Real, JointStatus) {
+        if !self.active {
+            return (sub.force, sub.gap, sub.status);
+        }
+        let (kn, ks) = self.stiffness;
+        let (x, y) = (sub.plane.x, sub.plane.y);
+        let u = (self.field[0] + self.field[1] * x) + self.field[2] * y;
+        let gap = face_gap(self.gap, x, y);
+        // As `ElasticRegime::step`: `(−k_n g) A`, `F_s − u (k_s A)`.
+        let force = JointForce {
+            normal: -kn * gap * sub.area,
+            shear: sub.force.shear - u * (ks * sub.area),
+        };
+        (force, gap, JointStatus::Elastic)
+    }
+
+    /// Writes the joint's cells `own` as they stand ([`JointLevel::live`]) and leaves
+    /// joint-level stepping: the cells hold the joint's history again.
+    pub(crate) fn write_cells<S>(&mut self, own: &mut [SubContact<S>]) {
+        if !self.active {
+            return;
+        }
+        for sub in own.iter_mut() {
+            (sub.force, sub.gap, sub.status) = self.live(sub);
+        }
+        *self = Self::default();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::law::{ConstitutiveLaw, CoulombSlip, CoulombState};
+
+    fn cell(x: Real, y: Real, area: Real, shear: Vector2) -> SubContact<CoulombState> {
+        SubContact {
+            plane: Vector2::new(x, y),
+            area,
+            gap: -1e-5,
+            force: JointForce { normal: 1.0, shear },
+            slip: 0.0,
+            half: [0.05, 0.05],
+            status: JointStatus::Elastic,
+            state: CoulombState::default(),
+        }
+    }
+
+    /// A 4 × 3 grid of cells stepped as a whole for 50 steps gives, cell by cell, what the
+    /// elastic regime's own step gives each cell, and the sums of those forces.
+    #[test]
+    fn the_joint_gives_each_cell_what_its_own_steps_give() {
+        let law = CoulombSlip::new(1e9, 4e8, 35.0, 30.0, 2e5, 1e5).expect("law");
+        let regime = law.elastic_regime().expect("regime");
+        let mut cells: Vec<_> = (0..12)
+            .map(|k| {
+                let (x, y) = (0.1 * (k % 4) as Real, 0.1 * (k / 4) as Real);
+                cell(
+                    x,
+                    y,
+                    0.01 * (1.0 + 0.1 * k as Real),
+                    Vector2::new(3.0 - 0.5 * k as Real, 0.2 * k as Real),
+                )
+            })
+            .collect();
+        let summary = CellSummary::of(&cells);
+        let g = (-2e-5, 1e-5, -3e-5);
+        let mut sums = ForceMoments::default();
+        for c in &cells {
+            sums.add_joint(&c.force, c.plane);
+        }
+        let held = [
+            Vector2::new(sums.force.y, sums.force.z),
+            Vector2::new(sums.per_x.y, sums.per_x.z),
+            Vector2::new(sums.per_y.y, sums.per_y.z),
+        ];
+        let mut joint = JointLevel::enter(&cells, &regime, g, held).expect("enters");
+        let mut own = cells.clone();
+        for step in 0..50 {
+            let t = step as Real;
+            let kinematics = Kinematics {
+                at_origin: Vector::new(0.0, 1e-9 * (0.1 * t).sin(), -2e-9),
+                per_x: Vector::new(0.0, 3e-9, 1e-9 * (0.3 * t).cos()),
+                per_y: Vector::new(0.0, -1e-9, 2e-9),
+            };
+            let (joint_sums, _) = joint.step(&summary, &regime, &kinematics, g, None).expect("sticks");
+            let mut cell_sums = ForceMoments::default();
+            for c in cells.iter_mut() {
+                let [_, d1, d2] = super::super::lanes::increment(&kinematics, c.plane.x, c.plane.y);
+                let gap = face_gap(g, c.plane.x, c.plane.y);
+                let (force, status) = regime
+                    .step(c.area, gap, Vector2::new(d1, d2), c.force.shear)
+                    .expect("regime");
+                assert_eq!(status, JointStatus::Elastic);
+                c.force = force;
+                c.gap = gap;
+                cell_sums.add_joint(&force, c.plane);
+            }
+            assert!(
+                joint_sums.matches(&cell_sums),
+                "step {step}: {joint_sums:?} vs {cell_sums:?}"
+            );
+        }
+        joint.write_cells(&mut own);
+        assert!(!joint.active);
+        for (a, b) in own.iter().zip(&cells) {
+            assert_eq!(a.force.normal, b.force.normal, "normal forces have no history");
+            assert_eq!(a.gap, b.gap);
+            assert!((a.force.shear - b.force.shear).length() < 1e-12 * b.force.shear.length().max(1.0));
+        }
+    }
+
+    /// The corner test fails as soon as a cell would slide, and not long before: a joint pushed
+    /// sideways leaves joint-level stepping at the step the first cell's shear reaches its
+    /// strength, within the test's margin.
+    #[test]
+    fn the_corner_test_fails_when_a_cell_would_slide() {
+        let law = CoulombSlip::dry(1e9, 4e8, 30.0).expect("law");
+        let regime = law.elastic_regime().expect("regime");
+        let cells: Vec<_> = (0..9)
+            .map(|k| cell(0.1 * (k % 3) as Real, 0.1 * (k / 3) as Real, 0.01, Vector2::ZERO))
+            .collect();
+        let summary = CellSummary::of(&cells);
+        // A uniform gap: every cell carries 1e4 N, and slides at 1e4 tan 30° N.
+        let g = (-1e-3, 0.0, 0.0);
+        let mut joint = JointLevel::enter(&cells, &regime, g, [Vector2::ZERO; 3]).expect("enters");
+        let per_step = 1e-6;
+        let kinematics = Kinematics {
+            at_origin: Vector::new(0.0, per_step, 0.0),
+            per_x: Vector::ZERO,
+            per_y: Vector::ZERO,
+        };
+        let strength = 1e4 * 30.0_f64.to_radians().tan();
+        let slides_at = strength / (4e8 * 0.01 * per_step);
+        let mut steps = 0;
+        while joint.step(&summary, &regime, &kinematics, g, None).is_some() {
+            steps += 1;
+            assert!(steps < 10_000, "never left");
+        }
+        assert!(
+            (steps as Real - slides_at.floor()).abs() <= 1.0,
+            "{steps} vs {slides_at}"
+        );
+    }
+}
