@@ -324,7 +324,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
     assert_eq!(keys(&whole[0]["joint"]), ["held_shear", "level"]);
     assert_eq!(
         keys(&whole[0]["joint"]["level"]),
-        ["active", "field", "gap", "held", "held_stress", "stiffness"]
+        ["active", "field", "gap", "held", "held_stress", "open", "stiffness"]
     );
     Ok(())
 }

@@ -40,6 +40,10 @@ pub(crate) struct JointLevel {
     /// Whether the joint is stepped as a whole: then its cells hold their shear forces as they
     /// were when last written (`F⁰ᵢ`), and [`JointLevel::live`] gives their forces now.
     pub(crate) active: bool,
+    /// Whether the joint is stepped as a whole because it is open all over (every cell open,
+    /// unloaded and virgin, the gap positive over the whole box, a law that keeps a virgin cell
+    /// open at any opening): its cells carry nothing, and only their gaps change.
+    pub(crate) open: bool,
     /// `Σ F⁰ᵢ`, `Σ F⁰ᵢ xᵢ`, `Σ F⁰ᵢ yᵢ` of the shear forces the cells hold (tangent components;
     /// N, N·m, N·m).
     pub(crate) held: [Vector2; 3],
@@ -84,12 +88,61 @@ impl JointLevel {
         }
         held_stress.is_finite().then_some(Self {
             active: true,
+            open: false,
             held: shear_sums,
             held_stress,
             field: [Vector2::ZERO; 3],
             stiffness: (regime.normal_stiffness, regime.shear_stiffness),
             gap,
         })
+    }
+
+    /// The joint as the cells `own` leave it after a step at gap coefficients `g` over which
+    /// the box of the cells (`cells`) is open ([`JointLevel::open_over`]), when every cell is
+    /// open, unloaded and virgin (the law keeping virgin cells open at any opening is the
+    /// caller's to know); `None` otherwise.
+    pub(super) fn enter_open<S: PartialEq + Default>(
+        own: &[SubContact<S>],
+        cells: &CellSummary,
+        g: (Real, Real, Real),
+    ) -> Option<Self> {
+        let virgin = S::default();
+        let unloaded = |sub: &SubContact<S>| {
+            sub.status == JointStatus::Open
+                && sub.force.normal == 0.0
+                && sub.force.shear == Vector2::ZERO
+                && sub.state == virgin
+        };
+        (Self::open_over(cells, g) && own.iter().all(unloaded)).then_some(Self {
+            active: true,
+            open: true,
+            gap: g,
+            ..Self::default()
+        })
+    }
+
+    /// Whether the gap `face_gap(g, x, y)` is positive over the whole box the cells cover (its
+    /// smallest value is at a corner), by a margin far above the round-off of the cells' own
+    /// tests, so that each cell would also find itself open all over.
+    #[inline]
+    pub(super) fn open_over(cells: &CellSummary, g: (Real, Real, Real)) -> bool {
+        let slope = Vector2::new(-g.1, -g.2);
+        let (lo, hi) = (slope * cells.lo, slope * cells.hi);
+        let smallest = g.0 + lo.x.min(hi.x) + lo.y.min(hi.y);
+        let scale = g.0.abs() + (slope.abs() * cells.lo.abs().max(cells.hi.abs())).element_sum();
+        smallest > 1e-9 * scale
+    }
+
+    /// One step of a joint stepped as a whole because it is open: `true` (and the gap
+    /// coefficients kept) while it stays open all over at `g`, else `false` (then its cells must
+    /// be written and stepped one by one).
+    #[inline]
+    pub(super) fn step_open(&mut self, cells: &CellSummary, g: (Real, Real, Real)) -> bool {
+        let open = Self::open_over(cells, g);
+        if open {
+            self.gap = g;
+        }
+        open
     }
 
     /// One step of a joint whose cells are all closed at the gap coefficients `g`: adds the
@@ -122,9 +175,11 @@ impl JointLevel {
         for (x, y) in [(lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y)] {
             let compression = -kn * face_gap(g, x, y);
             let strength = regime.cohesion + regime.tan_friction * compression;
-            let stress = self.held_stress + ks * (field[0] + field[1] * x + field[2] * y).length();
-            // NaN, or a strength not positive, fails too.
-            let sticks = stress <= STRENGTH_SHARE * strength;
+            // `τ⁰ + k_s |U| ≤ share · strength`, squared to spare the square root: the room left
+            // above `τ⁰` must not be negative, nor NaN (which fails both tests).
+            let room = STRENGTH_SHARE * strength - self.held_stress;
+            let u = field[0] + field[1] * x + field[2] * y;
+            let sticks = room >= 0.0 && ks * ks * u.length_squared() <= room * room;
             if !sticks {
                 return None;
             }
@@ -162,6 +217,14 @@ impl JointLevel {
     pub(crate) fn live<S>(&self, sub: &SubContact<S>) -> (JointForce, Real, JointStatus) {
         if !self.active {
             return (sub.force, sub.gap, sub.status);
+        }
+        if self.open {
+            // As the cells' own loop keeps an open cell (`elastic_step::stays_open_cell`): the
+            // gap at its corner nearest to closing.
+            let half = sub.half();
+            let spread = self.gap.1.abs() * half.x + self.gap.2.abs() * half.y;
+            let gap = face_gap(self.gap, sub.plane.x, sub.plane.y) - spread;
+            return (sub.force, gap, JointStatus::Open);
         }
         let (kn, ks) = self.stiffness;
         let (x, y) = (sub.plane.x, sub.plane.y);

@@ -177,7 +177,10 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let mut whole_joint = false;
     if pair.joint.active {
         if let (true, Some(regime), Some(g)) = (ctx.joint_level, elastic_regime.as_ref(), face_gap_coefficients) {
-            if let WholeContact::Closed(cells) = WholeContact::of(g, &pair.cells) {
+            if pair.joint.open {
+                // Open all over: nothing to sum (the sums and spread energy stay zero).
+                whole_joint = exact.is_some_and(|e| e.virgin_without_tension) && pair.joint.step_open(&pair.cells, g);
+            } else if let WholeContact::Closed(cells) = WholeContact::of(g, &pair.cells) {
                 if let Some(step) = pair.joint.step(cells, regime, &kinematics, g, exact) {
                     (sums, spread_energy) = step;
                     whole_joint = true;
@@ -209,11 +212,22 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 );
                 // A joint closed all over whose cells all stuck in the elastic regime is
                 // stepped as a whole from the next step on.
+                // So is a joint open all over whose cells all stayed open and unloaded, for a
+                // law that keeps a virgin cell open at any opening.
                 let (s, lost, _, consumed) = step;
-                if ctx.joint_level && matches!(whole, WholeContact::Closed(_)) && lost == 0.0 && consumed == 0.0 {
-                    let shear = |v: Vector| Vector2::new(v.y, v.z);
-                    let held = [shear(s.force), shear(s.per_x), shear(s.per_y)];
-                    if let Some(joint) = JointLevel::enter(subs, &regime, g, held) {
+                if ctx.joint_level && lost == 0.0 && consumed == 0.0 {
+                    let entered = match whole {
+                        WholeContact::Closed(_) => {
+                            let shear = |v: Vector| Vector2::new(v.y, v.z);
+                            let held = [shear(s.force), shear(s.per_x), shear(s.per_y)];
+                            JointLevel::enter(subs, &regime, g, held)
+                        }
+                        WholeContact::Mixed if exact.is_some_and(|e| e.virgin_without_tension) => {
+                            JointLevel::enter_open(subs, &pair.cells, g)
+                        }
+                        WholeContact::Mixed => None,
+                    };
+                    if let Some(joint) = entered {
                         pair.joint = joint;
                     }
                 }
