@@ -29,7 +29,7 @@
 
 use crate::common;
 
-use common::{cube, fingerprint, fixed_slab};
+use common::{fingerprint, fixed_slab};
 use voussoir::prelude::*;
 
 /// FNV-1a over the words of a fingerprint.
@@ -55,15 +55,7 @@ fn drop_model() -> Model {
 fn cube_drop(tilt: (Real, Real)) -> Model {
     let mut model = drop_model();
     model.add_block(fixed_slab("slab")).expect("slab");
-    let turn = Rotation::from_rotation_y(tilt.1) * Rotation::from_rotation_x(tilt.0);
-    let block = cube("cube", Vector::ZERO);
-    let centre = block.state().pose.translation;
-    // Lowest corner 20 mm above the slab once turned about the centroid.
-    let corners = voussoir::block::cuboid_corners(Vector::splat(-0.1), Vector::splat(0.1));
-    let lowest = corners.iter().map(|c| (turn * *c).z).fold(Real::INFINITY, Real::min);
-    let lift = Vector::new(0.0, 0.0, 0.02 - lowest - centre.z);
-    let pose = Pose::from_parts(centre + lift, turn) * Pose::from_translation(-centre);
-    model.add_block(block.transformed(pose)).expect("cube");
+    model.add_block(common::tilted_cube("cube", tilt, 0.02)).expect("cube");
     model
 }
 

@@ -103,6 +103,14 @@ impl Worst {
     }
 }
 
+/// `model`, with gravity one ulp heavier if `nudge`.
+fn nudged(mut model: Model, nudge: bool) -> Model {
+    if nudge {
+        one_ulp_heavier(&mut model);
+    }
+    model
+}
+
 /// Runs `build` both ways for `steps` (comparing every `every` steps) and checks that they
 /// agree to round-off (see the module's documentation); `build(true)` builds the scene with
 /// one ulp changed (gravity, or a block's height). Returns the largest share of joints stepped
@@ -138,13 +146,7 @@ fn agree(name: &str, build: impl Fn(bool) -> Model, steps: u64, every: u64, leng
 fn a_settling_wall_agrees_with_its_cells() {
     let share = agree(
         "settling wall",
-        |nudge| {
-            let mut wall = voussoir::scenes::benchmark_wall(300).expect("wall");
-            if nudge {
-                one_ulp_heavier(&mut wall);
-            }
-            wall
-        },
+        |nudge| nudged(voussoir::scenes::benchmark_wall(300).expect("wall"), nudge),
         1000,
         100,
         1.0,
@@ -157,11 +159,8 @@ fn a_shaking_wall_agrees_with_its_cells() {
     agree(
         "shaking wall",
         |nudge| {
-            let mut wall = voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall");
-            if nudge {
-                one_ulp_heavier(&mut wall);
-            }
-            wall
+            let wall = voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall");
+            nudged(wall, nudge)
         },
         1000,
         100,
@@ -169,24 +168,17 @@ fn a_shaking_wall_agrees_with_its_cells() {
     );
 }
 
-/// A cube released 5 mm above the slab (and one ulp more, `nudge`), turned by `tilt` (rad)
+/// A cube released 5 mm above the slab (and 3e-17 m more, `nudge`: about two ulps of its
+/// centroid's height), turned by `tilt` (rad)
 /// about x then about y, with friction and local damping, so that it lands, rocks and comes to
 /// rest.
 fn cube_drop(tilt: (Real, Real), nudge: bool) -> Model {
     let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 35.0).expect("law"));
     model.add_block(fixed_slab("slab")).expect("slab");
-    let turn = Rotation::from_rotation_y(tilt.1) * Rotation::from_rotation_x(tilt.0);
-    let block = cube("cube", Vector::ZERO);
-    let centre = block.state().pose.translation;
-    let corners = voussoir::block::cuboid_corners(Vector::splat(-0.1), Vector::splat(0.1));
-    let lowest = corners.iter().map(|c| (turn * *c).z).fold(Real::INFINITY, Real::min);
-    let mut height = 0.005 - lowest;
-    if nudge {
-        height = height.next_up();
-    }
-    let lift = Vector::new(0.0, 0.0, height - centre.z);
-    let pose = Pose::from_parts(centre + lift, turn) * Pose::from_translation(-centre);
-    model.add_block(block.transformed(pose)).expect("cube");
+    let height = if nudge { 0.005 + 3e-17 } else { 0.005 };
+    model
+        .add_block(common::tilted_cube("cube", tilt, height))
+        .expect("cube");
     model
 }
 

@@ -46,6 +46,20 @@ pub fn fixed_slab(name: &str) -> RigidBlock {
     .with_fixity(Fixity::FIXED)
 }
 
+/// The stone cube [`cube`] at the origin turned by `tilt` (rad) about x then about y (about its
+/// centroid), its lowest corner `height` above the plane z = 0: a cube to drop on the slab.
+pub fn tilted_cube(name: &str, tilt: (Real, Real), height: Real) -> RigidBlock {
+    let turn = Rotation::from_rotation_y(tilt.1) * Rotation::from_rotation_x(tilt.0);
+    let block = cube(name, Vector::ZERO);
+    let centre = block.state().pose.translation;
+    let h = 0.5 * CUBE_EDGE;
+    let corners = voussoir::block::cuboid_corners(Vector::splat(-h), Vector::splat(h));
+    let lowest = corners.iter().map(|c| (turn * *c).z).fold(Real::INFINITY, Real::min);
+    let lift = Vector::new(0.0, 0.0, height - lowest - centre.z);
+    let pose = Pose::from_parts(centre + lift, turn) * Pose::from_translation(-centre);
+    block.transformed(pose)
+}
+
 /// A free, axis-aligned 0.2 m stone cube named `name` whose bottom face is centred on `at`.
 pub fn cube(name: &str, at: Vector) -> RigidBlock {
     let h = 0.5 * CUBE_EDGE;
