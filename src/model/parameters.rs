@@ -32,7 +32,8 @@ pub struct ModelParameters {
 }
 
 /// How the step advances a face-face joint that is closed all over and sticks (every cell in
-/// its law's elastic regime, none sliding): as a whole, or cell by cell
+/// its law's elastic regime, none sliding), or open all over with its cells unloaded: as a
+/// whole, or cell by cell
 /// ([`Model::set_joint_stepping`](crate::Model::set_joint_stepping), `docs/theory.md` §3.1).
 ///
 /// Both give the same forces and poses to round-off; as a whole, such a joint costs a few dozen

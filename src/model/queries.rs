@@ -137,7 +137,8 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     /// How many joints are stepped as a whole after the last step: face-face joints closed all
-    /// over whose sub-contacts all stick ([`Model::set_joint_stepping`]).
+    /// over whose sub-contacts all stick, or open all over with their sub-contacts unloaded
+    /// ([`Model::set_joint_stepping`]).
     pub fn whole_joint_count(&self) -> usize {
         self.state.contacts.pairs.iter().filter(|p| p.joint.active).count()
     }

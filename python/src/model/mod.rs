@@ -340,7 +340,8 @@ impl PyModel {
         }
     }
 
-    /// How many joints were stepped as a whole in the last step (closed all over, sticking).
+    /// How many joints were stepped as a whole in the last step (closed all over and sticking,
+    /// or open all over and unloaded).
     fn whole_joint_count(&self, py: Python<'_>) -> usize {
         self.lock(py).model.whole_joint_count()
     }
