@@ -358,6 +358,11 @@ fn an_edited_whole_joint_is_refused() -> Result<()> {
         .pop();
     let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("one short");
     assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
+    // A node contact is not stepped as a whole: a record on one is refused.
+    let mut edited = json.clone();
+    edited["contacts"][k]["kind"] = serde_json::json!("Nodes");
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a node contact's record");
+    assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
     // Unedited, it loads; as version 13 wrote it (no joints stepped as a whole: the cells as
     // they stand), it loads too, its joints stepped cell by cell until they enter again.
     assert_eq!(

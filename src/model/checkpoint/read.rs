@@ -40,11 +40,17 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
         let count = e.subcontacts.len() as u32;
         let joint = match &e.joint {
             None => JointLevel::default(),
-            Some(j) if j.level.active && j.held_shear.len() == e.subcontacts.len() => j.level,
+            Some(j)
+                if j.level.active
+                    && j.held_shear.len() == e.subcontacts.len()
+                    && matches!(e.kind, crate::geometry::ContactKind::FaceFace { .. }) =>
+            {
+                j.level
+            }
             Some(_) => {
                 return Err(corrupt(
                     &format!("contacts[{k}].joint"),
-                    "must be active and hold one shear force per sub-contact",
+                    "must be a face-face joint's, active, with one shear force per sub-contact",
                 ))
             }
         };
