@@ -8,7 +8,7 @@ use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
 use super::spread::{CellResponse, CellRule, ExactCells};
 use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, JointLevel, SubContact, SubContactRecord};
-use crate::block::BlockState;
+use crate::block::BlockMotion;
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{Matrix, Pose, Real, Vector, Vector2};
 
@@ -98,8 +98,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     reference: &ContactReference,
     subs: &mut [SubContact<L::State>],
     records: &mut [SubContactRecord],
-    (sa, rotation_a): (&BlockState, &Matrix),
-    (sb, rotation_b): (&BlockState, &Matrix),
+    sa: &BlockMotion,
+    sb: &BlockMotion,
     law: &L,
     ctx: KernelContext,
     host_radius: Real,
@@ -116,7 +116,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // oriented from a to b, so that the normal force is the gradient of the spring energy.
     let mut face_plane = None;
     if ctx.mode == DisplacementMode::Large {
-        let (m, g0) = other_face_plane(pair, (&sa.pose, rotation_a), (&sb.pose, rotation_b));
+        let (m, g0) = other_face_plane(pair, (&sa.pose, &sa.rotation), (&sb.pose, &sb.rotation));
         pair.normal = if pair.host_is_a { -m } else { m };
         face_plane = Some((g0, -m));
         pair.tangent = turned_tangent(previous_axes, pair.normal);
@@ -124,8 +124,8 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let axes = pair.axes();
     let (n, t1, t2) = (axes.normal, axes.tangent, axes.tangent_2());
     let rotation = match ctx.mode {
-        DisplacementMode::Large if pair.host_is_a => *rotation_a,
-        DisplacementMode::Large => *rotation_b,
+        DisplacementMode::Large if pair.host_is_a => sa.rotation,
+        DisplacementMode::Large => sb.rotation,
         DisplacementMode::Small => Matrix::from_quat(host.rotation),
     };
     // v_rel(p) = v_b + ω_b × (p − x_b) − v_a − ω_a × (p − x_a) = v₀ + (ω_b − ω_a) × r.

@@ -96,11 +96,11 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
             model.state.contacts.pairs[k].a as usize,
             model.state.contacts.pairs[k].b as usize,
         );
-        let (ra, rb) = (
-            crate::math::Matrix::from_quat(model.state.blocks[a].state.pose.rotation),
-            crate::math::Matrix::from_quat(model.state.blocks[b].state.pose.rotation),
+        let (ma, mb) = (
+            crate::block::BlockMotion::of(&model.state.blocks[a]),
+            crate::block::BlockMotion::of(&model.state.blocks[b]),
         );
-        let (sa, sb) = ((&model.state.blocks[a].state, &ra), (&model.state.blocks[b].state, &rb));
+        let (sa, sb) = (&ma, &mb);
         if matches!(model.state.contacts.pairs[k].kind, crate::geometry::ContactKind::Nodes) {
             // Node contacts have one loop (`contact/node_step.rs`).
             counts[3] += r.len();

@@ -11,13 +11,13 @@
 use rayon::prelude::*;
 
 use super::detection::prepare_chunk;
-use crate::block::{Block, Dof, RigidBlock, Wrench};
+use crate::block::{Block, BlockMotion, Dof, RigidBlock, Wrench};
 use crate::contact::{ContactWrench, DisplacementMode};
 use crate::error::Error;
 use crate::ids::BlockId;
 use crate::integrate::{Integrator, StepDurations, StepRecord};
 use crate::law::ConstitutiveLaw;
-use crate::math::{Matrix, Real, Vector};
+use crate::math::{Real, Vector};
 use crate::model::Pipeline;
 use crate::model::{diverged, BlockSums, ModelState, BLOCK_CHUNK};
 
@@ -208,26 +208,26 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .resize(self.blocks.len().div_ceil(BLOCK_CHUNK), BlockSums::default());
         let integrator: &dyn Integrator = &*self.integrator;
         let step = StepDurations { kick, drift };
-        // Also the next step's first stage, while the blocks are in cache: their rotation
-        // matrices and movement check (`prepare_blocks`).
-        pipeline.rotations.resize(self.blocks.len(), Matrix::IDENTITY);
+        // Also the next step's first stage, while the blocks are in cache: their motions and
+        // movement check (`prepare_blocks`).
+        pipeline.motions.resize(self.blocks.len(), BlockMotion::default());
         pipeline.detection.moved.resize(self.blocks.len(), false);
         self.blocks
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(pipeline.forces.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.records.par_chunks_mut(BLOCK_CHUNK))
-            .zip(pipeline.rotations.par_chunks_mut(BLOCK_CHUNK))
+            .zip(pipeline.motions.par_chunks_mut(BLOCK_CHUNK))
             .zip(pipeline.detection.moved.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.found.ref_poses.par_chunks(BLOCK_CHUNK))
             .zip(pipeline.block_sums.par_iter_mut())
             .enumerate()
             .for_each(
-                |(k, ((((((blocks, forces), records), rotations), moved), refs), sums))| {
+                |(k, ((((((blocks, forces), records), motions), moved), refs), sums))| {
                     let first_block = k * BLOCK_CHUNK;
                     pass.gather(first_block, blocks, forces, records, sums);
                     integrator.advance_chunk(blocks, forces, step, records);
                     pass.settle(first_block, blocks, records, sums);
-                    sums.moved = prepare_chunk(rotations, moved, blocks, refs, pass.trigger);
+                    sums.moved = prepare_chunk(motions, moved, blocks, refs, pass.trigger);
                 },
             );
         pipeline.detection.prepared = Some(pipeline.block_sums.iter().any(|s| s.moved));

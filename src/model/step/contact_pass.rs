@@ -9,12 +9,12 @@
 //! needed. Sums are kept per chunk of [`CONTACT_CHUNK`] contacts and added in chunk order
 //! afterwards, so that they do not depend on the number of threads.
 
-use crate::block::{Block, RigidBlock};
+use crate::block::{Block, BlockMotion, RigidBlock};
 use crate::contact::{update_contact, update_nodes, ContactReference, KernelContext, LaneBuild};
 use crate::geometry::ContactKind;
 use crate::integrate::{StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
-use crate::math::{Matrix, Real};
+use crate::math::Real;
 use crate::model::{ModelState, Pipeline};
 
 /// Contacts per chunk of the contact pass: sums are taken per chunk, then over the chunks in
@@ -27,8 +27,8 @@ const CHUNKS_PER_TASK: usize = 4;
 /// What the contact pass reads, shared by its tasks.
 pub(in crate::model) struct ContactPass<'a, L: ConstitutiveLaw> {
     pub blocks: &'a [RigidBlock],
-    /// The blocks' rotation matrices, index for index.
-    pub rotations: &'a [Matrix],
+    /// The blocks' motions, index for index.
+    pub motions: &'a [BlockMotion],
     /// The contacts' references, index for index with the contacts.
     pub references: &'a [ContactReference],
     pub laws: &'a [L],
@@ -116,17 +116,17 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
         let base = pairs[0].first as usize;
         let references = &self.references[first..first + pairs.len()];
         for ((p, reference), w) in pairs.iter_mut().zip(references).zip(wrenches) {
-            let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
-            let (ra, rb) = (&self.rotations[p.a as usize], &self.rotations[p.b as usize]);
+            let (ma, mb) = (&self.motions[p.a as usize], &self.motions[p.b as usize]);
             let range = p.first as usize - base..p.first as usize - base + p.count as usize;
             let watch = !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok();
             let step = if matches!(p.kind, ContactKind::Nodes) {
+                let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
                 update_nodes(
                     p,
                     &mut subs[range.clone()],
                     &mut records[range],
-                    (&a.state, ra, a.shape()),
-                    (&b.state, rb, b.shape()),
+                    (&a.state, &ma.rotation, a.shape()),
+                    (&b.state, &mb.rotation, b.shape()),
                     &self.laws[p.law as usize],
                     ctx,
                     watch,
@@ -137,11 +137,11 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                     reference,
                     &mut subs[range.clone()],
                     &mut records[range],
-                    (&a.state, ra),
-                    (&b.state, rb),
+                    ma,
+                    mb,
                     &self.laws[p.law as usize],
                     ctx,
-                    if p.host_is_a { a.radius } else { b.radius },
+                    if p.host_is_a { ma.radius } else { mb.radius },
                     watch,
                 )
             };
@@ -207,9 +207,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // checkpoint load).
         assert!(self.contacts.in_step(), "contact lists out of step");
         assert_eq!(
-            pipeline.rotations.len(),
+            pipeline.motions.len(),
             self.blocks.len(),
-            "rotation matrices out of step"
+            "block motions out of step"
         );
         // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed
         // per fixed chunk of contacts, so that the totals do not depend on the thread count.
@@ -221,7 +221,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             let (references, slices) = self.contacts.pass_view(&mut pipeline.pair_sums);
             let pass = ContactPass {
                 blocks: &self.blocks,
-                rotations: &pipeline.rotations,
+                motions: &pipeline.motions,
                 references,
                 laws: self.laws.laws(),
                 bounds: &pipeline.bounds,

@@ -3,9 +3,9 @@
 //! store it, and a restored model rebuilds it.
 
 use super::contact_pass::PairSums;
-use crate::block::Wrench;
+use crate::block::{BlockMotion, Wrench};
 use crate::integrate::StiffnessBound;
-use crate::math::{Matrix, Real};
+use crate::math::Real;
 use crate::model::{BlockSums, Timings};
 
 /// Scratch of the step's stages. `D` is the detection's scratch
@@ -22,8 +22,9 @@ pub(in crate::model) struct PipelineOf<D> {
     /// Per-chunk sums of the contact pass and of the block pass.
     pub pair_sums: Vec<PairSums>,
     pub block_sums: Vec<BlockSums>,
-    /// Rotation matrices of the blocks at the start of the step (see `prepare_blocks`).
-    pub rotations: Vec<Matrix>,
+    /// The blocks' motions at the start of the step, as the contact pass reads them (see
+    /// `prepare_blocks`).
+    pub motions: Vec<BlockMotion>,
     /// The blocks' squared frequency bounds of the last step evaluation (critical step and
     /// impact probe).
     pub bounds: Vec<StiffnessBound>,
@@ -76,7 +77,7 @@ impl<D: Default> Default for PipelineOf<D> {
             forces: Vec::new(),
             pair_sums: Vec::new(),
             block_sums: Vec::new(),
-            rotations: Vec::new(),
+            motions: Vec::new(),
             bounds: Vec::new(),
             refresh_blocks: Vec::new(),
             refresh_bounds: Vec::new(),

@@ -5,12 +5,12 @@ use parry3d_f64::shape::Shape;
 use rayon::prelude::*;
 
 use super::changes::Changes;
-use crate::block::{Block, BlockId, RigidBlock};
+use crate::block::{Block, BlockId, BlockMotion, RigidBlock};
 use crate::contact::DisplacementMode;
 use crate::error::{Error, Result};
 use crate::geometry::BroadPhase;
 use crate::law::ConstitutiveLaw;
-use crate::math::{Matrix, Pose, Real};
+use crate::math::{Pose, Real};
 use crate::model::Pipeline;
 use crate::model::{ModelState, BLOCK_CHUNK};
 
@@ -206,20 +206,20 @@ impl<S> Default for DetectionScratch<S> {
     }
 }
 
-/// The rotation matrices of a chunk of blocks and, given the re-detection `trigger`, which of
-/// them moved beyond it since their reference poses in `refs` (`moved`, all `false` without a
-/// trigger); returns whether any did.
+/// The motions of a chunk of blocks ([`BlockMotion`]: poses, velocities, rotation matrices) and,
+/// given the re-detection `trigger`, which of them moved beyond it since their reference poses
+/// in `refs` (`moved`, all `false` without a trigger); returns whether any did.
 #[inline]
 pub(in crate::model) fn prepare_chunk(
-    rotations: &mut [Matrix],
+    motions: &mut [BlockMotion],
     moved: &mut [bool],
     blocks: &[RigidBlock],
     refs: &[Pose],
     trigger: Option<Real>,
 ) -> bool {
     let mut any = false;
-    for (((rotation, moved), b), r) in rotations.iter_mut().zip(moved).zip(blocks).zip(refs) {
-        *rotation = Matrix::from_quat(b.state.pose.rotation);
+    for (((motion, moved), b), r) in motions.iter_mut().zip(moved).zip(blocks).zip(refs) {
+        *motion = BlockMotion::of(b);
         *moved = trigger.is_some_and(|trigger| moved_beyond(b, r, trigger));
         any |= *moved;
     }
@@ -261,24 +261,24 @@ struct BlockIndex<'a> {
 }
 
 impl<L: ConstitutiveLaw> ModelState<L> {
-    /// The step's first pass over the blocks: their rotation matrices, which the contact pass
-    /// reads instead of turning every contact's normals by quaternions, and (`check`) which
+    /// The step's first pass over the blocks: their motions ([`BlockMotion`]: the poses,
+    /// velocities and rotation matrices the contact pass reads, in one compact list), and (`check`) which
     /// blocks moved more than the re-detection trigger since their reference poses (the flags in
     /// [`DetectionScratch::moved`]; whether any did is returned). (After a step of a blockwise
     /// integrator the block pass has done this already, see [`DetectionScratch::prepared`].)
     pub(in crate::model) fn prepare_blocks(&mut self, pipeline: &mut Pipeline<L::State>, check: bool) -> bool {
         let trigger = self.params.contact.redetect_fraction * self.params.contact.tolerance;
         let n = self.blocks.len();
-        pipeline.rotations.resize(n, Matrix::IDENTITY);
+        pipeline.motions.resize(n, BlockMotion::default());
         pipeline.detection.moved.resize(n, false);
         pipeline
-            .rotations
+            .motions
             .par_chunks_mut(BLOCK_CHUNK)
             .zip(pipeline.detection.moved.par_chunks_mut(BLOCK_CHUNK))
             .zip(self.blocks.par_chunks(BLOCK_CHUNK))
             .zip(self.found.ref_poses.par_chunks(BLOCK_CHUNK))
-            .map(|(((rotations, moved), blocks), refs)| {
-                prepare_chunk(rotations, moved, blocks, refs, check.then_some(trigger))
+            .map(|(((motions, moved), blocks), refs)| {
+                prepare_chunk(motions, moved, blocks, refs, check.then_some(trigger))
             })
             .reduce(|| false, |a, b| a || b)
     }
