@@ -221,15 +221,13 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .zip(self.found.ref_poses.par_chunks(BLOCK_CHUNK))
             .zip(pipeline.block_sums.par_iter_mut())
             .enumerate()
-            .for_each(
-                |(k, ((((((blocks, forces), records), motions), moved), refs), sums))| {
-                    let first_block = k * BLOCK_CHUNK;
-                    pass.gather(first_block, blocks, forces, records, sums);
-                    integrator.advance_chunk(blocks, forces, step, records);
-                    pass.settle(first_block, blocks, records, sums);
-                    sums.moved = prepare_chunk(motions, moved, blocks, refs, pass.trigger);
-                },
-            );
+            .for_each(|(k, ((((((blocks, forces), records), motions), moved), refs), sums))| {
+                let first_block = k * BLOCK_CHUNK;
+                pass.gather(first_block, blocks, forces, records, sums);
+                integrator.advance_chunk(blocks, forces, step, records);
+                pass.settle(first_block, blocks, records, sums);
+                sums.moved = prepare_chunk(motions, moved, blocks, refs, pass.trigger);
+            });
         pipeline.detection.prepared = Some(pipeline.block_sums.iter().any(|s| s.moved));
         self.gather_block_sums(pipeline)
     }

@@ -206,11 +206,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // The records run index for index with the sub-contacts (kept so by detection and
         // checkpoint load).
         assert!(self.contacts.in_step(), "contact lists out of step");
-        assert_eq!(
-            pipeline.motions.len(),
-            self.blocks.len(),
-            "block motions out of step"
-        );
+        assert_eq!(pipeline.motions.len(), self.blocks.len(), "block motions out of step");
         // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed
         // per fixed chunk of contacts, so that the totals do not depend on the thread count.
         pipeline.pair_sums.clear();
