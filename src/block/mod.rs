@@ -464,9 +464,6 @@ impl Block for RigidBlock {
     }
 }
 
-/// Makes blocks whose shapes are the same bit for bit share one (a checkpoint's bricks, each
-/// read on its own): memory, not physics.
-#[cfg(feature = "serde")]
 /// What the contact pass reads of a block, copied once per step into a compact list (the
 /// pipeline's `motions`, index for index with the blocks): its pose, velocities, rotation
 /// matrix and bounding radius, in three cache lines. A contact reads its two blocks at
@@ -514,6 +511,9 @@ impl BlockMotion {
     }
 }
 
+/// Makes blocks whose shapes are the same bit for bit share one (a checkpoint's bricks, each
+/// read on its own): memory, not physics.
+#[cfg(feature = "serde")]
 pub(crate) fn share_shapes(blocks: &mut [RigidBlock]) {
     let mut first: std::collections::HashMap<u64, Vec<usize>> = std::collections::HashMap::new();
     for i in 0..blocks.len() {
