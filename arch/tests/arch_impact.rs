@@ -101,7 +101,8 @@ fn impact_energy_momentum_and_outcomes() {
 
 /// The default impactor is a free block (no constrained degree of freedom) held in place only by
 /// the contacts with the fixed frame blocks: it stays within the clearance (plus the spring
-/// deflection of the guide joint), and the frictionless guide pushes only horizontally.
+/// deflection of the guide joint), and the frictionless guide pushes along the normal of the
+/// impactor's face that a frame block's edge presses: horizontally, but for the impactor's tilt.
 #[test]
 fn frame_guided_impactor_is_free_and_guided_by_contacts() {
     let case = ImpactCase {

@@ -22,7 +22,11 @@ pub(crate) const PARALLEL_ANGLE: Real = 0.017_453_292_519_943_295;
 /// its edge row or corner node, whose cells the other face covers: their areas do not change as
 /// the edge slides along the face. (Hosted by the other face, the deepest sub-contacts sit in
 /// the partly covered cells along the edge, whose areas are refreshed only at re-detections,
-/// and each refresh changed their stored energy by `½ k ΔA g²` at the deepest gaps.)
+/// and each refresh changed their stored energy by `½ k ΔA g²` at the deepest gaps.) Faces
+/// parallel within [`PARALLEL_ANGLE`] whose gaps still vary are hosted so too when an edge of
+/// the other face is the deepest by more than round-off (see [`face_face_hosted`]); a joint
+/// kept without history (`kept_host` `None` for a blank joint, see
+/// [`super::PreviousContact::blank`]) is hosted afresh by the same rules.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn face_face(
     a: BlockGeometry<'_>,
@@ -131,22 +135,51 @@ pub(super) fn face_face_hosted(
     if min_gap > params.tolerance {
         return Hosted::None;
     }
-    if check_deepest && n_other.dot(face.normal) > -PARALLEL_ANGLE.cos() {
-        // The midpoint of the overlap's deepest edge (an edge, so that an edge crossing the
-        // host face, whose end points lie on the host's boundary, is not taken for the host's).
-        let overlap = &scratch.other;
-        let deepest = (0..overlap.len())
-            .map(|k| (overlap[k], overlap[(k + 1) % overlap.len()]))
-            .min_by(|(p, q), (r, t)| (gap_at(*p) + gap_at(*q)).total_cmp(&(gap_at(*r) + gap_at(*t))))
-            .map_or(DVec2::ZERO, |(p, q)| 0.5 * (p + q));
+    // Whether a point of the host plane lies on the host face's boundary.
+    let on_host_boundary = |at: DVec2| {
         let poly = &scratch.host;
-        let on_boundary = (0..poly.len()).any(|k| {
+        (0..poly.len()).any(|k| {
             let (p, q) = (poly[k], poly[(k + 1) % poly.len()]);
             let e = q - p;
-            let t = ((deepest - p).dot(e) / e.length_squared()).clamp(0.0, 1.0);
-            (deepest - (p + e * t)).length() <= 1e-6 * e.length()
-        });
-        if !on_boundary {
+            let t = ((at - p).dot(e) / e.length_squared()).clamp(0.0, 1.0);
+            (at - (p + e * t)).length() <= 1e-6 * e.length()
+        })
+    };
+    // The overlap's edges, each with the sum of its end points' gaps (twice its mean gap) and
+    // its midpoint (an edge, so that an edge crossing the host face, whose end points lie on
+    // the host's boundary, is not taken for the host's).
+    let overlap = &scratch.other;
+    let edges = (0..overlap.len()).map(|k| {
+        let (p, q) = (overlap[k], overlap[(k + 1) % overlap.len()]);
+        (gap_at(p) + gap_at(q), 0.5 * (p + q))
+    });
+    if check_deepest && n_other.dot(face.normal) > -PARALLEL_ANGLE.cos() {
+        // Tilted faces: the host is the face that the overlap's deepest edge belongs to.
+        let deepest = edges
+            .min_by(|(g, _), (h, _)| g.total_cmp(h))
+            .map_or(DVec2::ZERO, |(_, mid)| mid);
+        if !on_host_boundary(deepest) {
+            return Hosted::DeepestOnOther;
+        }
+    } else if check_deepest {
+        // Faces parallel within `PARALLEL_ANGLE` whose gaps still vary over the overlap (the
+        // faces turned by a fraction of a degree): when an edge of the other face is deeper
+        // than every edge of the host's own boundary by more than round-off, the joint would
+        // close along the other face's edge, in cells that edge cuts, whose areas change at
+        // each re-detection while it slides — each change making or destroying `½ k ΔA g²`
+        // at the deepest gaps. The other face hosts instead, as for tilted faces. Faces that
+        // are parallel to round-off keep the smaller face as the host.
+        let (mut own, mut other) = (Real::INFINITY, Real::INFINITY);
+        for (g, mid) in edges {
+            if on_host_boundary(mid) {
+                own = own.min(g);
+            } else {
+                other = other.min(g);
+            }
+        }
+        let (host_lo, host_hi) = bounds(&scratch.host);
+        let round_off = 1e-9 * (host_hi - host_lo).length();
+        if other < own - round_off {
             return Hosted::DeepestOnOther;
         }
     }

@@ -278,6 +278,12 @@ pub struct PreviousContact {
     pub host_is_a: bool,
     /// Whether it carried a normal force.
     pub loaded: bool,
+    /// Whether it is a face-face joint whose sub-contacts carry nothing the step reads: no
+    /// force, no dashpot force, each in a fresh cell's state (a joint open all over that never
+    /// closed, or only without changing its law's state). Such a joint has no history to keep,
+    /// and its host is chosen again as a new joint's would be (its cells' record of
+    /// accumulated slip, which the step only adds to, then starts again from zero).
+    pub blank: bool,
 }
 
 /// A sub-contact as created by detection.
@@ -422,10 +428,13 @@ pub fn detect(
     let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
     let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
     let cos = opposite(fa, fb);
+    // A joint kept between the same faces keeps its host, so that its sub-contacts keep their
+    // keys and history; a blank one has none to keep, and is hosted as a new joint would be.
     let kept_host = match previous {
         Some(PreviousContact {
             kind: ContactKind::FaceFace { face_a, face_b },
             host_is_a,
+            blank: false,
             ..
         }) if face_a as usize == fa && face_b as usize == fb => Some(host_is_a),
         _ => None,

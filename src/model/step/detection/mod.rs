@@ -384,6 +384,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             params: &params,
             keep_within: (!full).then_some(KEEP_FRACTION * trigger),
             pairs: &self.contacts.pairs,
+            subs: &self.contacts.subs,
+            records: &self.contacts.sub_records,
         };
         // In batches, so that the seeds of a full detection are not all held at once: the tests
         // of a batch in parallel; the places of its contacts in the staging lists, in plan

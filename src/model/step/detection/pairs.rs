@@ -2,11 +2,13 @@
 //! detection (candidates with their old entries), the parallel narrow phase over it.
 
 use crate::block::{Block, RigidBlock};
-use crate::contact::ContactPair;
+use crate::contact::{ContactPair, SubContact, SubContactRecord};
 use crate::geometry::{
-    detect, BlockGeometry, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact, SubContactSeed,
+    detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact,
+    SubContactSeed,
 };
-use crate::math::{Pose, Real};
+use crate::law::JointForce;
+use crate::math::{Pose, Real, Vector};
 
 /// A block pair the narrow phase tested, with the relative pose it was tested at: its verdict
 /// holds until the pair has moved relatively past the trigger (a contact) or past `slack` (a
@@ -98,16 +100,41 @@ pub(super) struct ChunkScratch {
 }
 
 /// What the parallel narrow phase reads.
-pub(super) struct PairTest<'a> {
+pub(super) struct PairTest<'a, S> {
     pub(super) blocks: &'a [RigidBlock],
     pub(super) tested: &'a [TestedPair],
     pub(super) pairs: &'a [ContactPair],
+    /// The contacts' sub-contacts and their records (their history, for
+    /// [`PreviousContact::blank`]).
+    pub(super) subs: &'a [SubContact<S>],
+    pub(super) records: &'a [SubContactRecord],
     pub(super) params: &'a ContactParameters,
     /// The relative motion within which a contact keeps its verdict; `None` tests every pair.
     pub(super) keep_within: Option<Real>,
 }
 
-impl PairTest<'_> {
+impl<S: PartialEq + Default> PairTest<'_, S> {
+    /// Whether contact `c` carries nothing that a change of host could lose
+    /// ([`PreviousContact::blank`]): a face-face joint whose sub-contacts have no force and no
+    /// dashpot force and are in the fresh state of a face joint's cell (`S::default()`, what
+    /// detection gives a new cell). A joint stepped as a whole is blank when open all over (its
+    /// cells unloaded and virgin; detection writes such a joint's cells before it looks at the
+    /// pair again).
+    fn blank(&self, c: usize) -> bool {
+        let p = &self.pairs[c];
+        if !matches!(p.kind, ContactKind::FaceFace { .. }) {
+            return false;
+        }
+        if p.joint.active {
+            return p.joint.open;
+        }
+        let fresh = S::default();
+        self.subs[p.range()]
+            .iter()
+            .all(|s| s.force == JointForce::default() && s.state == fresh)
+            && self.records[p.range()].iter().all(|r| r.dashpot == Vector::ZERO)
+    }
+
     /// Decides and, where needed, tests one chunk of planned pairs.
     pub(super) fn run(&self, plan: &[Planned], outcomes: &mut [Outcome], scratch: &mut ChunkScratch) {
         scratch.seeds.clear();
@@ -127,6 +154,8 @@ impl PairTest<'_> {
                 kind: self.pairs[c].kind,
                 host_is_a: self.pairs[c].host_is_a,
                 loaded: self.pairs[c].normal_force > 0.0,
+                // (Only an unloaded joint can be blank: a loaded one is not looked at.)
+                blank: self.pairs[c].normal_force <= 0.0 && self.blank(c),
             });
             let found = detect(
                 BlockGeometry {
