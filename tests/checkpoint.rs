@@ -234,6 +234,30 @@ fn pending_redetection_survives_a_checkpoint() -> Result<()> {
     Ok(())
 }
 
+/// A velocity set between steps reaches the next step's contacts: the step after
+/// `set_velocity` is the one a restarted model takes from the same state (the contact pass
+/// reads the blocks' motions from a list the block pass prepares; a setter must not leave it
+/// stale).
+#[test]
+fn a_velocity_set_between_steps_reaches_the_contacts() -> Result<()> {
+    let mut model = moving_wall()?;
+    model.run_steps(30)?;
+    let id = model
+        .contacts()
+        .find(|c| c.normal_force() > 0.0 && !model.blocks()[c.blocks().1.index()].fixity().is_fixed())
+        .map(|c| c.blocks().1)
+        .expect("a loaded contact of a free block");
+    model.set_velocity(id, Vector::new(0.05, 0.0, -0.02), Vector::new(0.0, 0.3, 0.0))?;
+    let mut restored: Model = Model::from_checkpoint_str(&model.to_checkpoint_string()?)?;
+    model.step()?;
+    restored.step()?;
+    assert_eq!(fingerprint(&model), fingerprint(&restored));
+    model.run_steps(5)?;
+    restored.run_steps(5)?;
+    assert_eq!(fingerprint(&model), fingerprint(&restored));
+    Ok(())
+}
+
 /// The checkpoint format is the transfer structs' fields, nothing of the step's storage: these
 /// key sets change only with the format version.
 #[test]

@@ -341,8 +341,10 @@ impl<L: ConstitutiveLaw> Model<L> {
 
     pub(super) fn block_mut(&mut self, id: BlockId) -> Result<&mut RigidBlock> {
         let count = self.state.blocks.len();
-        // A velocity or fixity may change: the next step measures the speeds afresh.
+        // A velocity or fixity may change: the next step measures the speeds afresh, and copies
+        // the blocks' motions (`BlockMotion`, which the contact pass reads) afresh.
         self.pipeline.max_speed = None;
+        self.pipeline.detection.prepared = None;
         self.state
             .blocks
             .get_mut(id.index())
