@@ -6,16 +6,25 @@ use crate::math::Real;
 
 /// Clips the convex polygon `poly` by the half-plane `{p : (p - origin) · outward <= 0}` into `out`.
 pub fn clip_halfplane(poly: &[DVec2], origin: DVec2, outward: DVec2, out: &mut Vec<DVec2>) {
+    clip_by(poly, out, |p| (p - origin).dot(outward));
+}
+
+/// Sutherland–Hodgman on one half-plane: keeps the part of the convex polygon `poly` where
+/// `distance(p) <= 0`, into `out`, starting at `poly[0]`. Each vertex's distance is taken once
+/// (it is both the start of one edge and the end of the previous).
+#[inline(always)]
+fn clip_by(poly: &[DVec2], out: &mut Vec<DVec2>, distance: impl Fn(DVec2) -> Real) {
     out.clear();
-    let n = poly.len();
-    if n == 0 {
+    let Some(&first) = poly.first() else {
         return;
-    }
-    for i in 0..n {
-        let a = poly[i];
-        let b = poly[(i + 1) % n];
-        let da = (a - origin).dot(outward);
-        let db = (b - origin).dot(outward);
+    };
+    let d_first = distance(first);
+    let (mut a, mut da) = (first, d_first);
+    for i in 1..=poly.len() {
+        let (b, db) = match poly.get(i) {
+            Some(&b) => (b, distance(b)),
+            None => (first, d_first),
+        };
         if da <= 0.0 {
             out.push(a);
         }
@@ -23,6 +32,7 @@ pub fn clip_halfplane(poly: &[DVec2], origin: DVec2, outward: DVec2, out: &mut V
             let t = da / (da - db);
             out.push(a + (b - a) * t);
         }
+        (a, da) = (b, db);
     }
 }
 
@@ -44,17 +54,21 @@ pub fn clip_convex(subject: &mut Vec<DVec2>, clip: &[DVec2], scratch: &mut Vec<D
 }
 
 /// Clips `subject` to the axis-aligned rectangle `[lo, hi]`.
+///
+/// The four half-planes in the order and with the distances of [`clip_halfplane`] with the
+/// outward normals `−x`, `−y`, `+x`, `+y`: `(p − o)·(−1, 0)` is `−(p.x − o.x)` exactly (a zero
+/// may change its sign, which neither test nor cut sees), so the result is the same to the bit.
 pub fn clip_rect(subject: &mut Vec<DVec2>, lo: DVec2, hi: DVec2, scratch: &mut Vec<DVec2>) {
-    for (origin, outward) in [
-        (lo, DVec2::new(-1.0, 0.0)),
-        (lo, DVec2::new(0.0, -1.0)),
-        (hi, DVec2::new(1.0, 0.0)),
-        (hi, DVec2::new(0.0, 1.0)),
-    ] {
+    for side in 0..4 {
         if subject.is_empty() {
             return;
         }
-        clip_halfplane(subject, origin, outward, scratch);
+        match side {
+            0 => clip_by(subject, scratch, |p| -(p.x - lo.x)),
+            1 => clip_by(subject, scratch, |p| -(p.y - lo.y)),
+            2 => clip_by(subject, scratch, |p| p.x - hi.x),
+            _ => clip_by(subject, scratch, |p| p.y - hi.y),
+        }
         std::mem::swap(subject, scratch);
     }
 }
@@ -155,5 +169,62 @@ mod tests {
         let mut r = sq.clone();
         clip_rect(&mut r, DVec2::new(0.0, 0.0), DVec2::new(2.0, 0.5), &mut scratch);
         assert!((area_centroid(&r).0 - 0.5).abs() < 1e-15);
+    }
+
+    /// `clip_rect` is the four general half-planes to the bit: random convex polygons (a
+    /// rotated, scaled square and regular polygons) against rectangles that cut them, hold
+    /// them, miss them, or share an edge or a vertex with them.
+    #[test]
+    fn clip_rect_matches_the_general_half_planes_to_the_bit() {
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut scratch, mut general) = (Vec::new(), Vec::new());
+        for case in 0..2000 {
+            let sides = 3 + case % 6;
+            let (cx, cy, r, turn) = (next() - 0.5, next() - 0.5, 0.1 + next(), next() * 6.3);
+            let poly: Vec<DVec2> = (0..sides)
+                .map(|k| {
+                    let t = turn + std::f64::consts::TAU * k as f64 / sides as f64;
+                    DVec2::new(cx + r * t.cos(), cy + r * t.sin())
+                })
+                .collect();
+            // Rectangles from a grid (shared vertices and edges with each other) or random.
+            let (lo, hi) = if case % 3 == 0 {
+                let (i, j) = ((next() * 8.0).floor(), (next() * 8.0).floor());
+                let lo = DVec2::new(-1.0 + 0.25 * i, -1.0 + 0.25 * j);
+                (lo, lo + DVec2::splat(0.25))
+            } else {
+                let lo = DVec2::new(next() * 2.0 - 1.0, next() * 2.0 - 1.0);
+                (lo, lo + DVec2::new(next(), next()))
+            };
+            let mut fast = poly.clone();
+            clip_rect(&mut fast, lo, hi, &mut scratch);
+            general.clear();
+            general.extend_from_slice(&poly);
+            for (origin, outward) in [
+                (lo, DVec2::new(-1.0, 0.0)),
+                (lo, DVec2::new(0.0, -1.0)),
+                (hi, DVec2::new(1.0, 0.0)),
+                (hi, DVec2::new(0.0, 1.0)),
+            ] {
+                if general.is_empty() {
+                    break;
+                }
+                let mut out = Vec::new();
+                clip_halfplane(&general, origin, outward, &mut out);
+                general = out;
+            }
+            let bits = |v: &[DVec2]| v.iter().map(|p| (p.x.to_bits(), p.y.to_bits())).collect::<Vec<_>>();
+            let (f, g) = (bits(&fast), bits(&general));
+            // Equal, but for the sign of a zero.
+            let zero = |x: u64| if f64::from_bits(x) == 0.0 { 0 } else { x };
+            let norm = |v: Vec<(u64, u64)>| v.into_iter().map(|(x, y)| (zero(x), zero(y))).collect::<Vec<_>>();
+            assert_eq!(norm(f), norm(g), "case {case}");
+        }
     }
 }

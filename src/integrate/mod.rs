@@ -11,7 +11,9 @@ pub use central_difference::CentralDifference;
 pub use critical_step::{critical_time_step, CriticalStep, Stiffness6, StiffnessBound, TimeStep, DEFAULT_SAFETY};
 pub use damping::Damping;
 
-pub(crate) use stability::{block_bound, contact_eigenvalues, AreaMoments, ContactStiffness};
+pub(crate) use stability::{
+    block_bound, block_side, bound_from_sides, contact_eigenvalues, AreaMoments, ContactStiffness,
+};
 
 use crate::block::{Block, BlockState, Fixity, RigidBlock, Wrench};
 use crate::geometry::MassProperties;

@@ -61,6 +61,61 @@ pub(crate) fn block_bound(
     }
 }
 
+/// Block `i`'s side of its contacts (in contact order): each one's largest eigenvalue on `i`
+/// written into `eigenvalues` (the entry of [`contact_eigenvalues`] for `i`), and the largest
+/// eigenvalue of their sum, the `λ_max(A_bb)` of [`block_bound`]; `None` for a block whose every
+/// degree of freedom is prescribed (its eigenvalues zero, no contact assembled). With
+/// [`bound_from_sides`], [`block_bound`] to the bit, each contact's side assembled once.
+pub(crate) fn block_side(
+    blocks: &[RigidBlock],
+    i: usize,
+    contacts: impl Iterator<Item = ContactStiffness>,
+    eigenvalues: &mut [Real],
+) -> Option<Real> {
+    if all_constrained(&blocks[i]) {
+        eigenvalues.fill(0.0);
+        return None;
+    }
+    let mut own = Stiffness6::default();
+    for (c, eigenvalue) in contacts.zip(eigenvalues) {
+        *eigenvalue = match side_stiffness(blocks, &c, i) {
+            Some(m) => {
+                own.add(&m);
+                m.max_eigenvalue().max(0.0)
+            }
+            None => 0.0,
+        };
+    }
+    Some(own.max_eigenvalue())
+}
+
+/// The bound of block `i` from its [`block_side`] (`own`) and the eigenvalues of its contacts on
+/// their two blocks, in contact order: what [`block_bound`] gives.
+pub(crate) fn bound_from_sides(
+    blocks: &[RigidBlock],
+    i: usize,
+    own: Option<Real>,
+    contacts: impl Iterator<Item = [Real; 2]>,
+    k_max: Real,
+) -> StiffnessBound {
+    let Some(own) = own else {
+        return StiffnessBound { omega_squared: 0.0 };
+    };
+    let mut coupling = 0.0;
+    let mut in_contact = false;
+    for [la, lb] in contacts {
+        coupling += (la * lb).sqrt();
+        in_contact = true;
+    }
+    StiffnessBound {
+        omega_squared: if in_contact {
+            own + coupling
+        } else {
+            free_flight_bound(&blocks[i], k_max)
+        },
+    }
+}
+
 /// The largest eigenvalues of contact `c`'s mass-normalised stiffness on its blocks `a` and
 /// `b` (zero on a block whose every degree of freedom is prescribed).
 pub(crate) fn contact_eigenvalues(blocks: &[RigidBlock], c: &ContactStiffness) -> [Real; 2] {
