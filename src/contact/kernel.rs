@@ -7,7 +7,7 @@ use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, 
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
 use super::spread::{CellResponse, CellRule, ExactCells};
-use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, JointLevel, SubContact, SubContactRecord};
+use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, JointLevel, SubContact};
 use crate::block::BlockMotion;
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{Matrix, Pose, Real, Vector, Vector2};
@@ -73,7 +73,8 @@ impl KernelContext {
 }
 
 /// Updates one contact for one step: its plane and axes (large-displacement mode), the forces of
-/// its sub-contacts (`subs` and `records` are the contact's own ranges), and returns its
+/// its sub-contacts (`subs` and `dashpot_forces` are the contact's own ranges; `dashpot_forces` may be empty
+/// when the contact has no dashpot forces and is not damped), and returns its
 /// resultant, moments about both centroids and energy increments. Sums run in a fixed order — in
 /// sub-contact order, or, four at a time, per lane, the lanes added in order, then the remaining
 /// sub-contacts — so the result does not depend on how contacts are spread over threads.
@@ -97,7 +98,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
     reference: &ContactReference,
     subs: &mut [SubContact<L::State>],
-    records: &mut [SubContactRecord],
+    dashpot_forces: &mut [Vector],
     sa: &BlockMotion,
     sb: &BlockMotion,
     law: &L,
@@ -160,6 +161,10 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     // Last step's dashpot forces still owe the second half of their work (also in the step
     // after Rayleigh damping was switched off).
     let dashpots = damped || pair.dashpots;
+    // Damped, the model keeps the dashpot forces; otherwise they are all zero, and an empty
+    // list stands for them (a new contact, or one after Rayleigh damping was switched off,
+    // still takes the dashpots' loop and order of sums).
+    debug_assert!(!damped || dashpot_forces.len() == subs.len(), "dashpot forces not kept");
 
     // Spring-force sums in the joint axes.
     let mut sums = ForceMoments::default();
@@ -262,14 +267,15 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
         done = groups.len() * LANES;
         (sums, dissipated, fracture) = lanes.total();
     }
-    for (sub, record) in subs[done..].iter_mut().zip(records[done..].iter_mut()) {
+    for (i, sub) in subs.iter_mut().enumerate().skip(done) {
         let (x, y) = (sub.plane.x, sub.plane.y);
         let cell = face_gap_coefficients.map(|g| exact.cell(law, sub, face_gap(g, x, y)));
         let face = cell.map(|c| c.law_gap);
         // A separated sub-contact that the law says stays open with no force and no change of
         // state needs neither kinematics nor an update (nor a dashpot: it had none and gets none).
         if let Some(gap) = face {
-            if (!dashpots || record.dashpot == Vector::ZERO) && stays_separated(law, sub, gap) {
+            if (!dashpots || dashpot_forces.get(i).is_none_or(|d| *d == Vector::ZERO)) && stays_separated(law, sub, gap)
+            {
                 sub.gap = gap;
                 continue;
             }
@@ -293,9 +299,12 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 }
             }
             let du = n * du_n + t1 * du_1 + t2 * du_2;
-            dashpot_sum += (record.dashpot + dashpot).dot(du);
+            let held = dashpot_forces.get(i).copied().unwrap_or(Vector::ZERO);
+            dashpot_sum += (held + dashpot).dot(du);
             dashpot_moments.add(dashpot, sub.plane);
-            record.dashpot = dashpot;
+            if let Some(d) = dashpot_forces.get_mut(i) {
+                *d = dashpot;
+            }
         }
     }
     pair.dashpots = damped;

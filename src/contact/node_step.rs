@@ -101,7 +101,8 @@ pub(crate) fn turned_shear(shear: Vector2, on_b: bool, shape: &Polyhedron, from:
 pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
     subs: &mut [SubContact<L::State>],
-    records: &mut [SubContactRecord],
+    records: &[SubContactRecord],
+    dashpot_forces: &mut [Vector],
     a: NodeBlock<'_>,
     b: NodeBlock<'_>,
     law: &L,
@@ -113,13 +114,17 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     let dt = ctx.dt;
     let (damped, cn, cs) = ctx.dashpot_coefficients(law.stiffness());
     let dashpots = damped || pair.dashpots;
+    // Damped, the model keeps the dashpot forces; otherwise they are all zero, and an empty
+    // list stands for them (a new contact, or one after Rayleigh damping was switched off,
+    // still takes the dashpots' loop and order of sums).
+    debug_assert!(!damped || dashpot_forces.len() == subs.len(), "dashpot forces not kept");
     let threshold = ctx.impact_speed * dt;
     let reach = ctx.impact_horizon / dt;
     let mut step = ContactStep::default();
     let (mut force, mut moment_a, mut moment_b) = (Vector::ZERO, Vector::ZERO, Vector::ZERO);
     let (mut spring_sum, mut dashpot_sum, mut normal_force) = (0.0, 0.0, 0.0);
     let mut fastest: Real = 0.0;
-    for (sub, record) in subs.iter_mut().zip(records.iter_mut()) {
+    for (i, (sub, record)) in subs.iter_mut().zip(records).enumerate() {
         let id = NodeId::from_key(record.key);
         let frame = node_frame(id, a, b);
         let other_shape = if id.on_b { a.2 } else { b.2 };
@@ -150,7 +155,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
                 && (gap > 0.0) != (du_n > 0.0)
                 && gap.abs() < reach * du_n.abs()
                 && law.stays_open(sub.area, gap.abs(), &sub.state));
-        if (!dashpots || record.dashpot == Vector::ZERO) && stays_separated(law, sub, gap) {
+        if (!dashpots || dashpot_forces.get(i).is_none_or(|d| *d == Vector::ZERO)) && stays_separated(law, sub, gap) {
             sub.gap = gap;
             continue;
         }
@@ -170,8 +175,11 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
                     dashpot -= axes.shear(du_s) * (cs * sub.area);
                 }
             }
-            dashpot_sum += (record.dashpot + dashpot).dot(du);
-            record.dashpot = dashpot;
+            let held = dashpot_forces.get(i).copied().unwrap_or(Vector::ZERO);
+            dashpot_sum += (held + dashpot).dot(du);
+            if let Some(d) = dashpot_forces.get_mut(i) {
+                *d = dashpot;
+            }
             total += dashpot;
         }
         // The force on b at the node, its opposite on a.

@@ -1,11 +1,13 @@
 //! The contacts as the step stores them: the pairs, their references and wrenches, the
 //! sub-contacts and their records, struct of arrays (each contact owns a contiguous range of
-//! the sub-contacts, `ContactPair::range`). One owner, [`ContactStore`], and the views the
+//! the sub-contacts, `ContactPair::range`), and the sub-contacts' dashpot forces when the model
+//! has any. One owner, [`ContactStore`], and the views the
 //! stages take of it: [`OldContacts`] (detection reading the contacts it replaces),
 //! [`ContactLists`] (detection rearranging them) and [`ContactSlices`] (the contact pass
 //! writing them, split at chunk boundaries).
 
 use super::{ContactPair, ContactReference, ContactWrench, SubContact, SubContactRecord};
+use crate::math::Vector;
 
 /// The contacts of a model (or detection's staging lists): struct of arrays, kept index for
 /// index (`pairs`, `references`, `wrenches`; `subs`, `sub_records`).
@@ -22,8 +24,16 @@ pub(crate) struct ContactStore<S> {
     pub wrenches: Vec<ContactWrench>,
     /// The sub-contacts, each contact's in its range.
     pub subs: Vec<SubContact<S>>,
-    /// The sub-contacts' records (key, dashpot force), index for index with `subs`.
+    /// The sub-contacts' records (keys), index for index with `subs`.
     pub sub_records: Vec<SubContactRecord>,
+    /// The sub-contacts' stiffness-proportional (Rayleigh) dashpot forces on `b` (world) of the
+    /// last step, index for index with `subs` while `dashpots_kept` — empty otherwise, while
+    /// no sub-contact of the model can hold one (no Rayleigh damping since the model was built
+    /// or loaded): every dashpot force is then zero, and the list costs nothing. Filled with
+    /// zeros when a step first needs it ([`ContactStore::keep_dashpots`]), and kept since.
+    pub sub_dashpots: Vec<Vector>,
+    /// Whether `sub_dashpots` is kept (index for index with `subs`).
+    pub dashpots_kept: bool,
 }
 
 impl<S> Default for ContactStore<S> {
@@ -34,6 +44,8 @@ impl<S> Default for ContactStore<S> {
             wrenches: Vec::new(),
             subs: Vec::new(),
             sub_records: Vec::new(),
+            sub_dashpots: Vec::new(),
+            dashpots_kept: false,
         }
     }
 }
@@ -46,7 +58,22 @@ impl<S> ContactStore<S> {
             references: &self.references,
             subs: &self.subs,
             records: &self.sub_records,
+            dashpots: &self.sub_dashpots,
         }
+    }
+
+    /// Keeps the sub-contacts' dashpot forces from now on (zero where none was kept).
+    pub(crate) fn keep_dashpots(&mut self) {
+        if !self.dashpots_kept {
+            self.dashpots_kept = true;
+            self.sub_dashpots.clear();
+            self.sub_dashpots.resize(self.subs.len(), Vector::ZERO);
+        }
+    }
+
+    /// The dashpot force of sub-contact `i` (zero when none are kept).
+    pub(crate) fn dashpot(&self, i: usize) -> Vector {
+        self.sub_dashpots.get(i).copied().unwrap_or(Vector::ZERO)
     }
 
     /// The lists as detection rearranges them.
@@ -57,6 +84,8 @@ impl<S> ContactStore<S> {
             wrenches: &mut self.wrenches,
             subs: &mut self.subs,
             records: &mut self.sub_records,
+            dashpots: &mut self.sub_dashpots,
+            dashpots_kept: self.dashpots_kept,
         }
     }
 
@@ -76,6 +105,11 @@ impl<S> ContactStore<S> {
                 sums,
                 subs: &mut self.subs[first_sub..],
                 records: &mut self.sub_records[first_sub..],
+                dashpots: if self.dashpots_kept {
+                    &mut self.sub_dashpots[first_sub..]
+                } else {
+                    &mut []
+                },
             },
         )
     }
@@ -84,6 +118,7 @@ impl<S> ContactStore<S> {
     /// load; the step asserts it).
     pub(crate) fn in_step(&self) -> bool {
         self.sub_records.len() == self.subs.len()
+            && self.sub_dashpots.len() == if self.dashpots_kept { self.subs.len() } else { 0 }
             && self.wrenches.len() == self.pairs.len()
             && self.references.len() == self.pairs.len()
     }
@@ -95,6 +130,15 @@ pub(crate) struct OldContacts<'a, S> {
     pub(crate) references: &'a [ContactReference],
     pub(crate) subs: &'a [SubContact<S>],
     pub(crate) records: &'a [SubContactRecord],
+    /// Empty when the model keeps no dashpot forces.
+    pub(crate) dashpots: &'a [Vector],
+}
+
+impl<S> OldContacts<'_, S> {
+    /// The dashpot force of sub-contact `i` (zero when none are kept).
+    pub(crate) fn dashpot(&self, i: usize) -> Vector {
+        self.dashpots.get(i).copied().unwrap_or(Vector::ZERO)
+    }
 }
 
 /// Contact lists as detection writes them: the staging lists, or the model's as they are
@@ -105,6 +149,9 @@ pub(crate) struct ContactLists<'a, S> {
     pub(crate) wrenches: &'a mut Vec<ContactWrench>,
     pub(crate) subs: &'a mut Vec<SubContact<S>>,
     pub(crate) records: &'a mut Vec<SubContactRecord>,
+    /// Index for index with `subs` when `dashpots_kept`, empty otherwise.
+    pub(crate) dashpots: &'a mut Vec<Vector>,
+    pub(crate) dashpots_kept: bool,
 }
 
 impl<S> ContactLists<'_, S> {
@@ -115,6 +162,7 @@ impl<S> ContactLists<'_, S> {
         self.wrenches.clear();
         self.subs.clear();
         self.records.clear();
+        self.dashpots.clear();
     }
 }
 
@@ -130,6 +178,8 @@ pub(crate) struct ContactSlices<'a, S, T> {
     /// The sub-contacts of `pairs`, from the first contact's first one.
     pub subs: &'a mut [SubContact<S>],
     pub records: &'a mut [SubContactRecord],
+    /// The sub-contacts' dashpot forces, or empty when the model keeps none.
+    pub dashpots: &'a mut [Vector],
 }
 
 impl<S, T> ContactSlices<'_, S, T> {
@@ -143,6 +193,11 @@ impl<S, T> ContactSlices<'_, S, T> {
         let (sums, sums_right) = self.sums.split_at_mut(chunks);
         let (subs, subs_right) = self.subs.split_at_mut(sub_at);
         let (records, records_right) = self.records.split_at_mut(sub_at);
+        let (dashpots, dashpots_right) = if self.dashpots.is_empty() {
+            (self.dashpots, &mut [][..])
+        } else {
+            self.dashpots.split_at_mut(sub_at)
+        };
         (
             Self {
                 first: self.first,
@@ -151,6 +206,7 @@ impl<S, T> ContactSlices<'_, S, T> {
                 sums,
                 subs,
                 records,
+                dashpots,
             },
             Self {
                 first: self.first + at,
@@ -159,6 +215,7 @@ impl<S, T> ContactSlices<'_, S, T> {
                 sums: sums_right,
                 subs: subs_right,
                 records: records_right,
+                dashpots: dashpots_right,
             },
         )
     }

@@ -146,6 +146,8 @@ pub struct ContactView<'a, S> {
     pair: &'a ContactPair,
     subs: &'a [SubContact<S>],
     records: &'a [SubContactRecord],
+    /// The sub-contacts' dashpot forces, or empty when the model keeps none.
+    dashpots: &'a [Vector],
     /// Maps anchors to world points: the host block's pose (its pose at detection in
     /// small-displacement mode).
     frame: Pose,
@@ -158,16 +160,18 @@ impl<'a, S> ContactView<'a, S> {
     pub(crate) fn new(
         pair: &'a ContactPair,
         subs: &'a [SubContact<S>],
-        records: &'a [SubContactRecord],
+        (records, dashpots): (&'a [SubContactRecord], &'a [Vector]),
         frame: Pose,
         wrench: ContactWrench,
         (nodes, cells): (Option<NodeGeometry<'a>>, Option<CellGeometry<'a, S>>),
     ) -> Self {
         debug_assert_eq!(subs.len(), records.len());
+        debug_assert!(dashpots.is_empty() || dashpots.len() == subs.len());
         Self {
             pair,
             subs,
             records,
+            dashpots,
             frame,
             wrench,
             nodes,
@@ -223,16 +227,18 @@ impl<'a, S> ContactView<'a, S> {
     }
     /// The sub-contacts, in order.
     pub fn subcontacts(&self) -> impl ExactSizeIterator<Item = SubContactView<'a, S>> + 'a {
-        let (pair, frame, nodes, cells) = (self.pair, self.frame, self.nodes, self.cells);
+        let (pair, frame, nodes, cells, dashpots) = (self.pair, self.frame, self.nodes, self.cells, self.dashpots);
         self.subs
             .iter()
             .zip(self.records)
-            .map(move |(sub, record)| SubContactView {
+            .enumerate()
+            .map(move |(i, (sub, record))| SubContactView {
                 pair,
                 frame,
                 sub,
                 live: pair.joint.live(sub),
                 record,
+                dashpot: dashpots.get(i).copied().unwrap_or(Vector::ZERO),
                 nodes,
                 cells,
             })
@@ -246,6 +252,7 @@ impl<'a, S> ContactView<'a, S> {
             sub,
             live: self.pair.joint.live(sub),
             record: &self.records[index],
+            dashpot: self.dashpots.get(index).copied().unwrap_or(Vector::ZERO),
             nodes: self.nodes,
             cells: self.cells,
         })
@@ -312,6 +319,8 @@ pub struct SubContactView<'a, S> {
     /// while the joint is stepped as a whole (`joint_level.rs`).
     live: (JointForce, Real, JointStatus),
     record: &'a SubContactRecord,
+    /// Its dashpot force (zero when the model keeps none).
+    dashpot: Vector,
     nodes: Option<NodeGeometry<'a>>,
     cells: Option<CellGeometry<'a, S>>,
 }
@@ -404,11 +413,11 @@ impl<'a, S> SubContactView<'a, S> {
     /// Stiffness-proportional (Rayleigh) dashpot force on block `b` (N, world); zero without
     /// Rayleigh damping.
     pub fn dashpot_force(&self) -> Vector {
-        self.record.dashpot
+        self.dashpot
     }
     /// Spring plus dashpot force on block `b` (N, world).
     pub fn total_force(&self) -> Vector {
-        self.axes().force(&self.live.0) + self.record.dashpot
+        self.axes().force(&self.live.0) + self.dashpot
     }
     /// Slip accumulated while sliding (m): the sum of the shear displacement increments of the
     /// steps that ended sliding.

@@ -124,7 +124,14 @@ impl<L: ConstitutiveLaw> Model<L> {
         ContactView::new(
             p,
             &self.state.contacts.subs[p.range()],
-            &self.state.contacts.sub_records[p.range()],
+            (
+                &self.state.contacts.sub_records[p.range()],
+                if self.state.contacts.dashpots_kept {
+                    &self.state.contacts.sub_dashpots[p.range()]
+                } else {
+                    &[]
+                },
+            ),
             p.frame(
                 &self.state.contacts.references[k],
                 &sa.pose,

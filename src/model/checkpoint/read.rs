@@ -35,6 +35,12 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
         Vec::with_capacity(entries.len()),
     );
     let (mut subs, mut records) = (Vec::with_capacity(total), Vec::with_capacity(total));
+    // Kept only when some sub-contact holds a dashpot force (a model without Rayleigh damping
+    // keeps none; one with it fills them at its next step).
+    let kept = entries
+        .iter()
+        .any(|e| e.subcontacts.iter().any(|s| s.dashpot != Vector::ZERO));
+    let mut dashpots = Vec::with_capacity(if kept { total } else { 0 });
     for (k, e) in entries.into_iter().enumerate() {
         let first = subs.len() as u32;
         let count = e.subcontacts.len() as u32;
@@ -82,10 +88,10 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
                 }
             }
             subs.push(sub);
-            records.push(SubContactRecord {
-                key: s.key,
-                dashpot: s.dashpot,
-            });
+            records.push(SubContactRecord { key: s.key });
+            if kept {
+                dashpots.push(s.dashpot);
+            }
         }
         pairs.push(ContactPair {
             a: e.blocks.0,
@@ -126,6 +132,8 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
         wrenches,
         subs,
         sub_records: records,
+        sub_dashpots: dashpots,
+        dashpots_kept: kept,
     })
 }
 
@@ -520,9 +528,10 @@ fn restore_contacts<L: ConstitutiveLaw>(
         p.cache_local_faces(Block::shape(a), Block::shape(b));
         p.cells = crate::contact::CellSummary::of(&model.state.contacts.subs[p.range()]);
         // Dashpot forces still held must be seen (and their work booked) by the next step.
-        p.dashpots |= model.state.contacts.sub_records[p.range()]
-            .iter()
-            .any(|r| r.dashpot != Vector::ZERO);
+        p.dashpots |= model.state.contacts.dashpots_kept
+            && model.state.contacts.sub_dashpots[p.range()]
+                .iter()
+                .any(|d| *d != Vector::ZERO);
         // A cell's half sizes are lengths: finite (a huge number read into an `f32` is
         // infinite, and would be saved as `null`) and not negative.
         if let Some(j) = model.state.contacts.subs[p.range()]

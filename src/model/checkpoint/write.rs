@@ -39,7 +39,8 @@ impl<L: ConstitutiveLaw> Model<L> {
             subcontacts: self.state.contacts.subs[range.clone()]
                 .iter()
                 .zip(&self.state.contacts.sub_records[range.clone()])
-                .map(|(s, rec)| {
+                .zip(range.clone())
+                .map(|((s, rec), i)| {
                     let (force, gap, status) = p.joint.live(s);
                     SubContactEntry {
                         key: rec.key,
@@ -51,7 +52,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                         half: s.half,
                         status,
                         state: s.state.clone(),
-                        dashpot: rec.dashpot,
+                        dashpot: self.state.contacts.dashpot(i),
                     }
                 })
                 .collect(),

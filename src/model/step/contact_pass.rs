@@ -111,6 +111,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             sums,
             subs,
             records,
+            dashpots,
         } = chunk;
         let sums = &mut sums[0];
         let base = pairs[0].first as usize;
@@ -119,12 +120,19 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             let (ma, mb) = (&self.motions[p.a as usize], &self.motions[p.b as usize]);
             let range = p.first as usize - base..p.first as usize - base + p.count as usize;
             let watch = !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok();
+            // Empty when the model keeps no dashpot forces.
+            let dashpots = if dashpots.is_empty() {
+                &mut [][..]
+            } else {
+                &mut dashpots[range.clone()]
+            };
             let step = if matches!(p.kind, ContactKind::Nodes) {
                 let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
                 update_nodes(
                     p,
                     &mut subs[range.clone()],
-                    &mut records[range],
+                    &records[range],
+                    dashpots,
                     (&a.state, &ma.rotation, a.shape()),
                     (&b.state, &mb.rotation, b.shape()),
                     &self.laws[p.law as usize],
@@ -135,8 +143,8 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 update_contact(
                     p,
                     reference,
-                    &mut subs[range.clone()],
-                    &mut records[range],
+                    &mut subs[range],
+                    dashpots,
                     ma,
                     mb,
                     &self.laws[p.law as usize],
@@ -203,6 +211,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             lanes: crate::contact::LaneBuild::Portable,
             joint_level: self.joint_stepping == crate::model::JointStepping::Whole,
         };
+        // Rayleigh damping puts dashpot forces on the sub-contacts: the model keeps them from
+        // its first damped step on.
+        if ctx.stiffness_damping > 0.0 {
+            self.contacts.keep_dashpots();
+        }
         // The records run index for index with the sub-contacts (kept so by detection and
         // checkpoint load).
         assert!(self.contacts.in_step(), "contact lists out of step");

@@ -385,7 +385,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             keep_within: (!full).then_some(KEEP_FRACTION * trigger),
             pairs: &self.contacts.pairs,
             subs: &self.contacts.subs,
-            records: &self.contacts.sub_records,
+            dashpots: &self.contacts.sub_dashpots,
         };
         // In batches, so that the seeds of a full detection are not all held at once: the tests
         // of a batch in parallel; the places of its contacts in the staging lists, in plan
@@ -393,6 +393,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // A full detection stages its contacts in a fresh layout (`place_subcontacts`): dead
         // room after every `SEGMENT` contacts.
         sc.staging.lists().clear();
+        sc.staging.store.dashpots_kept = self.contacts.dashpots_kept;
         sc.staging_spread = full;
         sc.segment_subs = 0;
         for start in (0..sc.plan.len()).step_by(BATCH) {
@@ -440,6 +441,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 .map_or(0, |p| (p.first + p.count) as usize);
             sc.staging.store.subs.truncate(end);
             sc.staging.store.sub_records.truncate(end);
+            sc.staging.store.sub_dashpots.truncate(end);
         }
         let index = BlockIndex {
             offsets: &pipeline.block_offsets,

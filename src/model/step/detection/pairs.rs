@@ -2,7 +2,7 @@
 //! detection (candidates with their old entries), the parallel narrow phase over it.
 
 use crate::block::{Block, RigidBlock};
-use crate::contact::{ContactPair, SubContact, SubContactRecord};
+use crate::contact::{ContactPair, SubContact};
 use crate::geometry::{
     detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact,
     SubContactSeed,
@@ -104,10 +104,10 @@ pub(super) struct PairTest<'a, S> {
     pub(super) blocks: &'a [RigidBlock],
     pub(super) tested: &'a [TestedPair],
     pub(super) pairs: &'a [ContactPair],
-    /// The contacts' sub-contacts and their records (their history, for
-    /// [`PreviousContact::blank`]).
+    /// The contacts' sub-contacts and their dashpot forces (their history, for
+    /// [`PreviousContact::blank`]; empty when the model keeps no dashpot forces).
     pub(super) subs: &'a [SubContact<S>],
-    pub(super) records: &'a [SubContactRecord],
+    pub(super) dashpots: &'a [Vector],
     pub(super) params: &'a ContactParameters,
     /// The relative motion within which a contact keeps its verdict; `None` tests every pair.
     pub(super) keep_within: Option<Real>,
@@ -132,7 +132,10 @@ impl<S: PartialEq + Default> PairTest<'_, S> {
         self.subs[p.range()]
             .iter()
             .all(|s| s.force == JointForce::default() && s.state == fresh)
-            && self.records[p.range()].iter().all(|r| r.dashpot == Vector::ZERO)
+            && self
+                .dashpots
+                .get(p.range())
+                .is_none_or(|d| d.iter().all(|d| *d == Vector::ZERO))
     }
 
     /// Decides and, where needed, tests one chunk of planned pairs.

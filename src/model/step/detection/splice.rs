@@ -5,7 +5,8 @@
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    stored_node_frame, ContactLists, ContactPair, ContactWrench, DisplacementMode, OldContacts, SubContactRecord,
+    stored_node_frame, ContactLists, ContactPair, ContactStore, ContactWrench, DisplacementMode, OldContacts,
+    SubContactRecord,
 };
 use crate::error::Result;
 use crate::geometry::{ContactKind, NodeId};
@@ -141,6 +142,40 @@ pub(super) fn move_into_dead_room<T>(list: &mut [T], range: std::ops::Range<usiz
     }
 }
 
+impl<S: Clone + Default> ContactStore<S> {
+    /// Makes the sub-contact lists (with their records and dashpot forces, when kept) `len`
+    /// long: dead room added at the end (never read), or the end cut off.
+    pub(super) fn resize_subcontacts(&mut self, len: usize) {
+        let (sub, record) = dead_subcontact();
+        self.subs.resize(len, sub);
+        self.sub_records.resize(len, record);
+        if self.dashpots_kept {
+            self.sub_dashpots.resize(len, Vector::ZERO);
+        }
+    }
+
+    /// Moves sub-contacts `range` (with their records and dashpot forces) by `shift` places
+    /// into dead room ([`move_into_dead_room`]).
+    pub(super) fn move_subcontacts(&mut self, range: std::ops::Range<usize>, shift: i64) {
+        move_into_dead_room(&mut self.subs, range.clone(), shift);
+        move_into_dead_room(&mut self.sub_records, range.clone(), shift);
+        if self.dashpots_kept {
+            move_into_dead_room(&mut self.sub_dashpots, range, shift);
+        }
+    }
+
+    /// Writes `from`'s sub-contacts `range` (with their records and dashpot forces) from
+    /// sub-contact `to` on.
+    pub(super) fn copy_subcontacts(&mut self, to: usize, from: &Self, range: std::ops::Range<usize>) {
+        let end = to + range.len();
+        self.subs[to..end].clone_from_slice(&from.subs[range.clone()]);
+        self.sub_records[to..end].clone_from_slice(&from.sub_records[range.clone()]);
+        if self.dashpots_kept {
+            self.sub_dashpots[to..end].copy_from_slice(&from.sub_dashpots[range]);
+        }
+    }
+}
+
 /// Which runs of kept contacts [`ContactLists::move_run`] moves.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum Direction {
@@ -168,7 +203,10 @@ impl<S> ContactLists<'_, S> {
     pub(super) fn move_subcontacts(&mut self, range: std::ops::Range<usize>, shift: i64, direction: Direction) {
         if (direction == Direction::Front && shift < 0) || (direction == Direction::Back && shift > 0) {
             move_into_dead_room(self.subs, range.clone(), shift);
-            move_into_dead_room(self.records, range, shift);
+            move_into_dead_room(self.records, range.clone(), shift);
+            if self.dashpots_kept {
+                move_into_dead_room(self.dashpots, range, shift);
+            }
         }
     }
 }
@@ -286,7 +324,8 @@ pub(super) fn add_dropped_work<S>(
     } else {
         (Matrix::IDENTITY, Matrix::IDENTITY)
     };
-    for (s, r) in old.subs[p.range()].iter().zip(&old.records[p.range()]) {
+    for ((s, r), i) in old.subs[p.range()].iter().zip(&old.records[p.range()]).zip(p.range()) {
+        let dashpot = old.dashpot(i);
         let (pt, axes) = if nodes {
             stored_node_frame(
                 NodeId::from_key(r.key),
@@ -298,7 +337,7 @@ pub(super) fn add_dropped_work<S>(
             (frame.transform_point(p.anchor(s)), p.axes())
         };
         let spring = axes.force(&s.force);
-        if spring == Vector::ZERO && r.dashpot == Vector::ZERO {
+        if spring == Vector::ZERO && dashpot == Vector::ZERO {
             continue;
         }
         if carried.is_some_and(|records| records.binary_search_by_key(&r.key, |t| t.key).is_ok()) {
@@ -308,7 +347,7 @@ pub(super) fn add_dropped_work<S>(
             (sb.velocity + sb.angular_velocity.cross(pt - xb)) - (sa.velocity + sa.angular_velocity.cross(pt - xa));
         let du = v_rel * dt;
         owed.0 -= 0.5 * spring.dot(du);
-        owed.1 -= 0.5 * r.dashpot.dot(du);
+        owed.1 -= 0.5 * dashpot.dot(du);
     }
 }
 
@@ -438,9 +477,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         if needed > room {
             // Dead room (sub-contacts not in any contact's range are never read).
-            let (sub, record) = dead_subcontact();
-            self.contacts.subs.resize(needed as usize, sub);
-            self.contacts.sub_records.resize(needed as usize, record);
+            self.contacts.resize_subcontacts(needed as usize);
         }
         // Pushed contacts move from the last: each moves into room that is dead by then (the
         // old room of the ones after it, which moved further back, or of re-tested ones).
@@ -452,18 +489,16 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 (last.first + last.count + run.shift) as usize,
             );
             let moved = start..end - run.shift as usize;
-            move_into_dead_room(&mut self.contacts.subs, moved.clone(), i64::from(run.shift));
-            move_into_dead_room(&mut self.contacts.sub_records, moved, i64::from(run.shift));
             for p in contacts {
                 p.first += run.shift;
             }
+            self.contacts.move_subcontacts(moved, i64::from(run.shift));
         }
         for r in &sc.replaced {
             let (k, s) = (r.contact as usize, r.staged as usize);
             let q = &sc.staging.store.pairs[s];
             let to = r.first as usize..(r.first + q.count) as usize;
-            self.contacts.subs[to.clone()].clone_from_slice(&sc.staging.store.subs[q.range()]);
-            self.contacts.sub_records[to].clone_from_slice(&sc.staging.store.sub_records[q.range()]);
+            self.contacts.copy_subcontacts(to.start, &sc.staging.store, q.range());
             self.contacts.pairs[k] = q.clone();
             self.contacts.pairs[k].first = r.first;
             self.contacts.references[k] = sc.staging.store.references[s].clone();
@@ -548,6 +583,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             std::mem::swap(&mut self.contacts.wrenches, &mut sc.staging.store.wrenches);
             std::mem::swap(&mut self.contacts.subs, &mut sc.staging.store.subs);
             std::mem::swap(&mut self.contacts.sub_records, &mut sc.staging.store.sub_records);
+            std::mem::swap(&mut self.contacts.sub_dashpots, &mut sc.staging.store.sub_dashpots);
             sc.release_staging();
             sc.room_limit = room_limit(self.contacts.pairs.iter().map(|p| p.count as usize).sum());
             sc.splices.full += 1;
@@ -583,9 +619,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         if room > self.contacts.subs.len() {
             // Dead room (sub-contacts not in any contact's range are never read).
-            let (sub, record) = dead_subcontact();
-            self.contacts.subs.resize(room, sub);
-            self.contacts.sub_records.resize(room, record);
+            self.contacts.resize_subcontacts(room);
         }
         // The kept contacts' sub-contacts move first, in runs of equal shift (while the contacts
         // still hold their old ranges), then the contacts, in runs that were neighbours and stay
@@ -636,7 +670,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     let q = &sc.staging.store.pairs[s as usize];
                     let (from, to) = (q.range(), first as usize..(first + q.count) as usize);
                     lists.subs[to.clone()].clone_from_slice(&sc.staging.store.subs[from.clone()]);
-                    lists.records[to].clone_from_slice(&sc.staging.store.sub_records[from]);
+                    lists.records[to.clone()].clone_from_slice(&sc.staging.store.sub_records[from.clone()]);
+                    if lists.dashpots_kept {
+                        lists.dashpots[to].copy_from_slice(&sc.staging.store.sub_dashpots[from]);
+                    }
                     lists.pairs[k] = q.clone();
                     lists.pairs[k].first = first;
                     lists.references[k] = sc.staging.store.references[s as usize].clone();
@@ -647,8 +684,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         self.contacts.pairs.truncate(contacts);
         self.contacts.references.truncate(contacts);
         self.contacts.wrenches.truncate(contacts);
-        self.contacts.subs.truncate(room);
-        self.contacts.sub_records.truncate(room);
+        self.contacts.resize_subcontacts(room);
         if STAGING_FRACTION * sc.staging.store.subs.capacity() > self.contacts.subs.len().max(1) {
             sc.release_staging();
         }
@@ -667,22 +703,16 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let mut shift: u32 = (0..segments.saturating_sub(1))
             .map(|k| slack(&self.contacts.pairs, k))
             .sum();
-        let (sub, record) = dead_subcontact();
         self.contacts
-            .subs
-            .resize(self.contacts.subs.len() + shift as usize, sub);
-        self.contacts
-            .sub_records
-            .resize(self.contacts.sub_records.len() + shift as usize, record);
+            .resize_subcontacts(self.contacts.subs.len() + shift as usize);
         for k in (1..segments).rev() {
             let contacts = &mut self.contacts.pairs[segment(k)];
             let last = &contacts[contacts.len() - 1];
             let (start, end) = (contacts[0].first as usize, (last.first + last.count) as usize);
-            move_into_dead_room(&mut self.contacts.subs, start..end, i64::from(shift));
-            move_into_dead_room(&mut self.contacts.sub_records, start..end, i64::from(shift));
             for p in contacts.iter_mut() {
                 p.first += shift;
             }
+            self.contacts.move_subcontacts(start..end, i64::from(shift));
             shift -= slack(&self.contacts.pairs, k - 1);
         }
     }

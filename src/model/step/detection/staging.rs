@@ -110,6 +110,11 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
         self.store
             .sub_records
             .par_extend(rayon::iter::repeat_n(record, subs - sub_base));
+        if self.store.dashpots_kept {
+            self.store
+                .sub_dashpots
+                .par_extend(rayon::iter::repeat_n(Vector::ZERO, subs - sub_base));
+        }
         StagingSlices {
             pair_base,
             sub_base,
@@ -118,6 +123,11 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
             wrenches: &mut self.store.wrenches[pair_base..],
             subs: &mut self.store.subs[sub_base..],
             records: &mut self.store.sub_records[sub_base..],
+            dashpots: if self.store.dashpots_kept {
+                &mut self.store.sub_dashpots[sub_base..]
+            } else {
+                &mut []
+            },
         }
     }
 }
@@ -132,6 +142,8 @@ pub(super) struct StagingSlices<'a, S> {
     pub(super) wrenches: &'a mut [ContactWrench],
     pub(super) subs: &'a mut [SubContact<S>],
     pub(super) records: &'a mut [SubContactRecord],
+    /// The sub-contacts' dashpot forces, or empty when the model keeps none.
+    pub(super) dashpots: &'a mut [Vector],
 }
 
 impl<'a, S> StagingSlices<'a, S> {
@@ -144,6 +156,11 @@ impl<'a, S> StagingSlices<'a, S> {
         let (wrenches_a, wrenches_b) = self.wrenches.split_at_mut(p);
         let (subs_a, subs_b) = self.subs.split_at_mut(s);
         let (records_a, records_b) = self.records.split_at_mut(s);
+        let (dashpots_a, dashpots_b) = if self.dashpots.is_empty() {
+            (self.dashpots, &mut [][..])
+        } else {
+            self.dashpots.split_at_mut(s)
+        };
         (
             Self {
                 pair_base: self.pair_base,
@@ -153,6 +170,7 @@ impl<'a, S> StagingSlices<'a, S> {
                 wrenches: wrenches_a,
                 subs: subs_a,
                 records: records_a,
+                dashpots: dashpots_a,
             },
             Self {
                 pair_base: pair,
@@ -162,6 +180,7 @@ impl<'a, S> StagingSlices<'a, S> {
                 wrenches: wrenches_b,
                 subs: subs_b,
                 records: records_b,
+                dashpots: dashpots_b,
             },
         )
     }
@@ -193,7 +212,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             let p = &old.pairs[k];
             debug_assert!(!p.joint.active, "a joint stepped as a whole re-detected unwritten");
             (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
-                .then(|| (&old.subs[p.range()], &old.records[p.range()]))
+                .then(|| (&old.subs[p.range()], &old.records[p.range()], p.first as usize))
         });
         let old_subs = old_subs.flatten();
         // Carried spring forces were composed in the old contact's axes: their shear forces
@@ -203,7 +222,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             (Some(k), Some(_)) => old.pairs[k].axes(),
             _ => JointAxes::from_normal(dc.normal),
         };
-        let (old_subs, old_records) = old_subs.unwrap_or((&[], &[]));
+        let (old_subs, old_records, old_first) = old_subs.unwrap_or((&[], &[], 0));
         let old_anchors = k_old.map_or(AnchorPlane::default(), |k| old.pairs[k].anchors);
         // A face-face contact's anchors lie on the host face, in its frame: the frame its
         // cells' rectangles are aligned with (`contact/spread.rs`).
@@ -224,6 +243,8 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             &mut self.subs[at..at + seeds.len()],
             &mut self.records[at..at + seeds.len()],
         );
+        // Empty when the model keeps no dashpot forces.
+        let dashpots = self.dashpots.get_mut(at..at + seeds.len()).unwrap_or(&mut []);
         let nodes = matches!(dc.kind, ContactKind::Nodes);
         // The state a new sub-contact starts from: a node contact is unbonded
         // (`ConstitutiveLaw::unbonded_state`), a face joint's cell virgin.
@@ -246,7 +267,9 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             Matrix::from_quat(bi.state.pose.rotation),
             Matrix::from_quat(bj.state.pose.rotation),
         );
-        for ((seed, sub_slot), record_slot) in seeds.iter().zip(subs.iter_mut()).zip(records.iter_mut()) {
+        for (n, ((seed, sub_slot), record_slot)) in
+            seeds.iter().zip(subs.iter_mut()).zip(records.iter_mut()).enumerate()
+        {
             let plane = if nodes {
                 // A node's plane coordinates hold the face of the other block it lies deepest
                 // under (`contact/node_step.rs`).
@@ -269,7 +292,8 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 status: JointStatus::Open,
                 state: fresh.clone(),
             };
-            let mut record = SubContactRecord::new(seed.key);
+            let record = SubContactRecord::new(seed.key);
+            let mut dashpot = Vector::ZERO;
             if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
                 let o = &old_subs[k];
                 if nodes {
@@ -290,10 +314,13 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 sub.slip = o.slip;
                 sub.status = o.status;
                 sub.state = o.state.clone();
-                record = old_records[k].clone();
+                dashpot = old.dashpot(old_first + k);
             }
             *sub_slot = sub;
             *record_slot = record;
+            if let Some(slot) = dashpots.get_mut(n) {
+                *slot = dashpot;
+            }
         }
         let mut pair = ContactPair {
             a: i,
@@ -362,6 +389,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             references: &self.contacts.references,
             subs: &self.contacts.subs,
             records: &self.contacts.sub_records,
+            dashpots: &self.contacts.sub_dashpots,
         };
         let mut slices = slices;
         for (p, o) in plan.iter().zip(outcomes) {
