@@ -13,6 +13,7 @@
 //! and sub-contacts), the checksum and the law type's name; `write.rs` writes a checkpoint and
 //! `read.rs` reads and checks one.
 
+mod checks;
 mod read;
 mod tested;
 mod write;
