@@ -53,6 +53,17 @@ pub fn rotation_from_vector(v: Vector) -> Rotation {
     Rotation::from_xyzw(xyz.x, xyz.y, xyz.z, cos)
 }
 
+/// Deterministic pseudo-random numbers in `[0, 1)` for tests: xorshift64 from `seed`.
+#[cfg(test)]
+pub(crate) fn test_uniform(mut seed: u64) -> impl FnMut() -> Real {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as Real / (1u64 << 53) as Real
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

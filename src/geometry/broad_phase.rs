@@ -403,13 +403,8 @@ mod tests {
         let n = poses.len();
 
         // Deterministic pseudo-random numbers in [-1, 1).
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut rand = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as Real / (1u64 << 52) as Real - 1.0
-        };
+        let mut uniform = crate::math::test_uniform(0x9e37_79b9_7f4a_7c15_u64);
+        let mut rand = move || 2.0 * uniform() - 1.0;
 
         let (mut rebuild, mut incremental) = (BroadPhase::default(), BroadPhase::default());
         let (mut expected, mut got) = (Vec::new(), Vec::new());

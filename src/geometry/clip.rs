@@ -176,13 +176,7 @@ mod tests {
     /// them, miss them, or share an edge or a vertex with them.
     #[test]
     fn clip_rect_matches_the_general_half_planes_to_the_bit() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::math::test_uniform(0x9e37_79b9_7f4a_7c15_u64);
         let (mut scratch, mut general) = (Vec::new(), Vec::new());
         for case in 0..2000 {
             let sides = 3 + case % 6;

@@ -245,13 +245,7 @@ mod tests {
     /// full, scales from 1e-3 to 1e12), a zero matrix, a diagonal one and one with a NaN.
     #[test]
     fn interleaved_jacobi_is_the_single_one_to_the_bit() {
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = crate::math::test_uniform(0x2545_f491_4f6c_dd1d_u64);
         let mut matrices = vec![Stiffness6::default()];
         let mut diagonal = Stiffness6::default();
         for i in 0..6 {
