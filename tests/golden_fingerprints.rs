@@ -21,7 +21,11 @@
 //! bricks share one shape; their corners moved by round-off), and when joints closed all over
 //! and sticking were stepped as a whole (issue 45, `contact/joint_level.rs`; round-off only:
 //! their sums come from the cells' area moments, and their shear history is kept as
-//! `F⁰ − k_s A U`; the drops' frictionless joints never stick and kept their bits).
+//! `F⁰ − k_s A U`; the drops' frictionless joints never stick and kept their bits). The
+//! face-contact ones changed again when the critical time step took a face joint's area
+//! moments from those its cells keep on the anchor plane (issue 45; round-off only: the same
+//! moments, summed otherwise, so the time step's last bits moved); the node-contact drops
+//! kept theirs.
 //!
 //! The values are those of x86_64 (with or without AVX2: both kernels give the same bits); the
 //! test does not run elsewhere.
@@ -94,7 +98,7 @@ type Scene = (&'static str, fn() -> Model, u64, u64);
 /// The scenes.
 fn scenes() -> Vec<Scene> {
     vec![
-        ("cube flat", || cube_drop((0.0, 0.0)), 1500, 0xe964_f77a_080a_2c46),
+        ("cube flat", || cube_drop((0.0, 0.0)), 1500, 0xfd3a_a393_3d2b_7b52),
         ("cube on an edge", || cube_drop((0.5, 0.0)), 1500, 0x38a1_94b9_f345_5b52),
         (
             "cube on a corner",
@@ -107,13 +111,13 @@ fn scenes() -> Vec<Scene> {
             "settling wall",
             || voussoir::scenes::benchmark_wall(300).expect("wall"),
             200,
-            0x4ea0_0504_e2d4_93e2,
+            0xddda_0e84_a3a8_c88e,
         ),
         (
             "shaking wall",
             || voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall"),
             400,
-            0x09d5_7a17_bd8e_e136,
+            0x4029_395a_82f8_47be,
         ),
     ]
 }

@@ -199,27 +199,33 @@ fn cube_drops_agree_with_their_cells() {
 /// block slides as in the cell-by-cell step.
 #[test]
 fn a_block_pushed_until_it_slides_agrees_with_its_cells() {
-    let build = |stepping: JointStepping, nudge: bool| {
+    // `ulps`: gravity that many ulps heavier (negative: lighter).
+    let build = |stepping: JointStepping, ulps: Real| {
         let mut model = common::model(CoulombSlip::dry(1e9, 4e8, 30.0).expect("law"));
         model.set_joint_stepping(stepping);
         model.add_block(fixed_slab("slab")).expect("slab");
         let id = model.add_block(cube("cube", Vector::ZERO)).expect("cube");
-        if nudge {
-            one_ulp_heavier(&mut model);
-        }
+        let mut params = *model.parameters();
+        params.gravity.z *= 1.0 + ulps * Real::EPSILON;
+        model.set_parameters(params).expect("parameters");
         model.run_steps(1500).expect("settle");
         (model, id)
     };
     let weight = common::STONE_DENSITY * 0.008 * 9.81;
     let limit = (30.0_f64).to_radians().tan() * weight;
-    let (mut whole, id) = build(JointStepping::Whole, false);
-    let (mut cells, _) = build(JointStepping::Cells, false);
-    let (mut nudged, _) = build(JointStepping::Cells, true);
+    let (mut whole, id) = build(JointStepping::Whole, 0.0);
+    let (mut cells, _) = build(JointStepping::Cells, 0.0);
+    // How far round-off carries in a block that slides is itself a matter of round-off (the
+    // floor of one perturbation read 7.4e-5 on one build and 1.0e-6 on another whose time step
+    // differed in its last bits): the floor is the largest over three perturbations.
+    let (mut heavier, _) = build(JointStepping::Cells, 1.0);
+    let (mut lighter, _) = build(JointStepping::Cells, -1.0);
+    let (mut heavier_2, _) = build(JointStepping::Cells, 2.0);
     let (mut left, mut worst, mut floor) = (false, Worst::default(), Worst::default());
     for k in 0..=60 {
         // Up to 1.2 × the friction limit, tan 30° W, in 60 increments of 50 steps.
         let push = 0.02 * k as Real * limit;
-        for m in [&mut whole, &mut cells, &mut nudged] {
+        for m in [&mut whole, &mut cells, &mut heavier, &mut lighter, &mut heavier_2] {
             m.set_load(
                 id,
                 Wrench {
@@ -231,17 +237,22 @@ fn a_block_pushed_until_it_slides_agrees_with_its_cells() {
             m.run_steps(50).expect("run");
         }
         worst.add(differences(&whole, &cells, 0.2));
-        floor.add(differences(&nudged, &cells, 0.2));
+        for nudged in [&heavier, &lighter, &heavier_2] {
+            floor.add(differences(nudged, &cells, 0.2));
+        }
         let stuck = whole.whole_joint_count() == 1;
         if push < 0.5 * limit {
             assert!(stuck, "push {push:.1} N: sticking, stepped as a whole");
         }
         left |= !stuck;
     }
-    println!("pushed block: {worst} against cells, {floor} one ulp changed");
+    println!("pushed block: {worst} against cells, {floor} gravity one or two ulps changed");
     let slid = cells.blocks()[id.index()].state().pose.translation.x;
     assert!(slid > 1e-3, "the block slid ({slid} m)");
-    assert!(worst.within(&floor), "{worst} against cells, {floor} one ulp changed");
+    assert!(
+        worst.within(&floor),
+        "{worst} against cells, {floor} gravity one or two ulps changed"
+    );
     assert!(left, "the joint left joint-level stepping as it began to slide");
 }
 

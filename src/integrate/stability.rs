@@ -226,6 +226,22 @@ impl Default for AreaMoments {
 }
 
 impl AreaMoments {
+    /// The moments about the plane's origin of cells on a plane with world axes `u`, `v`, from
+    /// their area moments in the plane's coordinates, `[Σ A, Σ A x, Σ A y, Σ A x², Σ A x y,
+    /// Σ A y²]` (a face-face joint's [`crate::contact::CellSummary`]): with `r = x u + y v`,
+    /// `Σ A r = u Σ A x + v Σ A y` and `Σ A r rᵀ = u uᵀ Σ A x² + (u vᵀ + v uᵀ) Σ A x y +
+    /// v vᵀ Σ A y²`. What [`AreaMoments::add`] gives cell by cell, in a number of operations
+    /// that does not depend on the cells (to round-off).
+    pub(crate) fn of_plane(plane: [Real; 6], u: Vector, v: Vector) -> Self {
+        let [a, ax, ay, axx, axy, ayy] = plane;
+        let uv = outer(u, v);
+        Self {
+            s0: a,
+            s1: u * ax + v * ay,
+            s2: outer(u, u) * axx + (uv + uv.transpose()) * axy + outer(v, v) * ayy,
+        }
+    }
+
     pub(crate) fn add(&mut self, p: Vector, area: Real) {
         self.s0 += area;
         self.s1 += p * area;
@@ -294,6 +310,42 @@ fn outer(a: Vector, b: Vector) -> crate::math::Matrix {
 mod tests {
     use super::*;
     use crate::math::Rotation;
+
+    /// The moments from the anchor plane's are those of the cells summed one by one in the
+    /// world, to round-off: random cells on randomly turned planes, about the plane's origin.
+    #[test]
+    fn plane_moments_are_the_cells_moments() {
+        let mut next = crate::math::test_uniform(0x51_7cc1_b727_220a_u64);
+        for _ in 0..200 {
+            let turn = Rotation::from_scaled_axis(Vector::new(next() - 0.5, next() - 0.5, next() - 0.5) * 6.0);
+            let (u, v) = (turn * Vector::X, turn * Vector::Y);
+            let mut plane = [0.0; 6];
+            let mut cells = AreaMoments::default();
+            for _ in 0..1 + (next() * 40.0) as usize {
+                let (x, y, a) = (next() * 0.4 - 0.1, next() * 0.2 - 0.05, next() * 1e-3);
+                for (m, add) in plane.iter_mut().zip([a, a * x, a * y, a * x * x, a * x * y, a * y * y]) {
+                    *m += add;
+                }
+                cells.add(u * x + v * y, a);
+            }
+            let from_plane = AreaMoments::of_plane(plane, u, v);
+            let close = |p: Real, q: Real, scale: Real| (p - q).abs() <= 1e-13 * scale;
+            assert!(close(from_plane.s0, cells.s0, cells.s0));
+            let scale1 = cells.s0 * 0.4;
+            for k in 0..3 {
+                assert!(
+                    close(from_plane.s1[k], cells.s1[k], scale1),
+                    "{:?} vs {:?}",
+                    from_plane.s1,
+                    cells.s1
+                );
+                for l in 0..3 {
+                    let (p, q) = (from_plane.s2.col(l)[k], cells.s2.col(l)[k]);
+                    assert!(close(p, q, cells.s0 * 0.16), "{p} vs {q}");
+                }
+            }
+        }
+    }
 
     /// The moment-based assembly equals the sum of rank-one spring terms.
     #[test]

@@ -256,13 +256,12 @@ impl<L: ConstitutiveLaw> BoundSources<'_, L> {
             let k = stiffness.normal.max(stiffness.shear);
             (stiffness.normal, stiffness.shear) = (k, k);
         } else {
+            // The cells' area moments on the anchor plane, turned into the world about the
+            // plane's origin: the same moments as cell by cell, without a pass over the cells.
             let frame = p.frame(reference, &sa.pose, &sb.pose, s.params.mode);
-            origin = subs
-                .first()
-                .map_or(Vector::ZERO, |s| frame.transform_point(p.anchor(s)));
-            for sub in subs {
-                moments.add(frame.transform_point(p.anchor(sub)) - origin, sub.area);
-            }
+            let plane = &p.anchors;
+            origin = frame.transform_point(plane.origin);
+            moments = AreaMoments::of_plane(p.cells.area_moments, frame.rotation * plane.u, frame.rotation * plane.v);
         }
         ContactStiffness {
             a: p.a as usize,
