@@ -58,14 +58,45 @@ pub(crate) struct JointLevel {
     pub(crate) gap: (Real, Real, Real),
 }
 
+/// Whether every cell of a joint whose cells are all closed at the gap coefficients `g` sticks
+/// by the corner test (module documentation): `τ⁰ + k_s |U| ≤ share · (c + tan φ k_n (−g))` at
+/// the four corners of the box the cells cover, for the largest stress the cells hold, `τ⁰`
+/// (`held_stress`), and the tangential displacement field `U` since (`field`).
+#[inline]
+fn corners_stick(
+    cells: &CellSummary,
+    regime: &ElasticRegime,
+    g: (Real, Real, Real),
+    held_stress: Real,
+    field: &[Vector2; 3],
+) -> bool {
+    let (kn, ks) = (regime.normal_stiffness, regime.shear_stiffness);
+    let (lo, hi) = (cells.lo, cells.hi);
+    [(lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y)]
+        .into_iter()
+        .all(|(x, y)| {
+            let compression = -kn * face_gap(g, x, y);
+            let strength = regime.cohesion + regime.tan_friction * compression;
+            // `τ⁰ + k_s |U| ≤ share · strength`, squared to spare the square root: the room left
+            // above `τ⁰` must not be negative, nor NaN (which fails both tests).
+            let room = STRENGTH_SHARE * strength - held_stress;
+            let u = field[0] + field[1] * x + field[2] * y;
+            room >= 0.0 && ks * ks * u.length_squared() <= room * room
+        })
+}
+
 impl JointLevel {
     /// The joint as the cells `own` leave it after a step in which every one of them took its
     /// law's elastic step (`regime`) as a virgin cell, all closed, and stayed
     /// [`JointStatus::Elastic`], with gap coefficients `gap`; `shear_sums` are the step's sums of
     /// their shear forces. `None` when a cell does not fit (a slide, a state, a zero area that
-    /// holds a force).
+    /// holds a force), or when the joint as it stands already fails the corner test over the
+    /// box of its cells (`cells`): its next joint-level step, which begins with that test, would
+    /// hand it back to its cells (a joint closed by round-off and carrying next to nothing, whose
+    /// cells stick one by one but whose corners have no strength to spare).
     pub(super) fn enter<S: PartialEq + Default>(
         own: &[SubContact<S>],
+        cells: &CellSummary,
         regime: &ElasticRegime,
         gap: (Real, Real, Real),
         shear_sums: [Vector2; 3],
@@ -86,7 +117,8 @@ impl JointLevel {
             };
             held_stress = held_stress.max(stress);
         }
-        held_stress.is_finite().then_some(Self {
+        let sticks = corners_stick(cells, regime, gap, held_stress, &[Vector2::ZERO; 3]);
+        sticks.then_some(Self {
             active: true,
             open: false,
             held: shear_sums,
@@ -170,19 +202,8 @@ impl JointLevel {
             self.field[1] + tangential(kinematics.per_x),
             self.field[2] + tangential(kinematics.per_y),
         ];
-        // The corners of the box the cells cover; the caller found the gap negative over it.
-        let (lo, hi) = (cells.lo, cells.hi);
-        for (x, y) in [(lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y)] {
-            let compression = -kn * face_gap(g, x, y);
-            let strength = regime.cohesion + regime.tan_friction * compression;
-            // `τ⁰ + k_s |U| ≤ share · strength`, squared to spare the square root: the room left
-            // above `τ⁰` must not be negative, nor NaN (which fails both tests).
-            let room = STRENGTH_SHARE * strength - self.held_stress;
-            let u = field[0] + field[1] * x + field[2] * y;
-            let sticks = room >= 0.0 && ks * ks * u.length_squared() <= room * room;
-            if !sticks {
-                return None;
-            }
+        if !corners_stick(cells, regime, g, self.held_stress, &field) {
+            return None;
         }
         self.field = field;
         self.gap = g;
@@ -297,7 +318,7 @@ mod tests {
             Vector2::new(sums.per_x.y, sums.per_x.z),
             Vector2::new(sums.per_y.y, sums.per_y.z),
         ];
-        let mut joint = JointLevel::enter(&cells, &regime, g, held).expect("enters");
+        let mut joint = JointLevel::enter(&cells, &summary, &regime, g, held).expect("enters");
         let mut own = cells.clone();
         for step in 0..50 {
             let t = step as Real;
@@ -346,7 +367,7 @@ mod tests {
         let summary = CellSummary::of(&cells);
         // A uniform gap: every cell carries 1e4 N, and slides at 1e4 tan 30° N.
         let g = (-1e-3, 0.0, 0.0);
-        let mut joint = JointLevel::enter(&cells, &regime, g, [Vector2::ZERO; 3]).expect("enters");
+        let mut joint = JointLevel::enter(&cells, &summary, &regime, g, [Vector2::ZERO; 3]).expect("enters");
         let per_step = 1e-6;
         let kinematics = Kinematics {
             at_origin: Vector::new(0.0, per_step, 0.0),
@@ -364,5 +385,49 @@ mod tests {
             (steps as Real - slides_at.floor()).abs() <= 1.0,
             "{steps} vs {slides_at}"
         );
+    }
+
+    /// A joint enters joint-level stepping only if its corners pass the test as it stands: one
+    /// tilted so that its far corners barely touch, with a cell at the middle holding the
+    /// shear its own compression allows, sticks cell by cell but would fail at a corner, and
+    /// stays with its cells; the same joint holding half that shear enters.
+    #[test]
+    fn a_joint_whose_corners_already_fail_stays_with_its_cells() {
+        let law = CoulombSlip::dry(1e9, 4e8, 30.0).expect("law");
+        let regime = law.elastic_regime().expect("regime");
+        let tan = 30.0_f64.to_radians().tan();
+        // The cells' box spans x in [−0.05, 0.25] (anchors 0.1 apart, half sizes 0.05): closed
+        // by 1e-6 m at x = −0.05 and by 1e-9 m at x = 0.25, `g = g_o − g_x x`.
+        let slope = (1e-6 - 1e-9) / 0.3;
+        let g = (-1e-6 + 0.05 * slope, -slope, 0.0);
+        let joint_with = |share: Real| {
+            let cells: Vec<_> = (0..9)
+                .map(|k| {
+                    let (x, y) = (0.1 * (k % 3) as Real, 0.1 * (k / 3) as Real);
+                    // The middle column's cells hold `share` of what their compression allows.
+                    let closed = -face_gap(g, x, y);
+                    let shear = if k % 3 == 1 {
+                        share * tan * 1e9 * closed * 0.01
+                    } else {
+                        0.0
+                    };
+                    cell(x, y, 0.01, Vector2::new(shear, 0.0))
+                })
+                .collect();
+            let summary = CellSummary::of(&cells);
+            JointLevel::enter(&cells, &summary, &regime, g, [Vector2::ZERO; 3])
+        };
+        assert!(
+            joint_with(0.99).is_none(),
+            "its far corners cannot hold the middle's stress"
+        );
+        // The far corners carry 1e-9 / 5e-7 of the middle's compression: half the middle's
+        // allowance is still far above their strength.
+        assert!(joint_with(0.5).is_none());
+        assert!(
+            joint_with(1e-4).is_some(),
+            "a joint with strength to spare at its corners enters"
+        );
+        assert!(joint_with(0.0).is_some());
     }
 }

@@ -225,7 +225,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                         WholeContact::Closed(_) => {
                             let shear = |v: Vector| Vector2::new(v.y, v.z);
                             let held = [shear(s.force), shear(s.per_x), shear(s.per_y)];
-                            JointLevel::enter(subs, &regime, g, held)
+                            JointLevel::enter(subs, &pair.cells, &regime, g, held)
                         }
                         WholeContact::Mixed if exact.is_some_and(|e| e.virgin_without_tension) => {
                             JointLevel::enter_open(subs, &pair.cells, g)
