@@ -71,7 +71,8 @@ impl<S> ContactStore<S> {
         }
     }
 
-    /// The dashpot force of sub-contact `i` (zero when none are kept).
+    /// The dashpot force of sub-contact `i` (zero when none are kept); read by checkpoints.
+    #[cfg(feature = "serde")]
     pub(crate) fn dashpot(&self, i: usize) -> Vector {
         self.sub_dashpots.get(i).copied().unwrap_or(Vector::ZERO)
     }
@@ -135,7 +136,8 @@ pub(crate) struct OldContacts<'a, S> {
 }
 
 impl<S> OldContacts<'_, S> {
-    /// The dashpot force of sub-contact `i` (zero when none are kept).
+    /// The dashpot force of sub-contact `i` (zero when none are kept); read by checkpoints.
+    #[cfg(feature = "serde")]
     pub(crate) fn dashpot(&self, i: usize) -> Vector {
         self.dashpots.get(i).copied().unwrap_or(Vector::ZERO)
     }
