@@ -388,9 +388,10 @@ mod tests {
     }
 
     /// A joint enters joint-level stepping only if its corners pass the test as it stands: one
-    /// tilted so that its far corners barely touch, with a cell at the middle holding the
-    /// shear its own compression allows, sticks cell by cell but would fail at a corner, and
-    /// stays with its cells; the same joint holding half that shear enters.
+    /// tilted so that its far corners barely touch, with its middle cells holding nearly the
+    /// shear their own compression allows (or half of it), sticks cell by cell but would fail
+    /// at a corner, and stays with its cells; the same joint holding 1e-4 of that shear, which
+    /// its far corners can carry, enters.
     #[test]
     fn a_joint_whose_corners_already_fail_stays_with_its_cells() {
         let law = CoulombSlip::dry(1e9, 4e8, 30.0).expect("law");
