@@ -136,8 +136,7 @@ pub(crate) struct OldContacts<'a, S> {
 }
 
 impl<S> OldContacts<'_, S> {
-    /// The dashpot force of sub-contact `i` (zero when none are kept); read by checkpoints.
-    #[cfg(feature = "serde")]
+    /// The dashpot force of sub-contact `i` (zero when none are kept).
     pub(crate) fn dashpot(&self, i: usize) -> Vector {
         self.dashpots.get(i).copied().unwrap_or(Vector::ZERO)
     }
