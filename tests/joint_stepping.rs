@@ -62,8 +62,13 @@ fn differences(whole: &Model, cells: &Model, length: Real) -> (Real, Real, Real)
 
 /// Gravity changed by one ulp: how far round-off carries in a scene.
 fn one_ulp_heavier(model: &mut Model) {
+    heavier_by_ulps(model, 1.0);
+}
+
+/// Gravity `ulps` ulps heavier (negative: lighter).
+fn heavier_by_ulps(model: &mut Model, ulps: Real) {
     let mut params = *model.parameters();
-    params.gravity.z *= 1.0 + Real::EPSILON;
+    params.gravity.z *= 1.0 + ulps * Real::EPSILON;
     model.set_parameters(params).expect("parameters");
 }
 
@@ -205,9 +210,7 @@ fn a_block_pushed_until_it_slides_agrees_with_its_cells() {
         model.set_joint_stepping(stepping);
         model.add_block(fixed_slab("slab")).expect("slab");
         let id = model.add_block(cube("cube", Vector::ZERO)).expect("cube");
-        let mut params = *model.parameters();
-        params.gravity.z *= 1.0 + ulps * Real::EPSILON;
-        model.set_parameters(params).expect("parameters");
+        heavier_by_ulps(&mut model, ulps);
         model.run_steps(1500).expect("settle");
         (model, id)
     };
@@ -229,7 +232,7 @@ fn a_block_pushed_until_it_slides_agrees_with_its_cells() {
     let (mut heavier, _) = build(JointStepping::Cells, 1.0);
     let (mut lighter, _) = build(JointStepping::Cells, -1.0);
     let (mut heavier_2, _) = build(JointStepping::Cells, 2.0);
-    let (mut left, mut worst, mut floor) = (false, Worst::default(), Worst::default());
+    let (mut worst, mut floor) = (Worst::default(), Worst::default());
     for k in 0..=60 {
         // Up to 1.2 × the friction limit, tan 30° W, in 60 increments of 50 steps.
         let push = 0.02 * k as Real * limit;
@@ -257,7 +260,6 @@ fn a_block_pushed_until_it_slides_agrees_with_its_cells() {
                 "push {push:.1} N: beyond the corner test's bound, {corner_bound:.1} N"
             );
         }
-        left |= !stuck;
     }
     println!("pushed block: {worst} against cells, {floor} gravity one or two ulps changed");
     let slid = cells.blocks()[id.index()].state().pose.translation.x;
@@ -266,7 +268,6 @@ fn a_block_pushed_until_it_slides_agrees_with_its_cells() {
         worst.within(&floor),
         "{worst} against cells, {floor} gravity one or two ulps changed"
     );
-    assert!(left, "the joint left joint-level stepping as it began to slide");
 }
 
 /// A checkpoint of a model whose joints are stepped as a whole stores the cells' forces as they
