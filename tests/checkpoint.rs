@@ -164,7 +164,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads versions 13 to 14"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads versions 13 to 15"),
         "{err}"
     );
     // The tested pairs: in order, with finite unit poses and slacks, one for every contact.
@@ -270,7 +270,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 14);
+    assert_eq!(json["version"], 15);
     assert_eq!(json["law_type"], "CoulombSlip");
     assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
@@ -348,7 +348,18 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
     assert_eq!(keys(&whole[0]["joint"]), ["held_shear", "level"]);
     assert_eq!(
         keys(&whole[0]["joint"]["level"]),
-        ["active", "field", "gap", "held", "held_stress", "open", "stiffness"]
+        [
+            "active",
+            "closed_box",
+            "entry",
+            "field",
+            "gap",
+            "held",
+            "held_stress",
+            "open",
+            "span",
+            "stiffness"
+        ]
     );
     Ok(())
 }
@@ -387,6 +398,15 @@ fn an_edited_whole_joint_is_refused() -> Result<()> {
     edited["contacts"][k]["kind"] = serde_json::json!("Nodes");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a node contact's record");
     assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
+    // A span beyond the joint's cells (a joint open in part stepped as a whole but for them),
+    // or on a joint open all over, is refused.
+    for (span, open) in [((0, 100_000), false), ((1, 1 << 31), false), ((0, 1), true)] {
+        let mut edited = json.clone();
+        edited["contacts"][k]["joint"]["level"]["span"] = serde_json::json!([span.0, span.1]);
+        edited["contacts"][k]["joint"]["level"]["open"] = serde_json::json!(open);
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a span out of range");
+        assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
+    }
     // Unedited, it loads; as version 13 wrote it (no joints stepped as a whole: the cells as
     // they stand), it loads too, its joints stepped cell by cell until they enter again.
     assert_eq!(

@@ -29,6 +29,10 @@
 //! while its corners already fail the test it would meet at its next step (issue 45; round-off
 //! only: a joint closed by round-off with next to no load had entered and left again at every
 //! step, its cells written from the joint's record each time; it now stays with its cells).
+//! The shaking wall's changed again when joints open in part (hinges) were stepped as a whole
+//! but for the cells the line `g = 0` crosses and the open ones (issue 45; round-off only: the
+//! closed cells' forces summed from the joint's moments, as for a joint closed all over); the
+//! settling wall has no such joint that qualifies in its 200 steps and kept its hash.
 //!
 //! The values are those of x86_64 (with or without AVX2: both kernels give the same bits); the
 //! test does not run elsewhere.
@@ -120,7 +124,7 @@ fn scenes() -> Vec<Scene> {
             "shaking wall",
             || voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall"),
             400,
-            0x20a2_820a_711c_bfdc,
+            0x3e99_8c0b_e0f8_c815,
         ),
     ]
 }

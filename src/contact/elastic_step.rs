@@ -272,16 +272,24 @@ pub(super) enum WholeContact<'a> {
 impl<'a> WholeContact<'a> {
     #[inline(always)]
     pub(super) fn of(g: (Real, Real, Real), cells: &'a CellSummary) -> Self {
-        let slope = Vector2::new(-g.1, -g.2);
-        let (lo, hi) = (slope * cells.lo, slope * cells.hi);
-        let largest = g.0 + lo.x.max(hi.x) + lo.y.max(hi.y);
-        let scale = g.0.abs() + (slope.abs() * cells.lo.abs().max(cells.hi.abs())).element_sum();
-        if largest < -1e-9 * scale {
+        if closed_over(g, (cells.lo, cells.hi)) {
             Self::Closed(cells)
         } else {
             Self::Mixed
         }
     }
+}
+
+/// Whether the gap `face_gap(g, x, y)` is negative over the whole box `(lo, hi)` (its largest
+/// value is at a corner), by a margin far above the round-off of the cells' own tests, so that
+/// each cell in the box would also find itself all closed.
+#[inline(always)]
+pub(super) fn closed_over(g: (Real, Real, Real), (lo, hi): (Vector2, Vector2)) -> bool {
+    let slope = Vector2::new(-g.1, -g.2);
+    let (low, high) = (slope * lo, slope * hi);
+    let largest = g.0 + low.x.max(high.x) + low.y.max(high.y);
+    let scale = g.0.abs() + (slope.abs() * lo.abs().max(hi.abs())).element_sum();
+    largest < -1e-9 * scale
 }
 
 /// A cell as the elastic-regime loop sees it: all closed (the gap at the anchor and the half

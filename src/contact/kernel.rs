@@ -2,10 +2,11 @@
 //! law, dashpot), summed into the contact's resultant, moments and energy increments in the same
 //! pass. The equations are in `docs/theory.md` ("Sub-contact kinematics").
 
-use super::elastic_step::{update_elastic_first, WholeContact};
+use super::elastic_step::{closed_over, update_elastic_first, WholeContact};
 use super::lanes::{face_gap, increment, update_group, ContactFrame, Kinematics, LaneSums, LANES};
 use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
+use super::joint_level::StickTest;
 use super::spread::{CellResponse, CellRule, ExactCells};
 use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, JointLevel, SubContact};
 use crate::block::BlockMotion;
@@ -53,7 +54,17 @@ pub(crate) struct KernelContext {
     pub lanes: super::LaneBuild,
     /// Whether closed, sticking joints are stepped as a whole (`joint_level.rs`).
     pub joint_level: bool,
+    /// The model's step count: a joint open in part tries to enter joint-level stepping at
+    /// one step in [`PARTIAL_ENTRY_PERIOD`] (its own, from its blocks).
+    pub step: u64,
 }
+
+/// A joint open in part whose cells could be stepped as a whole tries one step in this many
+/// ([`JointLevel::enter_partial`] scans its cells): a joint that cannot enter (its closed cells
+/// fewer than half, or without room) is not scanned at every step, on a moving scene that
+/// holds thousands of them. Which step is the joint's own, from its blocks' indices and the
+/// model's step count, so that a restarted run tries at the same steps.
+pub(crate) const PARTIAL_ENTRY_PERIOD: u64 = 8;
 
 impl KernelContext {
     /// Whether Rayleigh stiffness damping is on, and the dashpot coefficients per unit area for
@@ -96,7 +107,7 @@ impl KernelContext {
 #[inline(always)]
 pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
-    reference: &ContactReference,
+    reference: &mut ContactReference,
     subs: &mut [SubContact<L::State>],
     dashpot_forces: &mut [Vector],
     sa: &BlockMotion,
@@ -108,7 +119,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
 ) -> ContactStep {
     // The axes of the previous step, in which the stored spring forces were composed.
     let previous_axes = pair.axes();
-    let host = pair.frame(reference, &sa.pose, &sb.pose, ctx.mode);
+    let host = pair.frame(&*reference, &sa.pose, &sb.pose, ctx.mode);
     let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, ctx.mode);
     let xh = host.translation;
     // Large displacements: the gap of the anchor p is its signed distance from the other
@@ -185,6 +196,36 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
             if pair.joint.open {
                 // Open all over: nothing to sum (the sums and spread energy stay zero).
                 whole_joint = exact.is_some_and(|e| e.virgin_without_tension) && pair.joint.step_open(&pair.cells, g);
+            } else if pair.joint.is_partial() {
+                // Open in part: the cells stepped as a whole while they stay closed and stick,
+                // the others (`span`) one by one (`joint_level.rs`). Only a hinge reads its
+                // record in the reference.
+                let hinge = &reference.hinge;
+                if exact.is_some_and(|e| e.virgin_without_tension)
+                    && closed_over(g, hinge.closed_box)
+                    && pair.joint.advance(StickTest::Hinge(hinge), regime, &kinematics, g)
+                {
+                    let span = pair.joint.span_range();
+                    let (span_sums, lost, span_spread, consumed) = update_elastic_first(
+                        &mut subs[span.clone()],
+                        law,
+                        regime,
+                        &kinematics,
+                        Some(g),
+                        exact,
+                        WholeContact::Mixed,
+                        axes,
+                        dt,
+                        ctx.lanes,
+                    );
+                    let (moments, j) = pair.cells.without(&subs[span]);
+                    let (whole_sums, whole_spread) = pair.joint.sums(&moments, j, exact);
+                    sums = whole_sums.plus(&span_sums);
+                    spread_energy = whole_spread + span_spread;
+                    dissipated = lost;
+                    fracture = consumed;
+                    whole_joint = true;
+                }
             } else if let WholeContact::Closed(cells) = WholeContact::of(g, &pair.cells) {
                 if let Some(step) = pair.joint.step(cells, regime, &kinematics, g, exact) {
                     (sums, spread_energy) = step;
@@ -227,10 +268,20 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                             let held = [shear(s.force), shear(s.per_x), shear(s.per_y)];
                             JointLevel::enter(subs, &pair.cells, &regime, g, held)
                         }
-                        WholeContact::Mixed if exact.is_some_and(|e| e.virgin_without_tension) => {
-                            JointLevel::enter_open(subs, &pair.cells, g)
-                        }
-                        WholeContact::Mixed => None,
+                        WholeContact::Mixed => match exact {
+                            Some(e) if e.virgin_without_tension => {
+                                let turn = (u64::from(pair.a) * 7 + u64::from(pair.b) * 3 + ctx.step)
+                                    .is_multiple_of(PARTIAL_ENTRY_PERIOD);
+                                JointLevel::enter_open(subs, &pair.cells, g).or_else(|| {
+                                    let (joint, hinge) = turn
+                                        .then(|| JointLevel::enter_partial(subs, &regime, g, e.slope, &kinematics))
+                                        .flatten()?;
+                                    reference.hinge = hinge;
+                                    Some(joint)
+                                })
+                            }
+                            _ => None,
+                        },
                     };
                     if let Some(joint) = entered {
                         pair.joint = joint;

@@ -17,7 +17,7 @@ mod view;
 use serde::{Deserialize, Serialize};
 
 pub(crate) use closed_lanes::LaneBuild;
-pub(crate) use joint_level::JointLevel;
+pub(crate) use joint_level::{HingeRecord, JointLevel};
 pub(crate) use kernel::{face_gap_coefficients, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
 pub(crate) use node_step::{node_frame, stored_node_frame, update_nodes};
@@ -48,9 +48,9 @@ pub enum DisplacementMode {
 
 /// One contact between blocks `a < b`, with a contiguous range of sub-contacts.
 ///
-/// Layout: what a step reads and writes; the reference geometry of small-displacement mode and
-/// the detection bookkeeping sit in a parallel internal list, which a large-displacement
-/// step does not read.
+/// Layout: what a step reads and writes; the reference geometry of small-displacement mode,
+/// the detection bookkeeping and the record of a hinge sit in a parallel internal list, which a
+/// large-displacement step reads for hinges only.
 #[derive(Debug, Clone, PartialEq)]
 #[repr(C)]
 pub(crate) struct ContactPair {
@@ -144,11 +144,25 @@ impl CellSummary {
         }
         s
     }
+
+    /// The area moments and `Σ J` of the cells other than `some` (of the same contact): the
+    /// summary's less those of `some`, summed in their order. A joint open in part steps the
+    /// cells outside its span as a whole with these (`contact/joint_level.rs`).
+    #[inline]
+    pub(crate) fn without<S>(&self, some: &[SubContact<S>]) -> ([Real; 6], Vector2) {
+        let part = Self::of(some);
+        let mut moments = self.area_moments;
+        for (m, p) in moments.iter_mut().zip(part.area_moments) {
+            *m -= p;
+        }
+        (moments, self.closed_moments - part.closed_moments)
+    }
 }
 
 /// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
-/// its geometry at detection, which small-displacement mode steps with, and the areas the
-/// critical-step bookkeeping compares.
+/// its geometry at detection, which small-displacement mode steps with, the areas the
+/// critical-step bookkeeping compares, and the record of a joint open in part, which the step
+/// reads for such joints only.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ContactReference {
     /// Centroids at detection (lever arms in small-displacement mode).
@@ -160,6 +174,9 @@ pub(crate) struct ContactReference {
     pub(crate) area: Real,
     /// `area` when the critical step was last evaluated (0 for a new contact).
     pub(crate) bound_area: Real,
+    /// Of a joint open in part ([`JointLevel::span`] not empty): what its cells stepped as a
+    /// whole need; stale otherwise.
+    pub(crate) hinge: HingeRecord,
 }
 
 impl ContactReference {
@@ -209,6 +226,14 @@ mod tests {
     fn subcontact_is_80_bytes_with_coulomb_state() {
         use crate::law::CoulombState;
         assert_eq!(std::mem::size_of::<super::SubContact<CoulombState>>(), 80);
+    }
+
+    /// The contact record every step streams stays at the size `docs/performance.md` counts:
+    /// a hinge's record lives in the reference, and its span in the joint record's padding.
+    #[test]
+    fn contact_records_keep_their_sizes() {
+        assert_eq!(std::mem::size_of::<super::ContactPair>(), 536);
+        assert_eq!(std::mem::size_of::<super::ContactReference>(), 160);
     }
 }
 

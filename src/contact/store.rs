@@ -90,29 +90,23 @@ impl<S> ContactStore<S> {
         }
     }
 
-    /// The contact pass's view: the references it reads, and the contacts from the first as
-    /// it writes them, with one of `sums` per chunk of contacts.
-    pub(crate) fn pass_view<'a, T>(
-        &'a mut self,
-        sums: &'a mut [T],
-    ) -> (&'a [ContactReference], ContactSlices<'a, S, T>) {
+    /// The contact pass's view: the contacts from the first as it writes them, with one of
+    /// `sums` per chunk of contacts.
+    pub(crate) fn pass_view<'a, T>(&'a mut self, sums: &'a mut [T]) -> ContactSlices<'a, S, T> {
         let first_sub = self.pairs.first().map_or(0, |p| p.first as usize);
-        (
-            &self.references,
-            ContactSlices {
-                first: 0,
-                pairs: &mut self.pairs,
-                wrenches: &mut self.wrenches,
-                sums,
-                subs: &mut self.subs[first_sub..],
-                records: &mut self.sub_records[first_sub..],
-                dashpots: if self.dashpots_kept {
-                    &mut self.sub_dashpots[first_sub..]
-                } else {
-                    &mut []
-                },
+        ContactSlices {
+            pairs: &mut self.pairs,
+            references: &mut self.references,
+            wrenches: &mut self.wrenches,
+            sums,
+            subs: &mut self.subs[first_sub..],
+            records: &mut self.sub_records[first_sub..],
+            dashpots: if self.dashpots_kept {
+                &mut self.sub_dashpots[first_sub..]
+            } else {
+                &mut []
             },
-        )
+        }
     }
 
     /// Whether the lists that run index for index do (kept so by detection and checkpoint
@@ -170,9 +164,9 @@ impl<S> ContactLists<'_, S> {
 /// What the contact pass writes: the contacts, their wrenches and per-chunk sums `T`, and the
 /// sub-contacts with their records, all starting at the same contact.
 pub(crate) struct ContactSlices<'a, S, T> {
-    /// Index of the first contact.
-    pub first: usize,
     pub pairs: &'a mut [ContactPair],
+    /// The contacts' references, index for index with `pairs` (the step writes a hinge's).
+    pub references: &'a mut [ContactReference],
     pub wrenches: &'a mut [ContactWrench],
     /// One per chunk of contacts.
     pub sums: &'a mut [T],
@@ -190,6 +184,7 @@ impl<S, T> ContactSlices<'_, S, T> {
         let base = self.pairs[0].first as usize;
         let sub_at = self.pairs[at].first as usize - base;
         let (pairs, pairs_right) = self.pairs.split_at_mut(at);
+        let (references, references_right) = self.references.split_at_mut(at);
         let (wrenches, wrenches_right) = self.wrenches.split_at_mut(at);
         let (sums, sums_right) = self.sums.split_at_mut(chunks);
         let (subs, subs_right) = self.subs.split_at_mut(sub_at);
@@ -201,8 +196,8 @@ impl<S, T> ContactSlices<'_, S, T> {
         };
         (
             Self {
-                first: self.first,
                 pairs,
+                references,
                 wrenches,
                 sums,
                 subs,
@@ -210,8 +205,8 @@ impl<S, T> ContactSlices<'_, S, T> {
                 dashpots,
             },
             Self {
-                first: self.first + at,
                 pairs: pairs_right,
+                references: references_right,
                 wrenches: wrenches_right,
                 sums: sums_right,
                 subs: subs_right,

@@ -81,6 +81,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
         mode: model.state.params.mode,
         lanes: crate::contact::LaneBuild::Portable,
         joint_level: false,
+        step: 0,
     };
     let (mut grouped_subs, mut single_subs) = (model.state.contacts.subs.clone(), model.state.contacts.subs.clone());
     let dashpots = vec![Vector::ZERO; model.state.contacts.subs.len()];
@@ -126,7 +127,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
             pairs[k].dashpots = dashpots;
             *wrench = update_contact(
                 &mut pairs[k],
-                &model.state.contacts.references[k],
+                &mut model.state.contacts.references[k].clone(),
                 &mut subs[r.clone()],
                 &mut dashpot_forces[r.clone()],
                 sa,

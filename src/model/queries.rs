@@ -144,8 +144,10 @@ impl<L: ConstitutiveLaw> Model<L> {
     }
 
     /// How many joints are stepped as a whole after the last step: face-face joints closed all
-    /// over whose sub-contacts all stick, or open all over with their sub-contacts unloaded
-    /// ([`Model::set_joint_stepping`]).
+    /// over whose sub-contacts all stick, open all over with their sub-contacts unloaded, or
+    /// open in part (a hinge) with the sub-contacts closed over their cells sticking, which are
+    /// stepped as a whole, and the others one by one ([`Model::set_joint_stepping`],
+    /// `docs/theory.md` §3.1).
     pub fn whole_joint_count(&self) -> usize {
         self.state.contacts.pairs.iter().filter(|p| p.joint.active).count()
     }
@@ -216,7 +218,8 @@ impl<L: ConstitutiveLaw> Model<L> {
                         let law = &laws[p.law as usize];
                         self.state.contacts.subs[p.range()]
                             .iter()
-                            .map(|s| law.elastic_energy(s.area, &p.joint.live(s).0, &s.state))
+                            .enumerate()
+                            .map(|(i, s)| law.elastic_energy(s.area, &p.joint.live(i, s).0, &s.state))
                             .sum::<Real>()
                             + p.spread_energy
                     })

@@ -341,7 +341,8 @@ impl PyModel {
     }
 
     /// How many joints were stepped as a whole in the last step (closed all over and sticking,
-    /// or open all over and unloaded).
+    /// open all over and unloaded, or open in part, a hinge, with their closed cells sticking
+    /// stepped as a whole and the others one by one).
     fn whole_joint_count(&self, py: Python<'_>) -> usize {
         self.lock(py).model.whole_joint_count()
     }

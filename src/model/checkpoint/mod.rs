@@ -41,7 +41,11 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// re-detection depends, and the blocks' stability bounds, which are re-evaluated block by block.
 /// Version 12 has node contacts (`"Nodes"`) where 11 had point contacts (`"Point"`, with a
 /// plane), and the refinement's travel cap (`refine_travel`).
-const VERSION: u32 = 14;
+/// Version 15 adds joints open in part (hinges) stepped as a whole but for a range of their
+/// cells: the joint record's `span` and the joint's `hinge` (its cells' box, gap and room at
+/// entry), absent (a joint closed or open all over) in the files of version 14, which this
+/// build reads.
+const VERSION: u32 = 15;
 /// The oldest version this build reads: 13 differs from 14 only in having no joints stepped
 /// as a whole ([`JointEntry`]).
 const OLDEST_VERSION: u32 = 13;
@@ -168,6 +172,10 @@ struct ContactEntry<S> {
 struct JointEntry {
     level: crate::contact::JointLevel,
     held_shear: Vec<Vector2>,
+    /// Of a joint open in part (its `level.span` not empty): its cells' box, gap and room at
+    /// entry (version 15).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    hinge: Option<crate::contact::HingeRecord>,
 }
 
 /// A sub-contact as checkpoints store it.

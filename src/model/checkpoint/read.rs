@@ -15,7 +15,7 @@ use super::{
 };
 use crate::block::Block;
 use crate::contact::{
-    ContactPair, ContactReference, ContactStore, ForceMoments, JointLevel, SubContact, SubContactRecord,
+    ContactPair, ContactReference, ContactStore, ForceMoments, SubContact, SubContactRecord,
 };
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
@@ -45,19 +45,26 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
     for (k, e) in entries.into_iter().enumerate() {
         let first = subs.len() as u32;
         let count = e.subcontacts.len() as u32;
-        let joint = match &e.joint {
-            None => JointLevel::default(),
+        let (joint, hinge) = match &e.joint {
+            None => Default::default(),
             Some(j)
                 if j.level.active
                     && j.held_shear.len() == e.subcontacts.len()
+                    && ((j.level.span == (0, 0) && j.hinge.is_none())
+                        || (!j.level.open
+                            && j.level.span.0 < j.level.span.1
+                            && usize::from(j.level.span.1) <= e.subcontacts.len()
+                            && j.hinge.is_some()))
                     && matches!(e.kind, crate::geometry::ContactKind::FaceFace { .. }) =>
             {
-                j.level
+                (j.level, j.hinge.unwrap_or_default())
             }
             Some(_) => {
                 return Err(corrupt(
                     &format!("contacts[{k}].joint"),
-                    "must be a face-face joint's, active, with one shear force per sub-contact",
+                    "must be a face-face joint's, active, with one shear force per sub-contact, and, when \
+                     its span is not empty, a joint not open all over, its span within its sub-contacts and \
+                     its hinge record",
                 ))
             }
         };
@@ -74,7 +81,7 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
             };
             if let Some(entry) = &e.joint {
                 sub.force.shear = entry.held_shear[j];
-                let (force, gap, status) = joint.live(&sub);
+                let (force, gap, status) = joint.live(j, &sub);
                 let same = |a: Real, b: Real| a.to_bits() == b.to_bits();
                 let matches = same(force.normal, s.force.normal)
                     && same(force.shear.x, s.force.shear.x)
@@ -124,6 +131,7 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
             ref_host_rotation: e.reference_host_rotation,
             area: e.area,
             bound_area: e.bound_area,
+            hinge,
         });
         wrenches.push(e.wrench);
     }
@@ -400,9 +408,10 @@ fn restore_contacts<L: ConstitutiveLaw>(
         let subs = if p.joint.active {
             live = subs
                 .iter()
-                .map(|s| {
+                .enumerate()
+                .map(|(i, s)| {
                     let mut cell = s.clone();
-                    (cell.force, cell.gap, cell.status) = p.joint.live(s);
+                    (cell.force, cell.gap, cell.status) = p.joint.live(i, s);
                     cell
                 })
                 .collect();
@@ -439,7 +448,8 @@ fn restore_contacts<L: ConstitutiveLaw>(
         let subs = &model.state.contacts.subs[p.range()];
         if let Some(j) = subs
             .iter()
-            .position(|s| !law.elastic_energy(s.area, &p.joint.live(s).0, &s.state).is_finite())
+            .enumerate()
+            .position(|(i, s)| !law.elastic_energy(s.area, &p.joint.live(i, s).0, &s.state).is_finite())
         {
             return Err(corrupt(
                 &format!("contacts[{k}].subcontacts[{j}]"),

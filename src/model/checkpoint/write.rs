@@ -41,7 +41,7 @@ impl<L: ConstitutiveLaw> Model<L> {
                 .zip(&self.state.contacts.sub_records[range.clone()])
                 .zip(range.clone())
                 .map(|((s, rec), i)| {
-                    let (force, gap, status) = p.joint.live(s);
+                    let (force, gap, status) = p.joint.live(i - range.start, s);
                     SubContactEntry {
                         key: rec.key,
                         plane: s.plane,
@@ -59,6 +59,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             joint: p.joint.active.then(|| JointEntry {
                 level: p.joint,
                 held_shear: self.state.contacts.subs[range].iter().map(|s| s.force.shear).collect(),
+                hinge: p.joint.is_partial().then_some(r.hinge),
             }),
         }
     }

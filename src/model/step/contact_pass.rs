@@ -10,7 +10,7 @@
 //! afterwards, so that they do not depend on the number of threads.
 
 use crate::block::{Block, BlockMotion, RigidBlock};
-use crate::contact::{update_contact, update_nodes, ContactReference, KernelContext, LaneBuild};
+use crate::contact::{update_contact, update_nodes, KernelContext, LaneBuild};
 use crate::geometry::ContactKind;
 use crate::integrate::{StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
@@ -29,8 +29,6 @@ pub(in crate::model) struct ContactPass<'a, L: ConstitutiveLaw> {
     pub blocks: &'a [RigidBlock],
     /// The blocks' motions, index for index.
     pub motions: &'a [BlockMotion],
-    /// The contacts' references, index for index with the contacts.
-    pub references: &'a [ContactReference],
     pub laws: &'a [L],
     /// The blocks' squared frequency bounds, for the impact probe.
     pub bounds: &'a [StiffnessBound],
@@ -105,8 +103,8 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
     fn run(&self, chunk: Slices<'_, L::State>, lanes: LaneBuild) {
         let ctx = KernelContext { lanes, ..self.ctx };
         let Slices {
-            first,
             pairs,
+            references,
             wrenches,
             sums,
             subs,
@@ -115,8 +113,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
         } = chunk;
         let sums = &mut sums[0];
         let base = pairs[0].first as usize;
-        let references = &self.references[first..first + pairs.len()];
-        for ((p, reference), w) in pairs.iter_mut().zip(references).zip(wrenches) {
+        for ((p, reference), w) in pairs.iter_mut().zip(references.iter_mut()).zip(wrenches) {
             let (ma, mb) = (&self.motions[p.a as usize], &self.motions[p.b as usize]);
             let range = p.first as usize - base..p.first as usize - base + p.count as usize;
             let watch = !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok();
@@ -210,6 +207,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             mode: self.params.mode,
             lanes: crate::contact::LaneBuild::Portable,
             joint_level: self.joint_stepping == crate::model::JointStepping::Whole,
+            step: self.clock.step,
         };
         // Rayleigh damping puts dashpot forces on the sub-contacts: the model keeps them from
         // its first damped step on.
@@ -227,11 +225,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .pair_sums
             .resize(self.contacts.pairs.len().div_ceil(CONTACT_CHUNK), PairSums::default());
         if !self.contacts.pairs.is_empty() {
-            let (references, slices) = self.contacts.pass_view(&mut pipeline.pair_sums);
+            let slices = self.contacts.pass_view(&mut pipeline.pair_sums);
             let pass = ContactPass {
                 blocks: &self.blocks,
                 motions: &pipeline.motions,
-                references,
                 laws: self.laws.laws(),
                 bounds: &pipeline.bounds,
                 refining: &self.clock.refining,
