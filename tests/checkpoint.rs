@@ -350,8 +350,6 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         keys(&whole[0]["joint"]["level"]),
         [
             "active",
-            "closed_box",
-            "entry",
             "field",
             "gap",
             "held",
@@ -399,13 +397,31 @@ fn an_edited_whole_joint_is_refused() -> Result<()> {
     let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a node contact's record");
     assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
     // A span beyond the joint's cells (a joint open in part stepped as a whole but for them),
-    // or on a joint open all over, is refused.
-    for (span, open) in [((0, 100_000), false), ((1, 1 << 31), false), ((0, 1), true)] {
+    // beyond what a span holds, on a joint open all over, or without its hinge record, is
+    // refused; so is a hinge record on a joint without a span.
+    let hinge = serde_json::json!({
+        "closed_box": [[0.0, 0.0], [0.1, 0.1]],
+        "entry_gap": [-1e-6, 0.0, 0.0],
+        "room": 1.0
+    });
+    for (span, open, with_hinge) in [
+        ((0, 60_000), false, true),
+        ((1, 100_000), false, true),
+        ((0, 1), true, true),
+        ((0, 1), false, false),
+        ((0, 0), false, true),
+    ] {
         let mut edited = json.clone();
         edited["contacts"][k]["joint"]["level"]["span"] = serde_json::json!([span.0, span.1]);
         edited["contacts"][k]["joint"]["level"]["open"] = serde_json::json!(open);
+        if with_hinge {
+            edited["contacts"][k]["joint"]["hinge"] = hinge.clone();
+        }
         let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a span out of range");
-        assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
+        assert!(
+            err.to_string().contains(&format!("contacts[{k}].joint")),
+            "{span:?} {open} {with_hinge}: {err}"
+        );
     }
     // Unedited, it loads; as version 13 wrote it (no joints stepped as a whole: the cells as
     // they stand), it loads too, its joints stepped cell by cell until they enter again.

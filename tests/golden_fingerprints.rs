@@ -124,7 +124,7 @@ fn scenes() -> Vec<Scene> {
             "shaking wall",
             || voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall"),
             400,
-            0x3e99_8c0b_e0f8_c815,
+            0x5ac4_7555_a386_03bf,
         ),
     ]
 }

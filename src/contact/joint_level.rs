@@ -126,7 +126,12 @@ fn corners_stick(
 /// room, where the test of a joint closed all over ([`corners_stick`]) takes the largest stress
 /// against the weakest corner: a hinge's cells next to the line `g = 0` carry little compression.
 #[inline]
-fn partial_corners_stick(hinge: &HingeRecord, regime: &ElasticRegime, g: (Real, Real, Real), field: &[Vector2; 3]) -> bool {
+fn partial_corners_stick(
+    hinge: &HingeRecord,
+    regime: &ElasticRegime,
+    g: (Real, Real, Real),
+    field: &[Vector2; 3],
+) -> bool {
     let (kn, ks) = (regime.normal_stiffness, regime.shear_stiffness);
     let ((lo, hi), entry_gap, room) = (hinge.closed_box, hinge.entry_gap, hinge.room);
     let weakening = STRENGTH_SHARE * regime.tan_friction * kn;
@@ -265,7 +270,7 @@ impl JointLevel {
     /// increments (`kinematics`) to the field and takes the gap coefficients `g` if every cell
     /// still sticks by the corner test `test` (and the regime is the one the joint was entered
     /// with); `false`, and nothing changed, otherwise.
-    #[inline]
+    #[inline(always)]
     pub(super) fn advance(
         &mut self,
         test: StickTest<'_>,
@@ -298,7 +303,7 @@ impl JointLevel {
     /// The spring-force sums in the joint axes and the spread energy of the cells stepped as a
     /// whole, whose area moments are `area_moments` and `Σ J` `closed_moments`
     /// ([`CellSummary`]), at the field and gap of the last [`JointLevel::advance`].
-    #[inline]
+    #[inline(always)]
     pub(super) fn sums(
         &self,
         area_moments: &[Real; 6],
@@ -352,6 +357,7 @@ impl JointLevel {
     /// in the range (those the line `g = 0` crosses, the open ones, and any between them) are
     /// stepped one by one. The joint and its [`HingeRecord`]; `None` otherwise (also when every
     /// cell fits: that joint is closed all over, [`JointLevel::enter`]).
+    #[inline(never)]
     pub(super) fn enter_partial<S: PartialEq + Default>(
         own: &[SubContact<S>],
         regime: &ElasticRegime,

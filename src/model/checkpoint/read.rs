@@ -14,9 +14,7 @@ use super::{
     VERSION,
 };
 use crate::block::Block;
-use crate::contact::{
-    ContactPair, ContactReference, ContactStore, ForceMoments, SubContact, SubContactRecord,
-};
+use crate::contact::{ContactPair, ContactReference, ContactStore, ForceMoments, SubContact, SubContactRecord};
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::integrate::CentralDifference;
