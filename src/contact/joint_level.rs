@@ -37,6 +37,14 @@ use crate::math::{Real, Vector, Vector2};
 /// keeps sticking sticks by the cells' own test too.
 const STRENGTH_SHARE: Real = 1.0 - 1e-9;
 
+/// A joint open in part enters joint-level stepping when at least one in this many of its
+/// cells are stepped as a whole ([`JointLevel::enter_partial`]): each of them saves its cell's
+/// step, and the range stepped one by one costs what it would cost anyway, plus one pass for
+/// its area moments. With one in two (the first version), 89 % of the static arch's entry
+/// attempts failed on a hinge open over more than half of its face; with one in eight its
+/// baseline case runs 2.36–2.58 s against 2.71–2.87 s (`docs/performance.md`).
+const MIN_CLOSED_SHARE: usize = 8;
+
 /// A face-face joint stepped as a whole while it is closed and sticking (see the module's
 /// documentation). Kept in its [`super::ContactPair`], so that it moves with it.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -353,7 +361,7 @@ impl JointLevel {
     /// the cells outside one range of them are all closed over their rectangles at the gap
     /// coefficients `g` (slope `slope`), elastic and virgin, cover a box over which the gap is
     /// negative by the margin of [`WholeContact::of`](super::elastic_step::WholeContact::of),
-    /// and stick by the corner test over it; they are at least half of the cells. The cells
+    /// and stick by the corner test over it; they are at least [`MIN_CLOSED_SHARE`] of the cells. The cells
     /// in the range (those the line `g = 0` crosses, the open ones, and any between them) are
     /// stepped one by one. The joint and its [`HingeRecord`]; `None` otherwise (also when every
     /// cell fits: that joint is closed all over, [`JointLevel::enter`]).
@@ -375,7 +383,7 @@ impl JointLevel {
         let first = own.iter().position(|s| !fits(s))?;
         let last = own.iter().rposition(|s| !fits(s)).map_or(first, |l| l + 1);
         let whole = own.len() - (last - first);
-        if 2 * whole < own.len() || u16::try_from(own.len()).is_err() {
+        if whole * MIN_CLOSED_SHARE < own.len() || u16::try_from(own.len()).is_err() {
             return None;
         }
         let mut lo = Vector2::splat(Real::INFINITY);
