@@ -63,8 +63,9 @@ pub(crate) struct KernelContext {
 
 /// A joint open in part whose cells could be stepped as a whole tries one step in this many
 /// ([`JointLevel::enter_partial`] scans its cells): a joint that cannot enter (its closed cells
-/// fewer than half, or without room) is not scanned at every step, on a moving scene that
-/// holds thousands of them. Which step is the joint's own, from its blocks' indices and the
+/// too few, or without room) is not scanned at every step, on a moving scene that holds
+/// thousands of them. (At every step, the static arch's hinges entered twice as often for 4 %
+/// more steps stepped so: a joint that enters right after leaving leaves again.) Which step is the joint's own, from its blocks' indices and the
 /// model's step count, so that a restarted run tries at the same steps.
 pub(crate) const PARTIAL_ENTRY_PERIOD: u64 = 8;
 
