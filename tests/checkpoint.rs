@@ -164,7 +164,7 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
     json.as_object_mut().expect("an object").remove("contacts");
     let err = Model::<CoulombSlip>::from_checkpoint_str(&json.to_string()).expect_err("version 6");
     assert!(
-        err.to_string().contains("version 6") && err.to_string().contains("reads versions 13 to 15"),
+        err.to_string().contains("version 6") && err.to_string().contains("reads versions 13 to 16"),
         "{err}"
     );
     // The tested pairs: in order, with finite unit poses and slacks, one for every contact.
@@ -270,7 +270,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         k.sort();
         k
     };
-    assert_eq!(json["version"], 15);
+    assert_eq!(json["version"], 16);
     assert_eq!(json["law_type"], "CoulombSlip");
     assert!(json["checksum"].as_str().expect("a checksum").starts_with("crc32:"));
     assert_eq!(
@@ -350,6 +350,7 @@ fn checkpoint_format_is_the_transfer_structs() -> Result<()> {
         keys(&whole[0]["joint"]["level"]),
         [
             "active",
+            "ends",
             "field",
             "gap",
             "held",
@@ -397,32 +398,49 @@ fn an_edited_whole_joint_is_refused() -> Result<()> {
     let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a node contact's record");
     assert!(err.to_string().contains(&format!("contacts[{k}].joint")), "{err}");
     // A span beyond the joint's cells (a joint open in part stepped as a whole but for them),
-    // beyond what a span holds, on a joint open all over, or without its hinge record, is
-    // refused; so is a hinge record on a joint without a span.
+    // beyond what a span holds, over all of them, on a joint open all over, or without its
+    // hinge record, is refused; so is a hinge record on a joint without a span, and open cells
+    // stepped as a whole at an end the span reaches, or on a joint without a span.
     let hinge = serde_json::json!({
         "closed_box": [[0.0, 0.0], [0.1, 0.1]],
         "entry_gap": [-1e-6, 0.0, 0.0],
         "room": 1.0
     });
-    for (span, open, with_hinge) in [
-        ((0, 60_000), false, true),
-        ((1, 100_000), false, true),
-        ((0, 1), true, true),
-        ((0, 1), false, false),
-        ((0, 0), false, true),
+    let cells = json["contacts"][k]["subcontacts"].as_array().expect("cells").len();
+    for (span, open, with_hinge, ends) in [
+        ((0, 60_000), false, true, "closed"),
+        ((1, 100_000), false, true, "closed"),
+        ((0, cells), false, true, "closed"),
+        ((0, 1), true, true, "closed"),
+        ((0, 1), false, false, "closed"),
+        ((0, 0), false, true, "closed"),
+        ((0, 1), false, true, "open_before"),
+        ((1, cells), false, true, "open_after"),
+        ((0, 0), false, false, "open_after"),
     ] {
         let mut edited = json.clone();
         edited["contacts"][k]["joint"]["level"]["span"] = serde_json::json!([span.0, span.1]);
         edited["contacts"][k]["joint"]["level"]["open"] = serde_json::json!(open);
+        edited["contacts"][k]["joint"]["level"]["ends"] = serde_json::json!(ends);
         if with_hinge {
             edited["contacts"][k]["joint"]["hinge"] = hinge.clone();
         }
         let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a span out of range");
         assert!(
             err.to_string().contains(&format!("contacts[{k}].joint")),
-            "{span:?} {open} {with_hinge}: {err}"
+            "{span:?} {open} {with_hinge} {ends}: {err}"
         );
     }
+    // A cell said to be open and stepped as a whole that carries a force is refused, naming it.
+    let mut edited = json.clone();
+    edited["contacts"][k]["joint"]["level"]["span"] = serde_json::json!([1, 2]);
+    edited["contacts"][k]["joint"]["level"]["ends"] = serde_json::json!("open_before");
+    edited["contacts"][k]["joint"]["hinge"] = hinge.clone();
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("an open cell with a force");
+    assert!(
+        err.to_string().contains(&format!("contacts[{k}].subcontacts[0]")) && err.to_string().contains("open"),
+        "{err}"
+    );
     // Unedited, it loads; as version 13 wrote it (no joints stepped as a whole: the cells as
     // they stand), it loads too, its joints stepped cell by cell until they enter again.
     assert_eq!(

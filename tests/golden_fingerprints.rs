@@ -125,7 +125,7 @@ fn scenes() -> Vec<Scene> {
             "shaking wall",
             || voussoir::scenes::shaking_wall(300, voussoir::scenes::BENCHMARK_SPACING).expect("wall"),
             400,
-            0xd22e_603c_1c2a_2711,
+            0x91f5_d8f8_1c0b_2006,
         ),
     ]
 }

@@ -137,7 +137,8 @@ fn an_impact_agrees_with_its_cells() {
 }
 
 /// The static arch pushed down by its plate opens most of its joints in part (hinges): they
-/// are stepped as a whole but for their open cells and those the line `g = 0` crosses. Within
+/// are stepped as a whole, their closed and their open cells, but for the cells the line
+/// `g = 0` crosses. Within
 /// 2,000 steps of the push, more joints are stepped as a whole than are closed or open all
 /// over, so hinges are among them, and the run agrees with its cells (the test above).
 #[test]
@@ -167,6 +168,10 @@ fn the_static_arch_steps_its_hinges_as_a_whole() {
     // continues bit for bit.
     let text = model.to_checkpoint_string().expect("save");
     assert!(text.contains("\"hinge\""), "no hinge record in the checkpoint");
+    assert!(
+        text.contains("\"open_before\"") || text.contains("\"open_after\""),
+        "no hinge's open cells stepped as a whole in the checkpoint"
+    );
     let mut restored: Model = Model::from_checkpoint_str(&text).expect("load");
     assert_eq!(restored.whole_joint_count(), model.whole_joint_count());
     model.run_steps(300).expect("run");

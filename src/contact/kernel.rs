@@ -9,7 +9,8 @@ use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
 use super::spread::{CellResponse, CellRule, ExactCells};
 use super::{
-    ContactPair, ContactReference, ContactWrench, DisplacementMode, HingeRecord, JointLevel, LaneBuild, SubContact,
+    ContactPair, ContactReference, ContactWrench, DisplacementMode, HingeRecord, JointLevel, LaneBuild, SpanEnds,
+    SubContact,
 };
 use crate::block::BlockMotion;
 use crate::law::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
@@ -269,7 +270,16 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                                     .is_multiple_of(PARTIAL_ENTRY_PERIOD);
                                 JointLevel::enter_open(subs, &pair.cells, g).or_else(|| {
                                     let (joint, hinge) = turn
-                                        .then(|| JointLevel::enter_partial(subs, &regime, g, e.slope, &kinematics))
+                                        .then(|| {
+                                            JointLevel::enter_partial(
+                                                subs,
+                                                &pair.cells,
+                                                &regime,
+                                                g,
+                                                e.slope,
+                                                &kinematics,
+                                            )
+                                        })
                                         .flatten()?;
                                     reference.hinge = hinge;
                                     Some(joint)
@@ -400,9 +410,10 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
 }
 
 /// A step of a joint open in part (a hinge, [`JointLevel::span`] not empty) without dashpot
-/// forces, at the gap coefficients `g`: its cells outside the span as a whole while they stay
-/// closed over `hinge.closed_box` and stick ([`JointLevel::advance`]), the span's cells one by
-/// one. The spring-force sums in the joint axes, the energy dissipated, the spread energy and
+/// forces, at the gap coefficients `g`: its closed cells outside the span as a whole while they
+/// stay closed over `hinge.closed_box` and stick ([`JointLevel::advance`]), its open cells
+/// outside the span (if any, [`SpanEnds`]) while they stay open over `hinge.open_box`, the
+/// span's cells one by one. The spring-force sums in the joint axes, the energy dissipated, the spread energy and
 /// the fracture work, as [`update_elastic_first`] returns them; `None`, with nothing changed,
 /// when the joint must leave. Kept out of line: the contact pass inlines the cell loop at its
 /// two call sites in [`update_contact`], and a third copy for the few hinges cost every contact
@@ -422,7 +433,12 @@ fn step_hinge<L: ConstitutiveLaw>(
     dt: Real,
     lanes: LaneBuild,
 ) -> Option<(ForceMoments, Real, Real, Real)> {
-    if !(closed_over(g, hinge.closed_box) && pair.joint.advance(StickTest::Hinge(hinge), regime, kinematics, g)) {
+    let open_stay_open = pair.joint.ends == SpanEnds::Closed || JointLevel::open_over(hinge.open_box, g);
+
+    if !(open_stay_open
+        && closed_over(g, hinge.closed_box)
+        && pair.joint.advance(StickTest::Hinge(hinge), regime, kinematics, g))
+    {
         return None;
     }
     let span = pair.joint.span_range();
@@ -438,7 +454,7 @@ fn step_hinge<L: ConstitutiveLaw>(
         dt,
         lanes,
     );
-    let (moments, j) = pair.cells.without(&subs[span]);
+    let (moments, j) = hinge.closed_moments;
     let (whole_sums, whole_spread) = pair.joint.sums(&moments, j, Some(exact));
     Some((whole_sums.plus(&span_sums), lost, whole_spread + span_spread, consumed))
 }

@@ -17,7 +17,7 @@ mod view;
 use serde::{Deserialize, Serialize};
 
 pub(crate) use closed_lanes::LaneBuild;
-pub(crate) use joint_level::{HingeRecord, JointLevel};
+pub(crate) use joint_level::{HingeRecord, JointLevel, SpanEnds};
 pub(crate) use kernel::{face_gap_coefficients, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
 pub(crate) use node_step::{node_frame, stored_node_frame, update_nodes};
@@ -233,7 +233,7 @@ mod tests {
     #[test]
     fn contact_records_keep_their_sizes() {
         assert_eq!(std::mem::size_of::<super::ContactPair>(), 536);
-        assert_eq!(std::mem::size_of::<super::ContactReference>(), 160);
+        assert_eq!(std::mem::size_of::<super::ContactReference>(), 256);
     }
 }
 

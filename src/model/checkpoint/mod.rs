@@ -44,8 +44,9 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// Version 15 adds joints open in part (hinges) stepped as a whole but for a range of their
 /// cells: the joint record's `span` and the joint's `hinge` (its cells' box, gap and room at
 /// entry), absent (a joint closed or open all over) in the files of version 14, which this
-/// build reads.
-const VERSION: u32 = 15;
+/// build reads. Version 16 adds a hinge's open cells stepped as a whole: the joint record's
+/// `ends` (`"closed"` in the files of version 15, which this build reads).
+const VERSION: u32 = 16;
 /// The oldest version this build reads: 13 differs from 14 only in having no joints stepped
 /// as a whole ([`JointEntry`]).
 const OLDEST_VERSION: u32 = 13;

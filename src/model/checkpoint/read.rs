@@ -14,11 +14,13 @@ use super::{
     VERSION,
 };
 use crate::block::Block;
-use crate::contact::{ContactPair, ContactReference, ContactStore, ForceMoments, SubContact, SubContactRecord};
+use crate::contact::{
+    ContactPair, ContactReference, ContactStore, ForceMoments, SpanEnds, SubContact, SubContactRecord,
+};
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
 use crate::integrate::CentralDifference;
-use crate::law::ConstitutiveLaw;
+use crate::law::{ConstitutiveLaw, JointForce};
 use crate::math::is_unit_pose;
 use crate::math::{Real, Vector};
 use crate::model::{Model, ModelParameters};
@@ -26,7 +28,7 @@ use crate::model::{Model, ModelParameters};
 /// The step's storage rebuilt from checkpointed joints. A joint stepped as a whole gets its
 /// cells' held shear forces back; its stored forces must be those its record gives them, to the
 /// bit (else the error names it).
-fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
+fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
     let total = entries.iter().map(|e| e.subcontacts.len()).sum();
     let (mut pairs, mut references, mut wrenches) = (
         Vec::with_capacity(entries.len()),
@@ -48,10 +50,13 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
             Some(j)
                 if j.level.active
                     && j.held_shear.len() == e.subcontacts.len()
-                    && ((j.level.span == (0, 0) && j.hinge.is_none())
+                    && ((j.level.span == (0, 0) && j.level.ends == SpanEnds::Closed && j.hinge.is_none())
                         || (!j.level.open
                             && j.level.span.0 < j.level.span.1
                             && usize::from(j.level.span.1) <= e.subcontacts.len()
+                            && (j.level.span.0 > 0 || usize::from(j.level.span.1) < e.subcontacts.len())
+                            && (j.level.ends == SpanEnds::Closed
+                                || (j.level.span.0 > 0 && usize::from(j.level.span.1) < e.subcontacts.len()))
                             && j.hinge.is_some()))
                     && matches!(e.kind, crate::geometry::ContactKind::FaceFace { .. }) =>
             {
@@ -61,8 +66,8 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
                 return Err(corrupt(
                     &format!("contacts[{k}].joint"),
                     "must be a face-face joint's, active, with one shear force per sub-contact, and, when \
-                     its span is not empty, a joint not open all over, its span within its sub-contacts and \
-                     its hinge record",
+                     its span is not empty, a joint not open all over, its span within its sub-contacts with \
+                     cells outside it (at both ends when one end is open) and its hinge record",
                 ))
             }
         };
@@ -79,6 +84,15 @@ fn into_storage<S>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
             };
             if let Some(entry) = &e.joint {
                 sub.force.shear = entry.held_shear[j];
+                // A cell stepped as a whole and open carries nothing and is virgin, as the
+                // joint entered with it (`JointLevel::enter_open`, `enter_partial`).
+                if joint.holds_open(j) && (sub.force != JointForce::default() || sub.state != Default::default()) {
+                    return Err(corrupt(
+                        &format!("contacts[{k}].subcontacts[{j}]"),
+                        "is open in a joint stepped as a whole, so must carry no force and be in its \
+                         law's initial state",
+                    ));
+                }
                 let (force, gap, status) = joint.live(j, &sub);
                 let same = |a: Real, b: Real| a.to_bits() == b.to_bits();
                 let matches = same(force.normal, s.force.normal)
@@ -380,6 +394,12 @@ fn restore_contacts<L: ConstitutiveLaw>(
         let (a, b) = (&model.state.blocks[p.a as usize], &model.state.blocks[p.b as usize]);
         p.cache_local_faces(Block::shape(a), Block::shape(b));
         p.cells = crate::contact::CellSummary::of(&model.state.contacts.subs[p.range()]);
+        if p.joint.is_partial() {
+            let subs = &model.state.contacts.subs[p.range()];
+            model.state.contacts.references[k]
+                .hinge
+                .measure(subs, &p.cells, &p.joint);
+        }
         // Dashpot forces still held must be seen (and their work booked) by the next step.
         p.dashpots |= model.state.contacts.dashpots_kept
             && model.state.contacts.sub_dashpots[p.range()]

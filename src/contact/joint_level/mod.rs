@@ -19,11 +19,17 @@
 //! it holds at every anchor if it holds at the four corners of the box the cells cover. When
 //! it fails at a corner, the joint's cells are written and the cell-by-cell step takes over.
 //!
-//! A joint open in part (a hinge) is stepped the same way for its cells closed all over, and
-//! cell by cell for one range of its cells that holds the open ones and those the line
-//! `g = 0` crosses ([`JointLevel::span`]): the closed cells' moments are the joint's less the
-//! range's, and their stick test takes each cell's room at entry, not the largest stress
-//! against the weakest corner ([`partial_corners_stick`]).
+//! A joint open in part (a hinge, `hinge.rs`) is stepped the same way for its cells closed
+//! all over, as a joint open all over is for its open cells at one end, and cell by cell for
+//! one range of its cells that holds those the line `g = 0` crosses ([`JointLevel::span`]):
+//! the closed cells' moments are the joint's less the other cells', and their stick test takes
+//! each cell's room at entry, not the largest stress against the weakest corner
+//! ([`partial_corners_stick`]).
+
+mod hinge;
+
+use hinge::partial_corners_stick;
+pub(crate) use hinge::{HingeRecord, SpanEnds};
 
 use super::lanes::{face_gap, Kinematics};
 use super::moments::ForceMoments;
@@ -36,14 +42,6 @@ use crate::math::{Real, Vector, Vector2};
 /// whole: a margin far above the round-off of the bound, so that a cell the joint-level step
 /// keeps sticking sticks by the cells' own test too.
 const STRENGTH_SHARE: Real = 1.0 - 1e-9;
-
-/// A joint open in part enters joint-level stepping when at least one in this many of its
-/// cells are stepped as a whole ([`JointLevel::enter_partial`]): each of them saves its cell's
-/// step, and the range stepped one by one costs what it would cost anyway, plus one pass for
-/// its area moments. With one in two (the first version), 89 % of the static arch's entry
-/// attempts failed on a hinge open over more than half of its face; with one in eight its
-/// baseline case runs 2.36–2.58 s against 2.71–2.87 s (`docs/performance.md`).
-const MIN_CLOSED_SHARE: usize = 8;
 
 /// A face-face joint stepped as a whole while it is closed and sticking (see the module's
 /// documentation). Kept in its [`super::ContactPair`], so that it moves with it.
@@ -66,6 +64,11 @@ pub(crate) struct JointLevel {
     /// so.)
     #[cfg_attr(feature = "serde", serde(default))]
     pub(crate) span: (u16, u16),
+    /// Of a joint open in part: whether the cells outside the span at one end are open all
+    /// over (unloaded, virgin), stepped as a whole too, carrying nothing, rather than closed
+    /// ([`SpanEnds`]). One byte, in the padding with the span.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub(crate) ends: SpanEnds,
     /// `Σ F⁰ᵢ`, `Σ F⁰ᵢ xᵢ`, `Σ F⁰ᵢ yᵢ` of the shear forces the cells hold (tangent components;
     /// N, N·m, N·m).
     pub(crate) held: [Vector2; 3],
@@ -78,25 +81,6 @@ pub(crate) struct JointLevel {
     pub(crate) stiffness: (Real, Real),
     /// The gap coefficients of the last step (`face_gap`), for the cells' gaps and normal forces.
     pub(crate) gap: (Real, Real, Real),
-}
-
-/// What a joint open in part ([`JointLevel::span`] not empty) needs besides its
-/// [`JointLevel`], set when it enters and read-only until it leaves. Kept in the contact's
-/// [`super::ContactReference`], which the step reads only for such joints, so that the record
-/// every contact streams through memory at every step does not grow for the few hinges.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
-pub(crate) struct HingeRecord {
-    /// The box (plane coordinates, lower and upper corner) of the cells stepped as a whole.
-    pub(crate) closed_box: (Vector2, Vector2),
-    /// The gap coefficients when the joint entered, `g_e`.
-    pub(crate) entry_gap: (Real, Real, Real),
-    /// The least room the cells stepped as a whole had when the joint entered,
-    /// `m = minᵢ (share · (c + tan φ k_n (−g_e(xᵢ, yᵢ))) − |F⁰ᵢ|/Aᵢ)` (Pa): they stick while
-    /// `k_s |U| + share · tan φ k_n (g − g_e) ≤ m` at the corners of `closed_box`
-    /// ([`partial_corners_stick`]).
-    pub(crate) room: Real,
 }
 
 /// Whether every cell of a joint whose cells are all closed at the gap coefficients `g` sticks
@@ -122,33 +106,6 @@ fn corners_stick(
             let room = STRENGTH_SHARE * strength - held_stress;
             let u = field[0] + field[1] * x + field[2] * y;
             room >= 0.0 && ks * ks * u.length_squared() <= room * room
-        })
-}
-
-/// Whether every cell stepped as a whole of a joint open in part still sticks: at the four
-/// corners of the box they cover, `k_s |U| + share · tan φ k_n (g − g_e) ≤ m` for the room `m`
-/// and gap `g_e` they had when the joint entered (`hinge`). Each cell had
-/// `|F⁰ᵢ|/Aᵢ ≤ share · (c + tan φ k_n (−g_e)) − m`, so the test bounds
-/// `|F⁰ᵢ|/Aᵢ + k_s |U|` by `share · (c + tan φ k_n (−g))` at its anchor; the left side less
-/// the right is convex in `(x, y)`, so the corners bound every anchor in the box. A per-cell
-/// room, where the test of a joint closed all over ([`corners_stick`]) takes the largest stress
-/// against the weakest corner: a hinge's cells next to the line `g = 0` carry little compression.
-#[inline]
-fn partial_corners_stick(
-    hinge: &HingeRecord,
-    regime: &ElasticRegime,
-    g: (Real, Real, Real),
-    field: &[Vector2; 3],
-) -> bool {
-    let (kn, ks) = (regime.normal_stiffness, regime.shear_stiffness);
-    let ((lo, hi), entry_gap, room) = (hinge.closed_box, hinge.entry_gap, hinge.room);
-    let weakening = STRENGTH_SHARE * regime.tan_friction * kn;
-    [(lo.x, lo.y), (hi.x, lo.y), (lo.x, hi.y), (hi.x, hi.y)]
-        .into_iter()
-        .all(|(x, y)| {
-            let left = room - weakening * (face_gap(g, x, y) - face_gap(entry_gap, x, y));
-            let u = field[0] + field[1] * x + field[2] * y;
-            left >= 0.0 && ks * ks * u.length_squared() <= left * left
         })
 }
 
@@ -199,6 +156,7 @@ impl JointLevel {
             active: true,
             open: false,
             span: (0, 0),
+            ends: SpanEnds::Closed,
             held: shear_sums,
             held_stress,
             field: [Vector2::ZERO; 3],
@@ -223,7 +181,7 @@ impl JointLevel {
                 && sub.force.shear == Vector2::ZERO
                 && sub.state == virgin
         };
-        (Self::open_over(cells, g) && own.iter().all(unloaded)).then_some(Self {
+        (Self::open_over((cells.lo, cells.hi), g) && own.iter().all(unloaded)).then_some(Self {
             active: true,
             open: true,
             gap: g,
@@ -231,15 +189,15 @@ impl JointLevel {
         })
     }
 
-    /// Whether the gap `face_gap(g, x, y)` is positive over the whole box the cells cover (its
+    /// Whether the gap `face_gap(g, x, y)` is positive over the whole box `(lo, hi)` (its
     /// smallest value is at a corner), by a margin far above the round-off of the cells' own
     /// tests, so that each cell would also find itself open all over.
     #[inline]
-    pub(super) fn open_over(cells: &CellSummary, g: (Real, Real, Real)) -> bool {
+    pub(super) fn open_over((lo, hi): (Vector2, Vector2), g: (Real, Real, Real)) -> bool {
         let slope = Vector2::new(-g.1, -g.2);
-        let (lo, hi) = (slope * cells.lo, slope * cells.hi);
-        let smallest = g.0 + lo.x.min(hi.x) + lo.y.min(hi.y);
-        let scale = g.0.abs() + (slope.abs() * cells.lo.abs().max(cells.hi.abs())).element_sum();
+        let (low, high) = (slope * lo, slope * hi);
+        let smallest = g.0 + low.x.min(high.x) + low.y.min(high.y);
+        let scale = g.0.abs() + (slope.abs() * lo.abs().max(hi.abs())).element_sum();
         smallest > 1e-9 * scale
     }
 
@@ -248,7 +206,7 @@ impl JointLevel {
     /// be written and stepped one by one).
     #[inline]
     pub(super) fn step_open(&mut self, cells: &CellSummary, g: (Real, Real, Real)) -> bool {
-        let open = Self::open_over(cells, g);
+        let open = Self::open_over((cells.lo, cells.hi), g);
         if open {
             self.gap = g;
         }
@@ -344,92 +302,16 @@ impl JointLevel {
         }
         (sums, spread_energy)
     }
-
-    /// Whether the joint is open in part: some of its cells are stepped one by one.
+    /// Whether the joint's cell `index` is stepped as a whole and open (carrying nothing):
+    /// every cell of a joint open all over, and those at a hinge's open end ([`SpanEnds`]).
     #[inline]
-    pub(crate) fn is_partial(&self) -> bool {
-        self.span.1 > self.span.0
-    }
-
-    /// The range of the joint's own cells stepped one by one (empty unless it is open in part).
-    #[inline]
-    pub(crate) fn span_range(&self) -> std::ops::Range<usize> {
-        self.span.0 as usize..self.span.1 as usize
-    }
-
-    /// The joint as the cells `own` leave it after a step, when it is open in part (a hinge):
-    /// the cells outside one range of them are all closed over their rectangles at the gap
-    /// coefficients `g` (slope `slope`), elastic and virgin, cover a box over which the gap is
-    /// negative by the margin of [`WholeContact::of`](super::elastic_step::WholeContact::of),
-    /// and stick by the corner test over it; they are at least [`MIN_CLOSED_SHARE`] of the cells. The cells
-    /// in the range (those the line `g = 0` crosses, the open ones, and any between them) are
-    /// stepped one by one. The joint and its [`HingeRecord`]; `None` otherwise (also when every
-    /// cell fits: that joint is closed all over, [`JointLevel::enter`]).
-    #[inline(never)]
-    pub(super) fn enter_partial<S: PartialEq + Default>(
-        own: &[SubContact<S>],
-        regime: &ElasticRegime,
-        g: (Real, Real, Real),
-        slope: Vector2,
-        kinematics: &Kinematics,
-    ) -> Option<(Self, HingeRecord)> {
-        let virgin = S::default();
-        let fits = |sub: &SubContact<S>| {
-            let half = sub.half();
-            let spread = slope.x.abs() * half.x + slope.y.abs() * half.y;
-            let gap = face_gap(g, sub.plane.x, sub.plane.y);
-            sub.status == JointStatus::Elastic && sub.state == virgin && gap < 0.0 && gap <= -spread && sub.area > 0.0
-        };
-        let first = own.iter().position(|s| !fits(s))?;
-        let last = own.iter().rposition(|s| !fits(s)).map_or(first, |l| l + 1);
-        let whole = own.len() - (last - first);
-        if whole * MIN_CLOSED_SHARE < own.len() || u16::try_from(own.len()).is_err() {
-            return None;
-        }
-        let mut lo = Vector2::splat(Real::INFINITY);
-        let mut hi = Vector2::splat(Real::NEG_INFINITY);
-        let mut held = [Vector2::ZERO; 3];
-        let mut held_stress: Real = 0.0;
-        let mut room = Real::INFINITY;
-        for sub in own[..first].iter().chain(&own[last..]) {
-            let half = sub.half();
-            lo = lo.min(sub.plane - half);
-            hi = hi.max(sub.plane + half);
-            let f = sub.force.shear;
-            held[0] += f;
-            held[1] += f * sub.plane.x;
-            held[2] += f * sub.plane.y;
-            let stress = f.length() / sub.area;
-            held_stress = held_stress.max(stress);
-            let compression = -regime.normal_stiffness * face_gap(g, sub.plane.x, sub.plane.y);
-            room = room.min(STRENGTH_SHARE * (regime.cohesion + regime.tan_friction * compression) - stress);
-        }
-        let hinge = HingeRecord {
-            closed_box: (lo, hi),
-            entry_gap: g,
-            room,
-        };
-        let closed = super::elastic_step::closed_over(g, (lo, hi));
-        // Its cells must have room for two more steps like this one, or the joint would leave
-        // again at once (a joint whose cells next to the line `g = 0` stick with nothing to
-        // spare, entering and leaving at every step, its cells scanned and written each time).
-        let tangential = |v: Vector| Vector2::new(v.y, v.z) * 2.0;
-        let ahead = [
-            tangential(kinematics.at_origin),
-            tangential(kinematics.per_x),
-            tangential(kinematics.per_y),
-        ];
-        let joint = Self {
-            active: true,
-            open: false,
-            span: (first as u16, last as u16),
-            held,
-            held_stress,
-            field: [Vector2::ZERO; 3],
-            stiffness: (regime.normal_stiffness, regime.shear_stiffness),
-            gap: g,
-        };
-        (closed && partial_corners_stick(&hinge, regime, g, &ahead)).then_some((joint, hinge))
+    pub(crate) fn holds_open(&self, index: usize) -> bool {
+        self.open
+            || match self.ends {
+                SpanEnds::Closed => false,
+                SpanEnds::OpenBefore => index < usize::from(self.span.0),
+                SpanEnds::OpenAfter => index >= usize::from(self.span.1),
+            }
     }
 
     /// A cell's force, gap and status as the joint stands (its own when the joint is not
@@ -439,7 +321,7 @@ impl JointLevel {
         if !self.active || self.span_range().contains(&index) {
             return (sub.force, sub.gap, sub.status);
         }
-        if self.open {
+        if self.holds_open(index) {
             // As the cells' own loop keeps an open cell (`elastic_step::stays_open_cell`): the
             // gap at its corner nearest to closing.
             let half = sub.half();
@@ -477,7 +359,7 @@ mod tests {
     use super::*;
     use crate::law::{ConstitutiveLaw, CoulombSlip, CoulombState};
 
-    fn cell(x: Real, y: Real, area: Real, shear: Vector2) -> SubContact<CoulombState> {
+    pub(super) fn cell(x: Real, y: Real, area: Real, shear: Vector2) -> SubContact<CoulombState> {
         SubContact {
             plane: Vector2::new(x, y),
             area,
@@ -492,7 +374,7 @@ mod tests {
 
     /// Each of `cells` takes its own elastic step (which must leave it elastic); returns the
     /// sums of their forces.
-    fn elastic_steps(
+    pub(super) fn elastic_steps(
         cells: &mut [SubContact<CoulombState>],
         regime: &ElasticRegime,
         kinematics: &Kinematics,
@@ -642,107 +524,5 @@ mod tests {
             "a joint with strength to spare at its corners enters"
         );
         assert!(joint_with(0.0).is_some());
-    }
-
-    /// A hinge: a 5 × 3 grid of cells (columns contiguous in cell order) whose first column is
-    /// open and second crossed by the line `g = 0`. The cells outside the first two columns are
-    /// stepped as a whole for 50 steps: their sums (the joint's moments less the span's) and
-    /// each cell as the joint gives it are what their own elastic steps give; the corner test
-    /// fails before any of them would slide.
-    #[test]
-    fn a_hinge_steps_its_closed_cells_as_a_whole() {
-        let law = CoulombSlip::dry(1e9, 4e8, 30.0).expect("law");
-        let regime = law.elastic_regime().expect("regime");
-        // `g = −s (x − 0.12)`: open for x < 0.12, closed beyond.
-        let s = 1e-4;
-        let g = (0.12 * s, s, 0.0);
-        let slope = Vector2::new(-g.1, -g.2);
-        let mut cells: Vec<_> = (0..15)
-            .map(|k| {
-                let (x, y) = (0.1 * (k / 3) as Real, 0.1 * (k % 3) as Real);
-                let gap = face_gap(g, x, y);
-                let mut c = cell(x, y, 0.01, Vector2::ZERO);
-                c.gap = gap;
-                if x < 0.05 {
-                    c.status = JointStatus::Open;
-                    c.force = JointForce::default();
-                } else {
-                    // A tenth of what the anchor's compression allows, varied over the cells.
-                    let allowed = 30.0_f64.to_radians().tan() * 1e9 * (-gap).max(0.0) * 0.01;
-                    c.force = JointForce {
-                        normal: 1e9 * (-gap).max(0.0) * 0.01,
-                        shear: Vector2::new(0.1 * allowed, -0.03 * allowed * (k % 3) as Real),
-                    };
-                }
-                c
-            })
-            .collect();
-        let summary = CellSummary::of(&cells);
-        let still = Kinematics {
-            at_origin: Vector::ZERO,
-            per_x: Vector::ZERO,
-            per_y: Vector::ZERO,
-        };
-        let (mut joint, hinge) = JointLevel::enter_partial(&cells, &regime, g, slope, &still).expect("enters");
-        assert_eq!(joint.span, (0, 6), "the open and the straddling column");
-        assert!((hinge.closed_box.0 - Vector2::new(0.15, -0.05)).length() < 1e-8);
-        assert!((hinge.closed_box.1 - Vector2::new(0.45, 0.25)).length() < 1e-8);
-        let span = joint.span_range();
-        let mut own = cells.clone();
-        for step in 0..50 {
-            let t = step as Real;
-            let kinematics = Kinematics {
-                at_origin: Vector::new(0.0, 2e-9 * (0.1 * t).sin(), -1e-9),
-                per_x: Vector::new(0.0, 3e-9, 1e-9 * (0.3 * t).cos()),
-                per_y: Vector::new(0.0, -1e-9, 2e-9),
-            };
-            assert!(
-                joint.advance(StickTest::Hinge(&hinge), &regime, &kinematics, g),
-                "step {step}: sticks"
-            );
-            let (moments, j) = summary.without(&own[span.clone()]);
-            let (joint_sums, _) = joint.sums(&moments, j, None);
-            let cell_sums = elastic_steps(&mut cells[span.end..], &regime, &kinematics, g);
-            assert!(
-                joint_sums.matches(&cell_sums),
-                "step {step}: {joint_sums:?} vs {cell_sums:?}"
-            );
-        }
-        for (i, (a, b)) in own.iter().zip(&cells).enumerate() {
-            let (force, gap, _) = joint.live(i, a);
-            assert!((force.normal - b.force.normal).abs() <= 1e-12 * b.force.normal.abs().max(1.0));
-            assert!((force.shear - b.force.shear).length() < 1e-12 * b.force.shear.length().max(1.0));
-            assert_eq!(gap.to_bits(), b.gap.to_bits());
-        }
-        joint.write_cells(&mut own);
-        assert!(!joint.active);
-        assert_eq!(own[..span.end], cells[..span.end], "the span's cells are their own");
-
-        // Pushed sideways until a cell stepped as a whole would slide: the test fails first.
-        let (mut joint, hinge) = JointLevel::enter_partial(&cells, &regime, g, slope, &still).expect("enters");
-        let push = Kinematics {
-            at_origin: Vector::new(0.0, 1e-8, 0.0),
-            per_x: Vector::ZERO,
-            per_y: Vector::ZERO,
-        };
-        let mut steps = 0;
-        while joint.advance(StickTest::Hinge(&hinge), &regime, &push, g) {
-            steps += 1;
-            for c in cells[span.end..].iter_mut() {
-                let gap = face_gap(g, c.plane.x, c.plane.y);
-                let (force, status) = regime
-                    .step(c.area, gap, Vector2::new(1e-8, 0.0), c.force.shear)
-                    .expect("regime");
-                assert_eq!(
-                    status,
-                    JointStatus::Elastic,
-                    "step {steps}: a cell the joint holds slides"
-                );
-                c.force = force;
-            }
-            assert!(steps < 100_000, "never left");
-        }
-        // The weakest cell, next to the line, had 0.9 of its strength to spare.
-        assert!(steps > 0);
     }
 }
