@@ -431,6 +431,14 @@ fn an_edited_whole_joint_is_refused() -> Result<()> {
             "{span:?} {open} {with_hinge} {ends}: {err}"
         );
     }
+    // A cell stepped as a whole that is not in its law's initial state is refused, naming it.
+    let mut edited = json.clone();
+    edited["contacts"][k]["subcontacts"][0]["state"] = serde_json::json!({ "failed": true });
+    let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&edited)?).expect_err("a failed cell held whole");
+    assert!(
+        err.to_string().contains(&format!("contacts[{k}].subcontacts[0]")) && err.to_string().contains("initial state"),
+        "{err}"
+    );
     // A cell said to be open and stepped as a whole that carries a force is refused, naming it.
     let mut edited = json.clone();
     edited["contacts"][k]["joint"]["level"]["span"] = serde_json::json!([1, 2]);

@@ -1,4 +1,4 @@
-//! Joint-level stepping (`src/contact/joint_level.rs`): a closed, sticking joint stepped as a
+//! Joint-level stepping (`src/contact/joint_level/`): a closed, sticking joint stepped as a
 //! whole gives the forces and poses of the cell-by-cell step to round-off, through settling,
 //! shaking, landing and sliding, and through a checkpoint.
 //!

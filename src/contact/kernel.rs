@@ -55,7 +55,7 @@ pub(crate) struct KernelContext {
     pub mode: DisplacementMode,
     /// How the all-closed joints' cells are computed (the same bits either way).
     pub lanes: super::LaneBuild,
-    /// Whether closed, sticking joints are stepped as a whole (`joint_level.rs`).
+    /// Whether closed, sticking joints are stepped as a whole (`joint_level/`).
     pub joint_level: bool,
     /// The model's step count: a joint open in part tries to enter joint-level stepping at
     /// one step in [`PARTIAL_ENTRY_PERIOD`] (its own, from its blocks).
@@ -192,8 +192,9 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
     let mut dissipated = 0.0;
     let mut fracture = 0.0;
     let elastic_regime = if dashpots { None } else { law.elastic_regime() };
-    // A joint stepped as a whole (`joint_level.rs`) takes the joint-level step while it stays
-    // closed and sticking; otherwise its cells are written and stepped one by one below.
+    // A joint stepped as a whole (`joint_level/`) takes the joint-level step while it stays
+    // closed and sticking (or open, or both in parts); otherwise its cells are written and
+    // stepped one by one below.
     let mut whole_joint = false;
     if pair.joint.active {
         if let (true, Some(regime), Some(g)) = (ctx.joint_level, elastic_regime.as_ref(), face_gap_coefficients) {
@@ -201,9 +202,10 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 // Open all over: nothing to sum (the sums and spread energy stay zero).
                 whole_joint = exact.is_some_and(|e| e.virgin_without_tension) && pair.joint.step_open(&pair.cells, g);
             } else if pair.joint.is_partial() {
-                // Open in part: the cells stepped as a whole while they stay closed and stick,
-                // the others (`span`) one by one (`joint_level.rs`). Only a hinge reads its
-                // record in the reference.
+                // Open in part: the closed cells stepped as a whole while they stay closed and
+                // stick, the open ones at one end (if any) while they stay open, the others
+                // (`span`) one by one (`joint_level/hinge.rs`). Only a hinge reads its record in
+                // the reference.
                 if let Some(step) = exact.filter(|e| e.virgin_without_tension).and_then(|e| {
                     step_hinge(
                         pair,

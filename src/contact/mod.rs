@@ -96,7 +96,7 @@ pub(crate) struct ContactPair {
     /// What the step needs of the cells as a whole (see [`CellSummary`]): derived from the
     /// sub-contacts whenever they are set (detection, checkpoint load), not stored.
     pub(crate) cells: CellSummary,
-    /// The joint stepped as a whole while it is closed and sticking (`contact/joint_level.rs`);
+    /// The joint stepped as a whole while it is closed and sticking (`contact/joint_level/`);
     /// inactive otherwise. Checkpointed.
     pub(crate) joint: JointLevel,
 }
@@ -115,7 +115,7 @@ pub(crate) struct CellSummary {
     pub(crate) closed_moments: Vector2,
     /// The cells' area moments about the plane's origin, taken at their anchors:
     /// `Σ A`, `Σ A x`, `Σ A y`, `Σ A x²`, `Σ A x y`, `Σ A y²` (m², m³, m³, m⁴, m⁴, m⁴), for
-    /// joint-level stepping (`contact/joint_level.rs`).
+    /// joint-level stepping (`contact/joint_level/`).
     pub(crate) area_moments: [Real; 6],
 }
 
@@ -146,8 +146,8 @@ impl CellSummary {
     }
 
     /// The area moments and `Σ J` of the cells other than `some` (of the same contact): the
-    /// summary's less those of `some`, summed in their order. A joint open in part steps the
-    /// cells outside its span as a whole with these (`contact/joint_level.rs`).
+    /// summary's less those of `some`, summed in their order. A joint open in part takes those
+    /// of its closed cells so when it enters (`contact/joint_level/hinge.rs`).
     #[inline]
     pub(crate) fn without<S>(&self, some: &[SubContact<S>]) -> ([Real; 6], Vector2) {
         let part = Self::of(some);

@@ -316,7 +316,7 @@ pub struct SubContactView<'a, S> {
     frame: Pose,
     sub: &'a SubContact<S>,
     /// The sub-contact's force, gap and status as they stand: its own, or those of its joint
-    /// while the joint is stepped as a whole (`joint_level.rs`).
+    /// while the joint is stepped as a whole (`joint_level/`).
     live: (JointForce, Real, JointStatus),
     record: &'a SubContactRecord,
     /// Its dashpot force (zero when the model keeps none).

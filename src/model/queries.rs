@@ -146,7 +146,7 @@ impl<L: ConstitutiveLaw> Model<L> {
     /// How many joints are stepped as a whole after the last step: face-face joints closed all
     /// over whose sub-contacts all stick, open all over with their sub-contacts unloaded, or
     /// open in part (a hinge) with the sub-contacts closed over their cells sticking, which are
-    /// stepped as a whole, and the others one by one ([`Model::set_joint_stepping`],
+    /// stepped as a whole with its open ones at one end, and the others one by one ([`Model::set_joint_stepping`],
     /// `docs/theory.md` §3.1).
     pub fn whole_joint_count(&self) -> usize {
         self.state.contacts.pairs.iter().filter(|p| p.joint.active).count()

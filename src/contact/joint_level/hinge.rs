@@ -20,8 +20,8 @@ const MIN_CLOSED_SHARE: usize = 8;
 /// ([`JointLevel::span`]): the cells closed all over, stepped as a whole while they stick, are
 /// at both ends or at one; in the second case the other end may hold the joint's open cells,
 /// stepped as a whole while the gap stays positive over their box
-/// ([`HingeRecord::open_box`]): a hinge whose neutral line runs along the cells' rows leaves
-/// only the row it crosses to be stepped one by one.
+/// ([`HingeRecord::open_box`]): a hinge whose line `g = 0` runs along the face grid's columns
+/// (contiguous in cell order) leaves only the column it crosses to be stepped one by one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
@@ -43,11 +43,12 @@ pub(crate) enum SpanEnds {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub(crate) struct HingeRecord {
-    /// The box (plane coordinates, lower and upper corner) of the cells stepped as a whole.
+    /// The box (plane coordinates, lower and upper corner) of the closed cells stepped as a
+    /// whole.
     pub(crate) closed_box: (Vector2, Vector2),
     /// The gap coefficients when the joint entered, `g_e`.
     pub(crate) entry_gap: (Real, Real, Real),
-    /// The least room the cells stepped as a whole had when the joint entered,
+    /// The least room the closed cells stepped as a whole had when the joint entered,
     /// `m = minᵢ (share · (c + tan φ k_n (−g_e(xᵢ, yᵢ))) − |F⁰ᵢ|/Aᵢ)` (Pa): they stick while
     /// `k_s |U| + share · tan φ k_n (g − g_e) ≤ m` at the corners of `closed_box`
     /// ([`partial_corners_stick`]).
@@ -81,7 +82,7 @@ impl HingeRecord {
     }
 }
 
-/// Whether every cell stepped as a whole of a joint open in part still sticks: at the four
+/// Whether every closed cell stepped as a whole of a joint open in part still sticks: at the four
 /// corners of the box they cover, `k_s |U| + share · tan φ k_n (g − g_e) ≤ m` for the room `m`
 /// and gap `g_e` they had when the joint entered (`hinge`). Each cell had
 /// `|F⁰ᵢ|/Aᵢ ≤ share · (c + tan φ k_n (−g_e)) − m`, so the test bounds
@@ -222,7 +223,7 @@ impl JointLevel {
             ..HingeRecord::default()
         };
         hinge.measure(own, cells, &joint);
-        // Open cells whose box the gap does not keep open (a line `g = 0` across the rows)
+        // Open cells whose box the gap does not keep open (a line `g = 0` across the columns)
         // stay in the range.
         if ends != SpanEnds::Closed && !Self::open_over(hinge.open_box, g) {
             (joint.ends, joint.span) = (SpanEnds::Closed, (first as u16, last as u16));

@@ -57,8 +57,9 @@ pub(crate) struct JointLevel {
     /// open at any opening): its cells carry nothing, and only their gaps change.
     pub(crate) open: bool,
     /// A joint open in part (a hinge): its cells `span.0..span.1` (indices among the joint's
-    /// own, in order) are stepped one by one every step, and the others, all closed, as a
-    /// whole; `held` and `field` are theirs, and the rest of what they need is the contact's
+    /// own, in order) are stepped one by one every step, and the others as a whole: those
+    /// closed all over, whose `held` and `field` these are, and, at one end, those open all
+    /// over ([`JointLevel::ends`]); the rest of what they need is the contact's
     /// [`HingeRecord`]. Empty for a joint closed all over or open all over. (Two `u16` fit in
     /// the record's padding after the flags: a joint of more than 65,535 cells is not stepped
     /// so.)
@@ -193,7 +194,7 @@ impl JointLevel {
     /// smallest value is at a corner), by a margin far above the round-off of the cells' own
     /// tests, so that each cell would also find itself open all over.
     #[inline]
-    pub(super) fn open_over((lo, hi): (Vector2, Vector2), g: (Real, Real, Real)) -> bool {
+    pub(crate) fn open_over((lo, hi): (Vector2, Vector2), g: (Real, Real, Real)) -> bool {
         let slope = Vector2::new(-g.1, -g.2);
         let (low, high) = (slope * lo, slope * hi);
         let smallest = g.0 + low.x.min(high.x) + low.y.min(high.y);

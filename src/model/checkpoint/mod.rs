@@ -160,7 +160,7 @@ struct ContactEntry<S> {
     /// The sub-contacts, with their forces as they stand (also those of a joint stepped as a
     /// whole).
     subcontacts: Vec<SubContactEntry<S>>,
-    /// A joint stepped as a whole (`contact/joint_level.rs`): what the step continues from.
+    /// A joint stepped as a whole (`contact/joint_level/`): what the step continues from.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     joint: Option<JointEntry>,
 }

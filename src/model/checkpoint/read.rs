@@ -84,13 +84,14 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>) -> Result
             };
             if let Some(entry) = &e.joint {
                 sub.force.shear = entry.held_shear[j];
-                // A cell stepped as a whole and open carries nothing and is virgin, as the
-                // joint entered with it (`JointLevel::enter_open`, `enter_partial`).
-                if joint.holds_open(j) && (sub.force != JointForce::default() || sub.state != Default::default()) {
+                // A cell stepped as a whole is virgin, and carries nothing if open, as the joint
+                // entered with it (`JointLevel::enter`, `enter_open`, `enter_partial`).
+                let whole = joint.active && !joint.span_range().contains(&j);
+                if whole && (sub.state != S::default() || (joint.holds_open(j) && sub.force != JointForce::default())) {
                     return Err(corrupt(
                         &format!("contacts[{k}].subcontacts[{j}]"),
-                        "is open in a joint stepped as a whole, so must carry no force and be in its \
-                         law's initial state",
+                        "is stepped as a whole with its joint, so must be in its law's initial state and, \
+                         open, carry no force",
                     ));
                 }
                 let (force, gap, status) = joint.live(j, &sub);
@@ -396,9 +397,15 @@ fn restore_contacts<L: ConstitutiveLaw>(
         p.cells = crate::contact::CellSummary::of(&model.state.contacts.subs[p.range()]);
         if p.joint.is_partial() {
             let subs = &model.state.contacts.subs[p.range()];
-            model.state.contacts.references[k]
-                .hinge
-                .measure(subs, &p.cells, &p.joint);
+            let hinge = &mut model.state.contacts.references[k].hinge;
+            hinge.measure(subs, &p.cells, &p.joint);
+            // Its open cells stepped as a whole are open over their box at the joint's gap.
+            if p.joint.ends != SpanEnds::Closed && !crate::contact::JointLevel::open_over(hinge.open_box, p.joint.gap) {
+                return Err(corrupt(
+                    &format!("contacts[{k}].joint"),
+                    "steps open cells as a whole where its gap closes them",
+                ));
+            }
         }
         // Dashpot forces still held must be seen (and their work booked) by the next step.
         p.dashpots |= model.state.contacts.dashpots_kept
