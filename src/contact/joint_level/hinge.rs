@@ -44,7 +44,9 @@ pub(crate) enum SpanEnds {
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub(crate) struct HingeRecord {
     /// The box (plane coordinates, lower and upper corner) of the closed cells stepped as a
-    /// whole.
+    /// whole. Derived from the cells like the fields below ([`HingeRecord::measure`]), so not
+    /// written; files of version 15 hold it, and it is measured again when they are read.
+    #[cfg_attr(feature = "serde", serde(default, skip_serializing))]
     pub(crate) closed_box: (Vector2, Vector2),
     /// The gap coefficients when the joint entered, `g_e`.
     pub(crate) entry_gap: (Real, Real, Real),
@@ -68,17 +70,24 @@ pub(crate) struct HingeRecord {
 
 impl HingeRecord {
     /// Sets what the record derives from the joint's cells `own` (their summary `cells`) and
-    /// its `joint` record: the open cells' box and the closed cells' moments.
+    /// its `joint` record: the closed cells' box and moments and the open cells' box.
     pub(crate) fn measure<S>(&mut self, own: &[SubContact<S>], cells: &CellSummary, joint: &JointLevel) {
         let (span, n) = (joint.span_range(), own.len());
         let (others, open) = match joint.ends {
-            SpanEnds::Closed => (span, 0..0),
+            SpanEnds::Closed => (span.clone(), 0..0),
             SpanEnds::OpenBefore => (0..span.end, 0..span.start),
             SpanEnds::OpenAfter => (span.start..n, span.end..n),
         };
         self.closed_moments = cells.without(&own[others]);
         let open = CellSummary::of(&own[open]);
         self.open_box = (open.lo, open.hi);
+        let (before, after) = match joint.ends {
+            SpanEnds::Closed => (0..span.start, span.end..n),
+            SpanEnds::OpenBefore => (0..0, span.end..n),
+            SpanEnds::OpenAfter => (0..span.start, n..n),
+        };
+        let (before, after) = (CellSummary::of(&own[before]), CellSummary::of(&own[after]));
+        self.closed_box = (before.lo.min(after.lo), before.hi.max(after.hi));
     }
 }
 
@@ -187,15 +196,10 @@ impl JointLevel {
                 (ends, span) = (SpanEnds::OpenAfter, (first, n - open));
             }
         }
-        let mut lo = Vector2::splat(Real::INFINITY);
-        let mut hi = Vector2::splat(Real::NEG_INFINITY);
         let mut held = [Vector2::ZERO; 3];
         let mut held_stress: Real = 0.0;
         let mut room = Real::INFINITY;
         for sub in own[..first].iter().chain(&own[last..]) {
-            let half = sub.half();
-            lo = lo.min(sub.plane - half);
-            hi = hi.max(sub.plane + half);
             let f = sub.force.shear;
             held[0] += f;
             held[1] += f * sub.plane.x;
@@ -217,7 +221,6 @@ impl JointLevel {
             gap: g,
         };
         let mut hinge = HingeRecord {
-            closed_box: (lo, hi),
             entry_gap: g,
             room,
             ..HingeRecord::default()
@@ -229,7 +232,7 @@ impl JointLevel {
             (joint.ends, joint.span) = (SpanEnds::Closed, (first as u16, last as u16));
             hinge.measure(own, cells, &joint);
         }
-        let closed = crate::contact::elastic_step::closed_over(g, (lo, hi));
+        let closed = crate::contact::elastic_step::closed_over(g, hinge.closed_box);
         // Its cells must have room for two more steps like this one, or the joint would leave
         // again at once (a joint whose cells next to the line `g = 0` stick with nothing to
         // spare, entering and leaving at every step, its cells scanned and written each time).

@@ -45,7 +45,8 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// cells: the joint record's `span` and the joint's `hinge` (its cells' box, gap and room at
 /// entry), absent (a joint closed or open all over) in the files of version 14, which this
 /// build reads. Version 16 adds a hinge's open cells stepped as a whole: the joint record's
-/// `ends` (`"closed"` in the files of version 15, which this build reads).
+/// `ends` (`"closed"` in the files of version 15, which this build reads); the hinge record's
+/// `closed_box` is no longer written, but measured from the cells when a file is read.
 const VERSION: u32 = 16;
 /// The oldest version this build reads: 13 differs from 14 only in having no joints stepped
 /// as a whole ([`JointEntry`]).
@@ -173,8 +174,8 @@ struct ContactEntry<S> {
 struct JointEntry {
     level: crate::contact::JointLevel,
     held_shear: Vec<Vector2>,
-    /// Of a joint open in part (its `level.span` not empty): its cells' box, gap and room at
-    /// entry (version 15).
+    /// Of a joint open in part (its `level.span` not empty): its cells' gap and room at entry
+    /// (version 15; also their box, which version 16 measures from the cells instead).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     hinge: Option<crate::contact::HingeRecord>,
 }
