@@ -449,6 +449,23 @@ fn an_edited_whole_joint_is_refused() -> Result<()> {
         err.to_string().contains(&format!("contacts[{k}].subcontacts[0]")) && err.to_string().contains("open"),
         "{err}"
     );
+    // What a file's version did not have is refused, naming the joint and the version: open
+    // cells stepped as a whole in a version 15 file, a span and a hinge record in a version 14
+    // one (no build of those versions wrote them).
+    for (version, what) in [(15, "`ends`"), (14, "a span or a hinge record")] {
+        let mut older = edited.clone();
+        older["version"] = serde_json::json!(version);
+        if version == 14 {
+            older["contacts"][k]["joint"]["level"]["ends"] = serde_json::json!("closed");
+        }
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&older)?).expect_err("newer than its version");
+        assert!(
+            err.to_string().contains(&format!("contacts[{k}].joint"))
+                && err.to_string().contains(what)
+                && err.to_string().contains(&format!("version {version} file")),
+            "{version}: {err}"
+        );
+    }
     // Unedited, it loads; as version 13 wrote it (no joints stepped as a whole: the cells as
     // they stand), it loads too, its joints stepped cell by cell until they enter again.
     assert_eq!(

@@ -66,8 +66,9 @@ pub(crate) struct KernelContext {
 /// ([`JointLevel::enter_partial`] scans its cells): a joint that cannot enter (its closed cells
 /// too few, or without room) is not scanned at every step, on a moving scene that holds
 /// thousands of them. (At every step, the static arch's hinges entered twice as often for 4 %
-/// more steps stepped so: a joint that enters right after leaving leaves again.) Which step is the joint's own, from its blocks' indices and the
-/// model's step count, so that a restarted run tries at the same steps.
+/// more steps stepped so: a joint that enters right after leaving leaves again.) Which step is
+/// the joint's own, from its blocks' indices and the model's step count, so that a restarted
+/// run tries at the same steps.
 pub(crate) const PARTIAL_ENTRY_PERIOD: u64 = 8;
 
 impl KernelContext {
@@ -205,22 +206,15 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 // Open in part: the closed cells stepped as a whole while they stay closed and
                 // stick, the open ones at one end (if any) while they stay open, the others
                 // (`span`) one by one (`joint_level/hinge.rs`). Only a hinge reads its record in
-                // the reference.
-                if let Some(step) = exact.filter(|e| e.virgin_without_tension).and_then(|e| {
-                    step_hinge(
-                        pair,
-                        &reference.hinge,
-                        subs,
-                        law,
-                        regime,
-                        &kinematics,
-                        g,
-                        e,
-                        axes,
-                        dt,
-                        ctx.lanes,
-                    )
-                }) {
+                // the reference (boxed: a joint open in part always has it).
+                let hinge = reference.hinge.as_deref();
+                if let Some(step) = exact
+                    .filter(|e| e.virgin_without_tension)
+                    .zip(hinge)
+                    .and_then(|(e, hinge)| {
+                        step_hinge(pair, hinge, subs, law, regime, &kinematics, g, e, axes, dt, ctx.lanes)
+                    })
+                {
                     (sums, dissipated, spread_energy, fracture) = step;
                     whole_joint = true;
                 }
@@ -283,7 +277,12 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                                             )
                                         })
                                         .flatten()?;
-                                    reference.hinge = hinge;
+                                    // The box is allocated at the contact's first entry
+                                    // since its detection, and reused after.
+                                    match reference.hinge.as_deref_mut() {
+                                        Some(record) => *record = hinge,
+                                        None => reference.hinge = Some(Box::new(hinge)),
+                                    }
                                     Some(joint)
                                 })
                             }

@@ -73,7 +73,9 @@ pub(crate) struct JointLevel {
     /// `Σ F⁰ᵢ`, `Σ F⁰ᵢ xᵢ`, `Σ F⁰ᵢ yᵢ` of the shear forces the cells hold (tangent components;
     /// N, N·m, N·m).
     pub(crate) held: [Vector2; 3],
-    /// `maxᵢ |F⁰ᵢ|/Aᵢ` (Pa).
+    /// `maxᵢ |F⁰ᵢ|/Aᵢ` (Pa): the corner test's `τ⁰`. Of a hinge, over its closed cells stepped
+    /// as a whole, for the record: its stick test reads each cell's room at entry instead
+    /// ([`HingeRecord`]).
     pub(crate) held_stress: Real,
     /// `U_o`, `U_x`, `U_y`: the tangential displacement since the cells were written, as an
     /// affine field over the anchor plane (m, m/m, m/m).

@@ -46,7 +46,8 @@ const FORMAT: &str = "voussoir-checkpoint";
 /// entry), absent (a joint closed or open all over) in the files of version 14, which this
 /// build reads. Version 16 adds a hinge's open cells stepped as a whole: the joint record's
 /// `ends` (`"closed"` in the files of version 15, which this build reads); the hinge record's
-/// `closed_box` is no longer written, but measured from the cells when a file is read.
+/// `closed_box` is no longer written, but measured from the cells when a file is read. A
+/// joint record holding what its file's version did not have is refused.
 const VERSION: u32 = 16;
 /// The oldest version this build reads: 13 differs from 14 only in having no joints stepped
 /// as a whole ([`JointEntry`]).

@@ -28,7 +28,10 @@ use crate::model::{Model, ModelParameters};
 /// The step's storage rebuilt from checkpointed joints. A joint stepped as a whole gets its
 /// cells' held shear forces back; its stored forces must be those its record gives them, to the
 /// bit (else the error names it).
-fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>) -> Result<ContactStore<S>> {
+/// A joint record holding what its file's `version` did not have (a span or a hinge record
+/// before version 15, open cells at one end before 16) is refused: no build of that version
+/// wrote it.
+fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: u32) -> Result<ContactStore<S>> {
     let total = entries.iter().map(|e| e.subcontacts.len()).sum();
     let (mut pairs, mut references, mut wrenches) = (
         Vec::with_capacity(entries.len()),
@@ -45,6 +48,21 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>) -> Result
     for (k, e) in entries.into_iter().enumerate() {
         let first = subs.len() as u32;
         let count = e.subcontacts.len() as u32;
+        if let Some(j) = &e.joint {
+            let newer = if version < 15 && (j.level.span != (0, 0) || j.hinge.is_some()) {
+                Some("a span or a hinge record, which version 15 added")
+            } else if version < 16 && j.level.ends != SpanEnds::Closed {
+                Some("open cells stepped as a whole (`ends`), which version 16 added")
+            } else {
+                None
+            };
+            if let Some(what) = newer {
+                return Err(corrupt(
+                    &format!("contacts[{k}].joint"),
+                    &format!("holds {what}, in a version {version} file"),
+                ));
+            }
+        }
         let (joint, hinge) = match &e.joint {
             None => Default::default(),
             Some(j)
@@ -60,7 +78,7 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>) -> Result
                             && j.hinge.is_some()))
                     && matches!(e.kind, crate::geometry::ContactKind::FaceFace { .. }) =>
             {
-                (j.level, j.hinge.unwrap_or_default())
+                (j.level, j.hinge.map(Box::new))
             }
             Some(_) => {
                 return Err(corrupt(
@@ -231,7 +249,7 @@ where
     pub fn from_checkpoint_str(text: &str) -> Result<Self> {
         let mut snap = parse_snapshot::<L>(text)?;
         let tested = check_snapshot(&snap)?;
-        let storage = into_storage(std::mem::take(&mut snap.contacts))?;
+        let storage = into_storage(std::mem::take(&mut snap.contacts), snap.version)?;
         check_contacts(&snap, &storage, &tested)?;
         let pending_detection = snap.pending_detection;
         let mut model = restore_blocks(snap.params, std::mem::take(&mut snap.blocks), snap.dt.max(snap.drift))?;
@@ -397,7 +415,13 @@ fn restore_contacts<L: ConstitutiveLaw>(
         p.cells = crate::contact::CellSummary::of(&model.state.contacts.subs[p.range()]);
         if p.joint.is_partial() {
             let subs = &model.state.contacts.subs[p.range()];
-            let hinge = &mut model.state.contacts.references[k].hinge;
+            // A hinge's record was read with it (checked above).
+            let Some(hinge) = model.state.contacts.references[k].hinge.as_deref_mut() else {
+                return Err(corrupt(
+                    &format!("contacts[{k}].joint"),
+                    "a joint open in part without its hinge record",
+                ));
+            };
             hinge.measure(subs, &p.cells, &p.joint);
             // Its open cells stepped as a whole are open over their box at the joint's gap.
             if p.joint.ends != SpanEnds::Closed && !crate::contact::JointLevel::open_over(hinge.open_box, p.joint.gap) {
