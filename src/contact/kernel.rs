@@ -57,6 +57,9 @@ pub(crate) struct KernelContext {
     pub lanes: super::LaneBuild,
     /// Whether closed, sticking joints are stepped as a whole (`joint_level/`).
     pub joint_level: bool,
+    /// The grid spacing of node contacts' nodes comes from this ([`crate::geometry::ContactParameters::density`]):
+    /// a node's strips are as wide as at its detection.
+    pub node_density: crate::geometry::SubContactDensity,
     /// The model's step count: a joint open in part tries to enter joint-level stepping at
     /// one step in [`PARTIAL_ENTRY_PERIOD`] (its own, from its blocks).
     pub step: u64,

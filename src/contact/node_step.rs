@@ -17,9 +17,10 @@
 
 use super::kernel::{plane_turn, ContactStep, KernelContext};
 use super::law_update::{stays_separated, update_with_law};
+use super::spread::tension_free;
 use super::{ContactPair, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
-use crate::geometry::{deepest_two, NodeId, Polyhedron};
+use crate::geometry::{deepest_two, for_each_strip, spacing, NodeId, Polyhedron, SharesOf, StripLoad};
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{plane_basis, Matrix, Real, Vector, Vector2};
 
@@ -124,6 +125,15 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     let (mut force, mut moment_a, mut moment_b) = (Vector::ZERO, Vector::ZERO, Vector::ZERO);
     let (mut spring_sum, mut dashpot_sum, mut normal_force) = (0.0, 0.0, 0.0);
     let mut fastest: Real = 0.0;
+    // Nodes integrated over their strips (`geometry/narrow_phase/strips.rs`): in
+    // large-displacement mode, for a law whose normal spring is linear (`k_n` per unit area)
+    // and, in the node's state, carries no tension; elsewhere at their points.
+    let integrated = (ctx.mode == DisplacementMode::Large)
+        .then(|| law.elastic_regime().map(|r| r.normal_stiffness))
+        .flatten()
+        .filter(|k| *k > 0.0);
+    let h = spacing(a.2, b.2, ctx.node_density);
+    let mut spread_energy = 0.0;
     for (i, (sub, record)) in subs.iter_mut().zip(records).enumerate() {
         let id = NodeId::from_key(record.key);
         let frame = node_frame(id, a, b);
@@ -141,8 +151,25 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         let du_n = axes.normal.dot(du);
         let du_s = axes.components(du);
         fastest = fastest.max(v_rel.length_squared());
+        let mut strips = None;
         let gap = match ctx.mode {
-            DisplacementMode::Large => frame.gap,
+            // Open, an integrated node reports the gap at its point (its pieces are out of the
+            // other block; the point, on their boundary, is not inside it), as a point node
+            // does: the impact probe watches it close as before.
+            DisplacementMode::Large => match integrated.filter(|_| tension_free(law, &sub.state)) {
+                // Its pieces lie within `h` of it (`strips::reach`): farther out, open.
+                Some(_) if frame.gap > h => frame.gap,
+                Some(_) => {
+                    let load = strip_load(id, a, b, h, sub.area);
+                    if load.load > 0.0 && sub.area > 0.0 {
+                        strips = Some(load);
+                        -load.load / sub.area
+                    } else {
+                        frame.gap.max(Real::MIN_POSITIVE)
+                    }
+                }
+                None => frame.gap,
+            },
             DisplacementMode::Small => sub.gap + du_n,
         };
         // The impact probe: the spring's kink (closing or opening fast), and, for a loaded
@@ -167,6 +194,21 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         spring_sum += (before + spring).dot(du);
         normal_force += sub.force.normal;
         let mut total = spring;
+        // Integrated, the normal force is the strips' pressure, each part along the normal of
+        // the face it lies under and where it acts: a force at the node and a couple about it
+        // (on the node's block; their opposites on the other), and the energy its spread
+        // stores beyond the law's `F_n²/(2 k_n A)`.
+        let mut couple = Vector::ZERO;
+        if let (Some(load), Some(kn)) = (strips, integrated) {
+            if sub.force.normal > 0.0 && status != JointStatus::Open {
+                let other = if id.on_b { a } else { b };
+                let side = if id.on_b { 1.0 } else { -1.0 };
+                let scale = side * sub.force.normal / load.load;
+                total += (*other.1 * load.force) * scale - axes.normal * sub.force.normal;
+                couple = (*other.1 * load.moment) * scale;
+                spread_energy += kn * (load.energy - 0.5 * load.load * load.load / sub.area);
+            }
+        }
         if dashpots {
             let mut dashpot = Vector::ZERO;
             if damped && status != JointStatus::Open {
@@ -184,10 +226,11 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         }
         // The force on b at the node, its opposite on a.
         force += total;
-        moment_b += (p - xb).cross(total);
-        moment_a -= (p - xa).cross(total);
+        moment_b += (p - xb).cross(total) + couple;
+        moment_a -= (p - xa).cross(total) + couple;
     }
     pair.dashpots = damped;
+    pair.spread_energy = spread_energy;
     pair.normal_force = normal_force;
     // The contact's normal for its views: along its resultant while it carries one.
     let length = force.length();
@@ -205,4 +248,24 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     step.work = -0.5 * spring_sum;
     step.dashpot_work = -0.5 * dashpot_sum;
     step
+}
+
+/// The load of node `id`'s strips (`geometry/narrow_phase/strips.rs`) in the other block, per
+/// unit `k_n`, in the other block's body frame, with moments about the node.
+fn strip_load(id: NodeId, a: NodeBlock<'_>, b: NodeBlock<'_>, h: Real, area: Real) -> StripLoad {
+    let (host, other) = if id.on_b { (b, a) } else { (a, b) };
+    // Host body frame to the other's body frame: q = R_oᵀ (x_h + R_h x − x_o).
+    let turn = other.1.transpose() * *host.1;
+    let shift = other.1.transpose() * (host.0.pose.translation - other.0.pose.translation);
+    let about = turn * id.point(host.2) + shift;
+    let mut load = StripLoad::default();
+    let shares = SharesOf {
+        shape: host.2,
+        h,
+        inner: area,
+    };
+    for_each_strip(host.2, &shares, id.place, h, |s| {
+        load.add(other.2, (turn * s.centre + shift, turn * s.u, turn * s.v), &s, about);
+    });
+    load
 }

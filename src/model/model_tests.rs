@@ -81,6 +81,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
         mode: model.state.params.mode,
         lanes: crate::contact::LaneBuild::Portable,
         joint_level: false,
+        node_density: model.state.params.contact.density,
         step: 0,
     };
     let (mut grouped_subs, mut single_subs) = (model.state.contacts.subs.clone(), model.state.contacts.subs.clone());

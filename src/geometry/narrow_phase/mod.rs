@@ -15,6 +15,7 @@ use crate::math::{Pose, Real, Vector};
 mod face;
 mod hull;
 pub(crate) mod nodes;
+pub(crate) mod strips;
 
 pub(crate) use face::contact_polygon;
 use face::*;
@@ -627,7 +628,7 @@ fn separating_axis(a: BlockGeometry<'_>, b: BlockGeometry<'_>, scratch: &mut Nar
 }
 
 /// Characteristic sub-contact spacing for a pair (m), used for node contacts.
-fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubContactDensity) -> Real {
+pub(crate) fn spacing(a: &Polyhedron, b: &Polyhedron, density: SubContactDensity) -> Real {
     match density {
         SubContactDensity::Spacing(h) => h,
         SubContactDensity::PerEdge(n) => a.volume().cbrt().min(b.volume().cbrt()) / n as Real,

@@ -192,6 +192,24 @@ impl FaceGrid {
         (n(self.size.0), n(self.size.1))
     }
 
+    /// The unit axes `(u, v)` of the grid (body frame).
+    #[inline]
+    pub(crate) fn axes(&self) -> (Vector, Vector) {
+        (self.u, self.v)
+    }
+
+    /// The size of a cell of the grid of `nu × nv` cells (m).
+    #[inline]
+    pub(crate) fn cell(&self, nu: u32, nv: u32) -> (Real, Real) {
+        (self.size.0 / nu as Real, self.size.1 / nv as Real)
+    }
+
+    /// Crossing `(i, j)` of the grid of `nu × nv` cells (body frame).
+    #[inline]
+    pub(crate) fn point_at(&self, i: u32, j: u32, nu: u32, nv: u32) -> Vector {
+        self.point(i, j, nu, nv)
+    }
+
     /// Plane coordinates of crossing `(i, j)`.
     fn coordinates(&self, i: u32, j: u32, nu: u32, nv: u32) -> (Real, Real) {
         (
@@ -314,7 +332,7 @@ pub(crate) fn deepest_two(shape: &Polyhedron, q: Vector) -> (usize, Real, Real) 
 }
 
 /// Segments of an edge of length `length` between nodes at most `h` apart.
-fn segments(length: Real, h: Real) -> u32 {
+pub(super) fn segments(length: Real, h: Real) -> u32 {
     ((length / h - 1e-9).ceil() as u32).clamp(1, MAX_EDGE_SEGMENTS)
 }
 
@@ -337,34 +355,80 @@ pub(crate) struct NodeAreas {
 
 impl NodeAreas {
     pub(crate) fn of(shape: &Polyhedron, h: Real) -> Self {
+        let (boundary, inner) = (0..shape.faces().len()).map(|f| Self::face_shares(shape, f, h)).unzip();
+        Self { boundary, inner }
+    }
+
+    /// Face `f`'s boundary nodes' area per unit length of boundary (m), for spacing `h`, as
+    /// [`NodeAreas::face_shares`] gives it, without counting the inner nodes (whether there is
+    /// one is enough).
+    pub(crate) fn face_boundary(shape: &Polyhedron, f: usize, h: Real) -> Real {
         let v = shape.vertices();
-        let (mut boundary, mut inner) = (Vec::new(), Vec::new());
-        for f in 0..shape.faces().len() {
-            let ring = shape.face_loop(f);
-            let m = ring.len();
-            let perimeter: Real = (0..m)
-                .map(|i| (v[ring[(i + 1) % m] as usize] - v[ring[i] as usize]).length())
-                .sum();
-            let grid = FaceGrid::of(shape, f);
-            let (nu, nv) = grid.lines(h);
-            let (du, dv) = (grid.size.0 / nu as Real, grid.size.1 / nv as Real);
-            let inner_nodes: u32 = (1..nv)
-                .map(|j| grid.row(shape, f, (j, nu, nv), 0.25 * du.min(dv)).len() as u32)
-                .sum();
-            let area = shape.faces()[f].area;
-            let strip = if inner_nodes == 0 {
-                area
-            } else {
-                (0.5 * du.min(dv) * perimeter).min(area)
-            };
-            boundary.push(if perimeter > 0.0 { 0.5 * strip / perimeter } else { 0.0 });
-            inner.push(if inner_nodes > 0 {
+        let ring = shape.face_loop(f);
+        let m = ring.len();
+        let perimeter: Real = (0..m)
+            .map(|i| (v[ring[(i + 1) % m] as usize] - v[ring[i] as usize]).length())
+            .sum();
+        let grid = FaceGrid::of(shape, f);
+        let (nu, nv) = grid.lines(h);
+        let (du, dv) = (grid.size.0 / nu as Real, grid.size.1 / nv as Real);
+        let inner = (1..nv).any(|j| !grid.row(shape, f, (j, nu, nv), 0.25 * du.min(dv)).is_empty());
+        let area = shape.faces()[f].area;
+        let strip = if inner {
+            (0.5 * du.min(dv) * perimeter).min(area)
+        } else {
+            area
+        };
+        if perimeter > 0.0 {
+            0.5 * strip / perimeter
+        } else {
+            0.0
+        }
+    }
+
+    /// Face `f`'s boundary nodes' area per unit length of boundary (m) and each inner node's
+    /// area (m²), for spacing `h` (see the type).
+    pub(crate) fn face_shares(shape: &Polyhedron, f: usize, h: Real) -> (Real, Real) {
+        let v = shape.vertices();
+        let ring = shape.face_loop(f);
+        let m = ring.len();
+        let perimeter: Real = (0..m)
+            .map(|i| (v[ring[(i + 1) % m] as usize] - v[ring[i] as usize]).length())
+            .sum();
+        let grid = FaceGrid::of(shape, f);
+        let (nu, nv) = grid.lines(h);
+        let (du, dv) = (grid.size.0 / nu as Real, grid.size.1 / nv as Real);
+        let inner_nodes: u32 = (1..nv)
+            .map(|j| grid.row(shape, f, (j, nu, nv), 0.25 * du.min(dv)).len() as u32)
+            .sum();
+        let area = shape.faces()[f].area;
+        let strip = if inner_nodes == 0 {
+            area
+        } else {
+            (0.5 * du.min(dv) * perimeter).min(area)
+        };
+        (
+            if perimeter > 0.0 { 0.5 * strip / perimeter } else { 0.0 },
+            if inner_nodes > 0 {
                 0.5 * (area - strip) / inner_nodes as Real
             } else {
                 0.0
-            });
-        }
-        Self { boundary, inner }
+            },
+        )
+    }
+
+    /// The area of each inner grid node of face `face` (m²).
+    #[inline]
+    pub(crate) fn inner(&self, face: usize) -> Real {
+        self.inner[face]
+    }
+
+    /// The area the boundary nodes of face `face` stand for per unit length of its boundary
+    /// (m): a strip along the boundary twice as wide (half a grid cell, or the face's area over
+    /// its perimeter when it has no inner node), at half weight.
+    #[inline]
+    pub(crate) fn boundary(&self, face: usize) -> Real {
+        self.boundary[face]
     }
 
     /// The area of node `place` of `shape` for spacing `h` (m²).
@@ -415,8 +479,10 @@ fn push_nodes(
     seeds: &mut Vec<SubContactSeed>,
 ) {
     let to_other = other.pose.inverse() * *host.pose;
-    // Nodes farther than this from the other block's centroid cannot be within the tolerance.
-    let reach = other.shape.radius() + tolerance;
+    // A node stands for the strips of surface around it, which lie within `h` of it
+    // (`strips.rs`); it is listed when they come within the tolerance of the other block.
+    // Nodes farther than this from the other block's centroid cannot.
+    let reach = other.shape.radius() + tolerance + h;
     let centre = to_other.inverse().transform_point(Vector::ZERO);
     let vertices = host.shape.vertices();
     let start = seeds.len();
@@ -429,8 +495,12 @@ fn push_nodes(
             return;
         }
         let (_, gap) = deepest_face(other.shape, q);
-        if gap < tolerance {
+        if gap < tolerance + h {
             let areas = areas.get_or_insert_with(|| NodeAreas::of(host.shape, h));
+            // The gap is 1-Lipschitz: over its strips it is at least this.
+            if gap - super::strips::reach(host.shape, &*areas, place, h, anchor) >= tolerance {
+                return;
+            }
             seeds.push(SubContactSeed {
                 key: id.key(),
                 anchor,
@@ -511,15 +581,15 @@ pub(super) fn node_contact(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::geometry::Polyhedron;
 
-    fn shape(points: &[Vector]) -> Polyhedron {
+    pub(in super::super) fn shape(points: &[Vector]) -> Polyhedron {
         Polyhedron::from_hull("test", points).expect("hull").shape
     }
 
-    fn cube(s: Real) -> Polyhedron {
+    pub(in super::super) fn cube(s: Real) -> Polyhedron {
         let v = |x, y, z| Vector::new(x, y, z);
         shape(&[
             v(-s, -s, -s),
@@ -533,7 +603,7 @@ mod tests {
         ])
     }
 
-    fn wedge(s: Real) -> Polyhedron {
+    pub(in super::super) fn wedge(s: Real) -> Polyhedron {
         let v = |x, y, z| Vector::new(x, y, z);
         shape(&[
             v(-s, -s, -s),
@@ -546,7 +616,7 @@ mod tests {
     }
 
     /// Every node of a block for spacing `h`, with its area.
-    fn all_nodes(shape: &Polyhedron, h: Real) -> Vec<(NodePlace, Real)> {
+    pub(in super::super) fn all_nodes(shape: &Polyhedron, h: Real) -> Vec<(NodePlace, Real)> {
         let areas = NodeAreas::of(shape, h);
         let mut places: Vec<NodePlace> = (0..shape.vertices().len() as u32).map(NodePlace::Vertex).collect();
         for &[i, j] in shape.edges() {

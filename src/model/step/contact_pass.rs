@@ -207,6 +207,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             mode: self.params.mode,
             lanes: crate::contact::LaneBuild::Portable,
             joint_level: self.joint_stepping == crate::model::JointStepping::Whole,
+            node_density: self.params.contact.density,
             step: self.clock.step,
         };
         // Rayleigh damping puts dashpot forces on the sub-contacts: the model keeps them from
