@@ -301,12 +301,22 @@ impl StripLoad {
             return;
         }
         // The faces that can be deepest somewhere on the piece (no other face above them all
-        // over) and below zero somewhere.
+        // over) and below zero somewhere. A face whose largest value over the piece is below
+        // another's least is never deepest there: that bound first, in one pass.
+        let highest = |(c, a, b): (Real, Real, Real)| {
+            corners
+                .iter()
+                .map(|&(s, t)| c + a * s + b * t)
+                .fold(Real::NEG_INFINITY, Real::max)
+        };
+        let floor = (0..faces.len())
+            .map(|f| lowest(linear(f)))
+            .fold(Real::NEG_INFINITY, Real::max);
         let mut candidates = [0usize; MAX_VERTICES - 4];
         let mut count = 0;
         for f in 0..faces.len() {
             let lf = linear(f);
-            if lowest(lf) > 0.0 {
+            if lowest(lf) > 0.0 || highest(lf) < floor {
                 continue;
             }
             let dominated = (0..faces.len()).any(|g| {
