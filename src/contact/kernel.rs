@@ -9,8 +9,8 @@ use super::law_update::{stays_separated, update_with_law};
 use super::moments::{ForceMoments, Lever};
 use super::spread::{CellResponse, CellRule, ExactCells};
 use super::{
-    ContactPair, ContactReference, ContactWrench, DisplacementMode, HingeRecord, JointLevel, LaneBuild, SpanEnds,
-    SubContact,
+    ContactPair, ContactReference, ContactWrench, DisplacementMode, HingeRecord, JointLevel, LaneBuild, SideRecord,
+    SpanEnds, SubContact,
 };
 use crate::block::BlockMotion;
 use crate::law::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
@@ -210,7 +210,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                 // stick, the open ones at one end (if any) while they stay open, the others
                 // (`span`) one by one (`joint_level/hinge.rs`). Only a hinge reads its record in
                 // the reference (boxed: a joint open in part always has it).
-                let hinge = reference.hinge.as_deref();
+                let hinge = reference.hinge();
                 if let Some(step) = exact
                     .filter(|e| e.virgin_without_tension)
                     .zip(hinge)
@@ -282,10 +282,7 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
                                         .flatten()?;
                                     // The box is allocated at the contact's first entry
                                     // since its detection, and reused after.
-                                    match reference.hinge.as_deref_mut() {
-                                        Some(record) => *record = hinge,
-                                        None => reference.hinge = Some(Box::new(hinge)),
-                                    }
+                                    reference.keep(SideRecord::Hinge(hinge));
                                     Some(joint)
                                 })
                             }

@@ -161,8 +161,8 @@ impl CellSummary {
 
 /// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
 /// its geometry at detection, which small-displacement mode steps with, the areas the
-/// critical-step bookkeeping compares, and the record of a joint open in part, which the step
-/// reads for such joints only.
+/// critical-step bookkeeping compares, and what a contact of one kind keeps on the side (a
+/// hinge's record, a node contact's strips), which the step reads for those contacts only.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ContactReference {
     /// Centroids at detection (lever arms in small-displacement mode).
@@ -174,11 +174,21 @@ pub(crate) struct ContactReference {
     pub(crate) area: Real,
     /// `area` when the critical step was last evaluated (0 for a new contact).
     pub(crate) bound_area: Real,
+    /// What the contact keeps on the side ([`SideRecord`]). Boxed, so that a contact that
+    /// needs none (almost every contact of a wall) pays 8 bytes for it: allocated when the
+    /// contact first needs it after its detection, and reused after.
+    pub(crate) side: Option<Box<SideRecord>>,
+}
+
+/// What a contact of one kind keeps beside its sub-contacts ([`ContactReference::side`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum SideRecord {
     /// Of a joint open in part ([`JointLevel::span`] not empty): what its cells stepped as a
-    /// whole need; stale otherwise. Boxed, so that a contact that is never a hinge (almost
-    /// every contact of a wall) pays 8 bytes for it, not 160: allocated when the contact
-    /// first enters as a hinge after its detection, and reused at its later entries.
-    pub(crate) hinge: Option<Box<HingeRecord>>,
+    /// whole need; stale otherwise.
+    Hinge(HingeRecord),
+    /// Of a node contact stepped integrated: its nodes' strips
+    /// (`geometry/narrow_phase/strips.rs`), built at its first such step after detection.
+    Nodes(crate::geometry::NodeStrips),
 }
 
 impl ContactReference {
@@ -189,6 +199,50 @@ impl ContactReference {
         match mode {
             DisplacementMode::Large => (pose_a.translation, pose_b.translation),
             DisplacementMode::Small => (self.ref_a, self.ref_b),
+        }
+    }
+
+    /// The record of a joint open in part, if it holds one.
+    #[inline]
+    pub(crate) fn hinge(&self) -> Option<&HingeRecord> {
+        match self.side.as_deref() {
+            Some(SideRecord::Hinge(h)) => Some(h),
+            _ => None,
+        }
+    }
+
+    /// The record of a joint open in part, if it holds one, to change.
+    #[inline]
+    pub(crate) fn hinge_mut(&mut self) -> Option<&mut HingeRecord> {
+        match self.side.as_deref_mut() {
+            Some(SideRecord::Hinge(h)) => Some(h),
+            _ => None,
+        }
+    }
+
+    /// Keeps `record` as the contact's side record, in the box it has if any.
+    #[inline]
+    pub(crate) fn keep(&mut self, record: SideRecord) {
+        match self.side.as_deref_mut() {
+            Some(side) => *side = record,
+            None => self.side = Some(Box::new(record)),
+        }
+    }
+
+    /// A node contact's strips for its `nodes` nodes: those kept, or `build`'s, kept for the
+    /// steps until its next detection (which drops them).
+    #[inline]
+    pub(crate) fn node_strips(
+        &mut self,
+        nodes: usize,
+        build: impl FnOnce() -> crate::geometry::NodeStrips,
+    ) -> Option<&crate::geometry::NodeStrips> {
+        if !matches!(self.side.as_deref(), Some(SideRecord::Nodes(s)) if s.holds(nodes)) {
+            self.keep(SideRecord::Nodes(build()));
+        }
+        match self.side.as_deref() {
+            Some(SideRecord::Nodes(s)) => Some(s),
+            _ => None,
         }
     }
 }

@@ -18,9 +18,9 @@
 use super::kernel::{plane_turn, ContactStep, KernelContext};
 use super::law_update::{stays_separated, update_with_law};
 use super::spread::tension_free;
-use super::{ContactPair, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
+use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
-use crate::geometry::{deepest_two, for_each_strip, spacing, NodeId, Polyhedron, SharesOf, StripLoad};
+use crate::geometry::{deepest_two, spacing, NodeId, NodeStrips, Polyhedron, Strip, StripLoad};
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{plane_basis, Matrix, Real, Vector, Vector2};
 
@@ -101,6 +101,7 @@ pub(crate) fn turned_shear(shear: Vector2, on_b: bool, shape: &Polyhedron, from:
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
+    reference: &mut ContactReference,
     subs: &mut [SubContact<L::State>],
     records: &[SubContactRecord],
     dashpot_forces: &mut [Vector],
@@ -133,6 +134,18 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         .flatten()
         .filter(|k| *k > 0.0);
     let h = spacing(a.2, b.2, ctx.node_density);
+    // Their strips depend on the shapes alone: built at the contact's first integrated step
+    // since its detection.
+    let strips = integrated.and_then(|_| {
+        reference.node_strips(subs.len(), || {
+            let nodes = records
+                .iter()
+                .zip(subs.iter())
+                .map(|(r, s)| (NodeId::from_key(r.key), s.area));
+            NodeStrips::build(nodes, (a.2, b.2), h)
+        })
+    });
+    let integrated = integrated.filter(|_| strips.is_some());
     let mut spread_energy = 0.0;
     for (i, (sub, record)) in subs.iter_mut().zip(records).enumerate() {
         let id = NodeId::from_key(record.key);
@@ -151,18 +164,18 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         let du_n = axes.normal.dot(du);
         let du_s = axes.components(du);
         fastest = fastest.max(v_rel.length_squared());
-        let mut strips = None;
+        let mut pressed = None;
         let gap = match ctx.mode {
             // Open, an integrated node reports the gap at its point (its pieces are out of the
             // other block; the point, on their boundary, is not inside it), as a point node
             // does: the impact probe watches it close as before.
             DisplacementMode::Large => match integrated.filter(|_| tension_free(law, &sub.state)) {
-                // Its pieces lie within `h` of it (`strips::reach`): farther out, open.
+                // Its pieces lie within `h` of it (`Strip::reach`): farther out, open.
                 Some(_) if frame.gap > h => frame.gap,
                 Some(_) => {
-                    let load = strip_load(id, a, b, h, sub.area);
+                    let load = strip_load(id, a, b, strips.map_or(&[][..], |s| s.of(i)), frame.face);
                     if load.load > 0.0 && sub.area > 0.0 {
-                        strips = Some(load);
+                        pressed = Some(load);
                         -load.load / sub.area
                     } else {
                         frame.gap.max(Real::MIN_POSITIVE)
@@ -199,7 +212,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         // (on the node's block; their opposites on the other), and the energy its spread
         // stores beyond the law's `F_n²/(2 k_n A)`.
         let mut couple = Vector::ZERO;
-        if let (Some(load), Some(kn)) = (strips, integrated) {
+        if let (Some(load), Some(kn)) = (pressed, integrated) {
             if sub.force.normal > 0.0 && status != JointStatus::Open {
                 let other = if id.on_b { a } else { b };
                 let side = if id.on_b { 1.0 } else { -1.0 };
@@ -250,22 +263,24 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     step
 }
 
-/// The load of node `id`'s strips (`geometry/narrow_phase/strips.rs`) in the other block, per
-/// unit `k_n`, in the other block's body frame, with moments about the node.
-fn strip_load(id: NodeId, a: NodeBlock<'_>, b: NodeBlock<'_>, h: Real, area: Real) -> StripLoad {
+/// The load of node `id`'s strips `strips` (`geometry/narrow_phase/strips.rs`) in the other
+/// block, per unit `k_n`, in the other block's body frame, with moments about the node; `near`
+/// is the face of the other block the node lies deepest under.
+fn strip_load(id: NodeId, a: NodeBlock<'_>, b: NodeBlock<'_>, strips: &[Strip], near: usize) -> StripLoad {
     let (host, other) = if id.on_b { (b, a) } else { (a, b) };
     // Host body frame to the other's body frame: q = R_oᵀ (x_h + R_h x − x_o).
     let turn = other.1.transpose() * *host.1;
     let shift = other.1.transpose() * (host.0.pose.translation - other.0.pose.translation);
     let about = turn * id.point(host.2) + shift;
     let mut load = StripLoad::default();
-    let shares = SharesOf {
-        shape: host.2,
-        h,
-        inner: area,
-    };
-    for_each_strip(host.2, &shares, id.place, h, |s| {
-        load.add(other.2, (turn * s.centre + shift, turn * s.u, turn * s.v), &s, about);
-    });
+    for s in strips {
+        load.add(
+            other.2,
+            (turn * s.centre + shift, turn * s.u, turn * s.v),
+            s,
+            about,
+            near,
+        );
+    }
     load
 }

@@ -11,7 +11,7 @@ pub use broad_phase::BroadPhase;
 pub(crate) use narrow_phase::contact_polygon;
 pub(crate) use narrow_phase::nodes::{deepest_two, NodeId};
 pub(crate) use narrow_phase::spacing;
-pub(crate) use narrow_phase::strips::{for_each_strip, SharesOf, StripLoad};
+pub(crate) use narrow_phase::strips::{NodeStrips, Strip, StripLoad};
 pub use narrow_phase::{
     detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact,
     SubContactDensity, SubContactSeed, SubKey, DEFAULT_SUBCONTACTS_PER_EDGE, MAX_SUBCONTACTS_PER_EDGE,

@@ -11,6 +11,7 @@
 //! which nodes a detection lists changes nothing as long as it lists every node that can reach
 //! the other block before the next detection (those with `g` below the tolerance).
 
+use super::strips::{for_each_strip, least_gap};
 use super::*;
 use crate::math::Real;
 
@@ -359,36 +360,9 @@ impl NodeAreas {
         Self { boundary, inner }
     }
 
-    /// Face `f`'s boundary nodes' area per unit length of boundary (m), for spacing `h`, as
-    /// [`NodeAreas::face_shares`] gives it, without counting the inner nodes (whether there is
-    /// one is enough).
-    pub(crate) fn face_boundary(shape: &Polyhedron, f: usize, h: Real) -> Real {
-        let v = shape.vertices();
-        let ring = shape.face_loop(f);
-        let m = ring.len();
-        let perimeter: Real = (0..m)
-            .map(|i| (v[ring[(i + 1) % m] as usize] - v[ring[i] as usize]).length())
-            .sum();
-        let grid = FaceGrid::of(shape, f);
-        let (nu, nv) = grid.lines(h);
-        let (du, dv) = (grid.size.0 / nu as Real, grid.size.1 / nv as Real);
-        let inner = (1..nv).any(|j| !grid.row(shape, f, (j, nu, nv), 0.25 * du.min(dv)).is_empty());
-        let area = shape.faces()[f].area;
-        let strip = if inner {
-            (0.5 * du.min(dv) * perimeter).min(area)
-        } else {
-            area
-        };
-        if perimeter > 0.0 {
-            0.5 * strip / perimeter
-        } else {
-            0.0
-        }
-    }
-
     /// Face `f`'s boundary nodes' area per unit length of boundary (m) and each inner node's
     /// area (m²), for spacing `h` (see the type).
-    pub(crate) fn face_shares(shape: &Polyhedron, f: usize, h: Real) -> (Real, Real) {
+    fn face_shares(shape: &Polyhedron, f: usize, h: Real) -> (Real, Real) {
         let v = shape.vertices();
         let ring = shape.face_loop(f);
         let m = ring.len();
@@ -468,7 +442,7 @@ impl NodeAreas {
     }
 }
 
-/// The nodes of `host` (on block `b` when `on_b`) whose gap to `other` is below `tolerance`,
+/// The nodes of `host` (on block `b` when `on_b`) whose strips come within `tolerance` of `other`,
 /// as seeds (anchor in the host's body frame), in key order.
 fn push_nodes(
     host: BlockGeometry<'_>,
@@ -479,9 +453,9 @@ fn push_nodes(
     seeds: &mut Vec<SubContactSeed>,
 ) {
     let to_other = other.pose.inverse() * *host.pose;
-    // A node stands for the strips of surface around it, which lie within `h` of it
-    // (`strips.rs`); it is listed when they come within the tolerance of the other block.
-    // Nodes farther than this from the other block's centroid cannot.
+    // A node stands for the strips of surface around it (`strips.rs`); it is listed when they
+    // come within the tolerance of the other block. Nodes farther than this from the other
+    // block's centroid cannot.
     let reach = other.shape.radius() + tolerance + h;
     let centre = to_other.inverse().transform_point(Vector::ZERO);
     let vertices = host.shape.vertices();
@@ -494,11 +468,21 @@ fn push_nodes(
         if q.length() > reach {
             return;
         }
-        let (_, gap) = deepest_face(other.shape, q);
+        let (face, gap) = deepest_face(other.shape, q);
+        // Its strips lie within `h` of it (`strips.rs`), and the gap is 1-Lipschitz.
         if gap < tolerance + h {
             let areas = areas.get_or_insert_with(|| NodeAreas::of(host.shape, h));
-            // The gap is 1-Lipschitz: over its strips it is at least this.
-            if gap - super::strips::reach(host.shape, &*areas, place, h, anchor) >= tolerance {
+            // Its strips, at least as far out as their faces' least values over them.
+            let mut least = Real::INFINITY;
+            for_each_strip(host.shape, &*areas, place, h, |s| {
+                let placed = (
+                    to_other.transform_point(s.centre),
+                    to_other.rotation * s.u,
+                    to_other.rotation * s.v,
+                );
+                least = least.min(least_gap(other.shape, placed, &s, face, tolerance));
+            });
+            if least >= tolerance {
                 return;
             }
             seeds.push(SubContactSeed {

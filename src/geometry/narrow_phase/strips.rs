@@ -25,7 +25,7 @@
 //! rectangle clipped by `g_f ≤ 0` and by `g_f ≥ g_h` for every other face `h` that can be
 //! deepest there), exact by triangles.
 
-use super::nodes::{FaceGrid, NodeAreas, NodePlace};
+use super::nodes::{FaceGrid, NodeAreas, NodeId, NodePlace};
 use crate::geometry::Polyhedron;
 use crate::math::{Real, Vector};
 
@@ -33,13 +33,16 @@ use crate::math::{Real, Vector};
 /// face (centre, unit axes in the face's plane, half sizes) cut to the face where it sticks out
 /// (at an acute corner), whose springs have the stiffness `k_n ρ` per unit area, `ρ` the area
 /// the rectangle stands for over its own area (one half, as the shares are made).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Strip {
     pub centre: Vector,
     pub u: Vector,
     pub v: Vector,
     /// The piece in the coordinates `(s, t)` along `u`, `v` from the centre.
     pub polygon: Polygon,
+    /// The piece's area moments `(∫1, ∫s, ∫t, ∫s², ∫st, ∫t²)`: a piece under one face all
+    /// over integrates from them.
+    moments: [Real; 6],
     pub density: Real,
 }
 
@@ -72,16 +75,26 @@ impl Strip {
                 polygon.clip(|s, t| c + a * s + b * t + slack);
             }
         }
+        let density = if half.0 > 0.0 && half.1 > 0.0 {
+            area / (4.0 * half.0 * half.1)
+        } else {
+            0.0
+        };
+        Self::of((centre, u, v), polygon, density)
+    }
+
+    /// The piece `polygon` in the plane through `centre` along `u`, `v`, of weight `density`.
+    fn of((centre, u, v): (Vector, Vector, Vector), polygon: Polygon, density: Real) -> Self {
+        let (area, s, t, _) = polygon.integrals(|_, _| 1.0);
+        let (_, ss, st, _) = polygon.integrals(|s, _| s);
+        let (_, _, tt, _) = polygon.integrals(|_, t| t);
         Self {
             centre,
             u,
             v,
             polygon,
-            density: if half.0 > 0.0 && half.1 > 0.0 {
-                area / (4.0 * half.0 * half.1)
-            } else {
-                0.0
-            },
+            moments: [area, s, t, ss, st, tt],
+            density,
         }
     }
 
@@ -93,6 +106,7 @@ impl Strip {
 
     /// The largest distance from `point` to the strip (m): a node's strips lie within this of
     /// it.
+    #[cfg(test)]
     fn reach(&self, point: Vector) -> Real {
         self.polygon.points[..self.polygon.len]
             .iter()
@@ -121,23 +135,70 @@ impl FaceShares for NodeAreas {
     }
 }
 
-/// The shares the step needs, computed when asked: a face's boundary share
-/// ([`NodeAreas::face_boundary`]), and, for a face's inner node, its own area (`inner`, the
-/// area its sub-contact holds). The step keeps no list of them.
+/// A block's face shares ([`NodeAreas`]) with one node's own area for its face's inner share:
+/// the area its sub-contact holds (the same, as detection gives it).
 pub(crate) struct SharesOf<'a> {
-    pub shape: &'a Polyhedron,
-    pub h: Real,
+    pub areas: &'a NodeAreas,
     pub inner: Real,
 }
 
 impl FaceShares for SharesOf<'_> {
     #[inline]
     fn boundary_share(&self, face: usize) -> Real {
-        NodeAreas::face_boundary(self.shape, face, self.h)
+        self.areas.boundary(face)
     }
     #[inline]
     fn inner_share(&self, _: usize) -> Real {
         self.inner
+    }
+}
+
+/// The strips of every node of a node contact, in the order of its sub-contacts, in the body
+/// frame of each node's block. They depend on the blocks' shapes and the node spacing alone, so
+/// a contact builds them at its first integrated step after its detection
+/// ([`crate::contact::ContactReference::node_strips`]) and steps with them until the next.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct NodeStrips {
+    /// Node `k`'s strips are `strips[starts[k]..starts[k + 1]]`; empty until built.
+    starts: Vec<u32>,
+    strips: Vec<Strip>,
+}
+
+impl NodeStrips {
+    /// The strips of `nodes` (each node's id and area) of a contact between blocks of shapes
+    /// `a` and `b`, for node spacing `h`.
+    pub(crate) fn build(
+        nodes: impl ExactSizeIterator<Item = (NodeId, Real)>,
+        (a, b): (&Polyhedron, &Polyhedron),
+        h: Real,
+    ) -> Self {
+        let mut starts = Vec::with_capacity(nodes.len() + 1);
+        let mut strips = Vec::new();
+        let mut areas: [Option<NodeAreas>; 2] = [None, None];
+        starts.push(0);
+        for (id, area) in nodes {
+            let shape = if id.on_b { b } else { a };
+            let areas = areas[usize::from(id.on_b)].get_or_insert_with(|| NodeAreas::of(shape, h));
+            let shares = SharesOf { areas, inner: area };
+            for_each_strip(shape, &shares, id.place, h, |s| strips.push(s));
+            starts.push(strips.len() as u32);
+        }
+        Self { starts, strips }
+    }
+
+    /// Whether it holds the strips of `nodes` nodes.
+    #[inline]
+    pub(crate) fn holds(&self, nodes: usize) -> bool {
+        self.starts.len() == nodes + 1
+    }
+
+    /// Node `k`'s strips.
+    #[inline]
+    pub(crate) fn of(&self, k: usize) -> &[Strip] {
+        match (self.starts.get(k), self.starts.get(k + 1)) {
+            (Some(&from), Some(&to)) => &self.strips[from as usize..to as usize],
+            _ => &[],
+        }
     }
 }
 
@@ -217,13 +278,6 @@ pub(crate) fn for_each_strip(
     }
 }
 
-/// The largest distance from a node at `point` to the corners of its strips (m).
-pub(crate) fn reach(shape: &Polyhedron, areas: &impl FaceShares, place: NodePlace, h: Real, point: Vector) -> Real {
-    let mut r: Real = 0.0;
-    for_each_strip(shape, areas, place, h, |s| r = r.max(s.reach(point)));
-    r
-}
-
 /// The faces of `shape` whose loop holds the edge `v0`–`v1`.
 fn faces_with_edge(shape: &Polyhedron, v0: u32, v1: u32) -> impl Iterator<Item = usize> + '_ {
     (0..shape.faces().len()).filter(move |&f| {
@@ -268,15 +322,21 @@ pub(crate) struct StripLoad {
 /// The most vertices a clipped rectangle keeps here: four, one more per clip that cuts it.
 const MAX_VERTICES: usize = 16;
 
+/// The most faces of the other block a piece is integrated under.
+const MAX_CANDIDATES: usize = 32;
+
 impl StripLoad {
     /// Adds the load of `strip`, whose centre and axes in the body frame of the other block
-    /// `other` are `centre`, `u`, `v`, with moments about `about` (same frame).
+    /// `other` are `centre`, `u`, `v`, with moments about `about` (same frame). `near` is the
+    /// face of `other` the piece is likeliest to be out of (the one its node lies deepest
+    /// under): it is tried first.
     pub(crate) fn add(
         &mut self,
         other: &Polyhedron,
         (centre, u, v): (Vector, Vector, Vector),
         strip: &Strip,
         about: Vector,
+        near: usize,
     ) {
         let piece = &strip.polygon;
         if piece.len < 3 || !(strip.density > 0.0) {
@@ -290,61 +350,84 @@ impl StripLoad {
             let m = faces[f].normal;
             (m.dot(centre) - faces[f].offset, m.dot(u), m.dot(v))
         };
-        let lowest = |(c, a, b): (Real, Real, Real)| {
+        // Its least and largest value over the piece: at corners of the (convex) piece.
+        let extremes = |(c, a, b): (Real, Real, Real)| {
             corners
                 .iter()
-                .map(|&(s, t)| c + a * s + b * t)
-                .fold(Real::INFINITY, Real::min)
+                .fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), &(s, t)| {
+                    let g = c + a * s + b * t;
+                    (lo.min(g), hi.max(g))
+                })
         };
         // Outside a face's plane all over: outside the block.
-        if (0..faces.len()).any(|f| lowest(linear(f)) > 0.0) {
+        let floor = least_gap(other, (centre, u, v), strip, near, 0.0);
+        if floor > 0.0 {
             return;
         }
-        // The faces that can be deepest somewhere on the piece (no other face above them all
-        // over) and below zero somewhere. A face whose largest value over the piece is below
-        // another's least is never deepest there: that bound first, in one pass.
-        let highest = |(c, a, b): (Real, Real, Real)| {
-            corners
-                .iter()
-                .map(|&(s, t)| c + a * s + b * t)
-                .fold(Real::NEG_INFINITY, Real::max)
-        };
-        let floor = (0..faces.len())
-            .map(|f| lowest(linear(f)))
-            .fold(Real::NEG_INFINITY, Real::max);
-        let mut candidates = [0usize; MAX_VERTICES - 4];
+        // The faces that can be deepest somewhere on the piece and are below zero somewhere. A
+        // face whose largest value over the piece is below `floor` is never deepest there;
+        // among the others, one that another lies above all over is not either (no face
+        // left out by the first test lies above a face kept by it).
+        let mut candidates = [(0usize, (0.0, 0.0, 0.0)); MAX_CANDIDATES];
         let mut count = 0;
+        let mut below = false;
         for f in 0..faces.len() {
             let lf = linear(f);
-            if lowest(lf) > 0.0 || highest(lf) < floor {
+            let (lo, hi) = extremes(lf);
+            if lo > 0.0 || hi < floor {
                 continue;
             }
-            let dominated = (0..faces.len()).any(|g| {
-                let lg = linear(g);
-                // `l_g − l_f` positive all over.
-                g != f && lowest((lg.0 - lf.0, lg.1 - lf.1, lg.2 - lf.2)) > 0.0
-            });
-            if !dominated {
-                if count == candidates.len() {
-                    // Beyond any shape a step meets (a face deepest in pieces of one strip):
-                    // the faces found so far bound the rest.
-                    break;
-                }
-                candidates[count] = f;
-                count += 1;
+            if count == candidates.len() {
+                // Beyond any shape a step meets (that many faces deepest in pieces of one
+                // strip): the faces found so far bound the rest.
+                break;
+            }
+            candidates[count] = (f, lf);
+            count += 1;
+            below = hi <= 0.0;
+        }
+        // One face deepest all over, the piece below its plane all over: `g` is that face's
+        // linear function on the whole piece, and its integrals follow from the piece's area
+        // moments (the usual case, a node pressed flat).
+        if count == 1 && below {
+            let (f, (c, a, b)) = candidates[0];
+            let [area, s, t, ss, st, tt] = strip.moments;
+            let rho = strip.density;
+            let load = -(c * area + a * s + b * t) * rho;
+            let first_s = -(c * s + a * ss + b * st) * rho;
+            let first_t = -(c * t + a * st + b * tt) * rho;
+            let square = (c * c * area + 2.0 * c * (a * s + b * t) + a * a * ss + 2.0 * a * b * st + b * b * tt) * rho;
+            self.accumulate(faces[f].normal, (centre, u, v), about, (load, first_s, first_t, square));
+            return;
+        }
+        let kept = &mut [true; MAX_CANDIDATES][..count];
+        if count > 1 {
+            for k in 0..count {
+                let lf = candidates[k].1;
+                kept[k] = !(0..count).any(|j| {
+                    let lg = candidates[j].1;
+                    // `l_g − l_f` positive all over.
+                    j != k && extremes((lg.0 - lf.0, lg.1 - lf.1, lg.2 - lf.2)).0 > 0.0
+                });
             }
         }
-        for (k, &f) in candidates[..count].iter().enumerate() {
-            let lf = linear(f);
+        let mut live = 0;
+        for k in 0..count {
+            if kept[k] {
+                candidates[live] = candidates[k];
+                live += 1;
+            }
+        }
+        let candidates = &candidates[..live];
+        for (k, &(f, lf)) in candidates.iter().enumerate() {
             let mut polygon = *piece;
             // Below the face's plane…
             polygon.clip(|s, t| -(lf.0 + lf.1 * s + lf.2 * t));
             // …and above every other candidate's.
-            for (j, &g) in candidates[..count].iter().enumerate() {
+            for (j, &(_, lg)) in candidates.iter().enumerate() {
                 if j == k || polygon.len == 0 {
                     continue;
                 }
-                let lg = linear(g);
                 // Ties go to the first of the two faces (`deepest_face`'s rule).
                 polygon.clip(|s, t| {
                     let d = (lf.0 - lg.0) + (lf.1 - lg.1) * s + (lf.2 - lg.2) * t;
@@ -359,19 +442,67 @@ impl StripLoad {
             if i.0 <= 0.0 {
                 continue;
             }
-            let m = faces[f].normal;
             let rho = strip.density;
-            let (load, first_s, first_t, square) = (i.0 * rho, i.1 * rho, i.2 * rho, i.3 * rho);
-            self.load += load;
-            self.force += m * load;
-            self.moment += ((centre - about) * load + u * first_s + v * first_t).cross(m);
-            self.energy += 0.5 * square;
+            self.accumulate(
+                faces[f].normal,
+                (centre, u, v),
+                about,
+                (i.0 * rho, i.1 * rho, i.2 * rho, i.3 * rho),
+            );
         }
     }
 }
 
+impl StripLoad {
+    /// Adds the part of a piece under a face of outward normal `m`: its load, first moments
+    /// along `u` and `v` about `centre`, and `∫ g²` (each times `ρ`), with moments about
+    /// `about`.
+    #[inline]
+    fn accumulate(
+        &mut self,
+        m: Vector,
+        (centre, u, v): (Vector, Vector, Vector),
+        about: Vector,
+        (load, first_s, first_t, square): (Real, Real, Real, Real),
+    ) {
+        self.load += load;
+        self.force += m * load;
+        self.moment += ((centre - about) * load + u * first_s + v * first_t).cross(m);
+        self.energy += 0.5 * square;
+    }
+}
+
+/// A lower bound of the signed distance from `other` over the piece of `strip` placed at
+/// `centre`, `u`, `v` (body frame of `other`): the largest of its faces' least values over the
+/// piece (`g ≥ g_f` everywhere for every face `f`), exact where one face is deepest all over.
+/// Face `near` is tried first, and the search stops once the bound exceeds `stop`.
+pub(crate) fn least_gap(
+    other: &Polyhedron,
+    (centre, u, v): (Vector, Vector, Vector),
+    strip: &Strip,
+    near: usize,
+    stop: Real,
+) -> Real {
+    let faces = other.faces();
+    let corners = &strip.polygon.points[..strip.polygon.len];
+    let mut floor = Real::NEG_INFINITY;
+    for f in std::iter::once(near).chain(0..faces.len()).filter(|&f| f < faces.len()) {
+        let m = faces[f].normal;
+        let (c, a, b) = (m.dot(centre) - faces[f].offset, m.dot(u), m.dot(v));
+        let least = corners
+            .iter()
+            .map(|&(s, t)| c + a * s + b * t)
+            .fold(Real::INFINITY, Real::min);
+        floor = floor.max(least);
+        if floor > stop {
+            break;
+        }
+    }
+    floor
+}
+
 /// A convex polygon in a strip's coordinates `(s, t)`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Polygon {
     points: [(Real, Real); MAX_VERTICES],
     len: usize,
@@ -538,14 +669,12 @@ mod tests {
             let area = 0.5 * 4.0 * half.0 * half.1;
             let y_turned = &y;
             let mut exact = StripLoad::default();
-            let strip = Strip {
-                centre,
-                u,
-                v,
-                polygon: Polygon::rectangle(half.0, half.1),
-                density: area / (4.0 * half.0 * half.1),
-            };
-            exact.add(y_turned, (centre, u, v), &strip, about);
+            let strip = Strip::of(
+                (centre, u, v),
+                Polygon::rectangle(half.0, half.1),
+                area / (4.0 * half.0 * half.1),
+            );
+            exact.add(y_turned, (centre, u, v), &strip, about, 0);
             let n = 500;
             let mut sampled = StripLoad::default();
             let cell = 4.0 * half.0 * half.1 / (n * n) as Real;
@@ -613,14 +742,12 @@ mod tests {
             let load = |shift: Vector, turn: Rotation| {
                 let mut l = StripLoad::default();
                 let c = about + turn * (centre - about) + shift;
-                let strip = Strip {
-                    centre: c,
-                    u: turn * u,
-                    v: turn * v,
-                    polygon: Polygon::rectangle(half.0, half.1),
-                    density: area / (4.0 * half.0 * half.1),
-                };
-                l.add(&y, (c, turn * u, turn * v), &strip, about + shift);
+                let strip = Strip::of(
+                    (c, turn * u, turn * v),
+                    Polygon::rectangle(half.0, half.1),
+                    area / (4.0 * half.0 * half.1),
+                );
+                l.add(&y, (c, turn * u, turn * v), &strip, about + shift, 0);
                 l
             };
             let at = load(Vector::ZERO, Rotation::IDENTITY);

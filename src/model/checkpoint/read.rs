@@ -15,7 +15,7 @@ use super::{
 };
 use crate::block::Block;
 use crate::contact::{
-    ContactPair, ContactReference, ContactStore, ForceMoments, SpanEnds, SubContact, SubContactRecord,
+    ContactPair, ContactReference, ContactStore, ForceMoments, SideRecord, SpanEnds, SubContact, SubContactRecord,
 };
 use crate::error::{Error, Result};
 use crate::ids::BlockId;
@@ -78,7 +78,7 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
                             && j.hinge.is_some()))
                     && matches!(e.kind, crate::geometry::ContactKind::FaceFace { .. }) =>
             {
-                (j.level, j.hinge.map(Box::new))
+                (j.level, j.hinge.map(|h| Box::new(SideRecord::Hinge(h))))
             }
             Some(_) => {
                 return Err(corrupt(
@@ -162,7 +162,7 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
             ref_host_rotation: e.reference_host_rotation,
             area: e.area,
             bound_area: e.bound_area,
-            hinge,
+            side: hinge,
         });
         wrenches.push(e.wrench);
     }
@@ -416,7 +416,7 @@ fn restore_contacts<L: ConstitutiveLaw>(
         if p.joint.is_partial() {
             let subs = &model.state.contacts.subs[p.range()];
             // A hinge's record was read with it (checked above).
-            let Some(hinge) = model.state.contacts.references[k].hinge.as_deref_mut() else {
+            let Some(hinge) = model.state.contacts.references[k].hinge_mut() else {
                 return Err(corrupt(
                     &format!("contacts[{k}].joint"),
                     "a joint open in part without its hinge record",

@@ -59,7 +59,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             joint: p.joint.active.then(|| JointEntry {
                 level: p.joint,
                 held_shear: self.state.contacts.subs[range].iter().map(|s| s.force.shear).collect(),
-                hinge: r.hinge.as_deref().copied().filter(|_| p.joint.is_partial()),
+                hinge: r.hinge().copied().filter(|_| p.joint.is_partial()),
             }),
         }
     }

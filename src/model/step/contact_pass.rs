@@ -127,6 +127,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 let (a, b) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
                 update_nodes(
                     p,
+                    reference,
                     &mut subs[range.clone()],
                     &records[range],
                     dashpots,

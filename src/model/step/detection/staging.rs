@@ -59,7 +59,7 @@ pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
         ref_host_rotation: crate::math::Rotation::IDENTITY,
         area: 0.0,
         bound_area: 0.0,
-        hinge: None,
+        side: None,
     };
     (pair, reference)
 }
@@ -354,7 +354,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             ref_host_rotation: host.state.pose.rotation,
             area: seeds.iter().map(|s| s.area).sum(),
             bound_area,
-            hinge: None,
+            side: None,
         };
     }
 }
