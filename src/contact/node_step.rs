@@ -150,13 +150,28 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     for (i, (sub, record)) in subs.iter_mut().zip(records).enumerate() {
         let id = NodeId::from_key(record.key);
         let frame = node_frame(id, a, b);
-        let other_shape = if id.on_b { a.2 } else { b.2 };
+        // Integrated (large-displacement mode, a linear normal spring, no tension in the
+        // node's state), a node within `h` of the other block (its pieces lie within that of
+        // it: `Strip::reach`) is pressed by its pieces' load, if they carry one.
+        let integrate = ctx.mode == DisplacementMode::Large
+            && integrated.is_some()
+            && tension_free(law, &sub.state)
+            && frame.gap <= h;
+        let pressed = integrate
+            .then(|| strip_load(id, a, b, strips.map_or(&[][..], |s| s.of(i)), frame.face))
+            .filter(|load| load.load > 0.0 && sub.area > 0.0);
+        // Its shear acts in the plane of the face that carries most of its load, pressed;
+        // else in that of the face its point lies deepest under.
+        let other = if id.on_b { a } else { b };
+        let (face, axes) = match pressed.and_then(|load| load.face()) {
+            Some(f) if f != frame.face => (f, node_axes(id.on_b, other.1, other.2.faces()[f].normal)),
+            _ => (frame.face, frame.axes),
+        };
         let last_face = sub.plane.x as usize;
-        if frame.face != last_face && sub.force.shear != Vector2::ZERO {
-            sub.force.shear = turned_shear(sub.force.shear, id.on_b, other_shape, last_face, frame.face);
+        if face != last_face && sub.force.shear != Vector2::ZERO {
+            sub.force.shear = turned_shear(sub.force.shear, id.on_b, other.2, last_face, face);
         }
-        sub.plane.x = frame.face as Real;
-        let axes = frame.axes;
+        sub.plane.x = face as Real;
         let p = frame.point;
         let v_rel =
             (sb.velocity + sb.angular_velocity.cross(p - xb)) - (sa.velocity + sa.angular_velocity.cross(p - xa));
@@ -164,26 +179,14 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         let du_n = axes.normal.dot(du);
         let du_s = axes.components(du);
         fastest = fastest.max(v_rel.length_squared());
-        let mut pressed = None;
-        let gap = match ctx.mode {
+        let gap = match (ctx.mode, pressed) {
+            (DisplacementMode::Large, Some(load)) => -load.load / sub.area,
             // Open, an integrated node reports the gap at its point (its pieces are out of the
             // other block; the point, on their boundary, is not inside it), as a point node
             // does: the impact probe watches it close as before.
-            DisplacementMode::Large => match integrated.filter(|_| tension_free(law, &sub.state)) {
-                // Its pieces lie within `h` of it (`Strip::reach`): farther out, open.
-                Some(_) if frame.gap > h => frame.gap,
-                Some(_) => {
-                    let load = strip_load(id, a, b, strips.map_or(&[][..], |s| s.of(i)), frame.face);
-                    if load.load > 0.0 && sub.area > 0.0 {
-                        pressed = Some(load);
-                        -load.load / sub.area
-                    } else {
-                        frame.gap.max(Real::MIN_POSITIVE)
-                    }
-                }
-                None => frame.gap,
-            },
-            DisplacementMode::Small => sub.gap + du_n,
+            (DisplacementMode::Large, None) if integrate => frame.gap.max(Real::MIN_POSITIVE),
+            (DisplacementMode::Large, None) => frame.gap,
+            (DisplacementMode::Small, _) => sub.gap + du_n,
         };
         // The impact probe: the spring's kink (closing or opening fast), and, for a loaded
         // node, the turn of its normal to another face (a kink of the potential inside the
@@ -214,7 +217,6 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         let mut couple = Vector::ZERO;
         if let (Some(load), Some(kn)) = (pressed, integrated) {
             if sub.force.normal > 0.0 && status != JointStatus::Open {
-                let other = if id.on_b { a } else { b };
                 let side = if id.on_b { 1.0 } else { -1.0 };
                 let scale = side * sub.force.normal / load.load;
                 total += (*other.1 * load.force) * scale - axes.normal * sub.force.normal;

@@ -317,6 +317,29 @@ pub(crate) struct StripLoad {
     pub moment: Vector,
     /// `½ Σ ρ ∫ min(g, 0)² dA` (m⁴): the stored energy over `k_n`.
     pub energy: Real,
+    /// The load under each face of the other block so far (face, load), the first
+    /// [`TRACKED_FACES`] faces met; [`StripLoad::face`] reads the largest.
+    parts: [(u32, Real); TRACKED_FACES],
+}
+
+/// The most faces of the other block a node's load is told apart by ([`StripLoad::face`]).
+const TRACKED_FACES: usize = 6;
+
+impl StripLoad {
+    /// The face of the other block that carries the largest part of the load (the first of
+    /// equal ones), `None` with no load: the plane the node's shear acts in. Unlike the face
+    /// its point lies deepest under, it is defined by the pieces that carry the load, also
+    /// for a node on an edge of the other block, where that face is the round-off's choice.
+    pub(crate) fn face(&self) -> Option<usize> {
+        self.parts
+            .iter()
+            .filter(|p| p.1 > 0.0)
+            .fold(None, |best: Option<(u32, Real)>, &p| match best {
+                Some(b) if b.1 >= p.1 => Some(b),
+                _ => Some(p),
+            })
+            .map(|p| p.0 as usize)
+    }
 }
 
 /// The most vertices a clipped rectangle keeps here: four, one more per clip that cuts it.
@@ -397,7 +420,12 @@ impl StripLoad {
             let first_s = -(c * s + a * ss + b * st) * rho;
             let first_t = -(c * t + a * st + b * tt) * rho;
             let square = (c * c * area + 2.0 * c * (a * s + b * t) + a * a * ss + 2.0 * a * b * st + b * b * tt) * rho;
-            self.accumulate(faces[f].normal, (centre, u, v), about, (load, first_s, first_t, square));
+            self.accumulate(
+                (f, faces[f].normal),
+                (centre, u, v),
+                about,
+                (load, first_s, first_t, square),
+            );
             return;
         }
         let kept = &mut [true; MAX_CANDIDATES][..count];
@@ -444,7 +472,7 @@ impl StripLoad {
             }
             let rho = strip.density;
             self.accumulate(
-                faces[f].normal,
+                (f, faces[f].normal),
                 (centre, u, v),
                 about,
                 (i.0 * rho, i.1 * rho, i.2 * rho, i.3 * rho),
@@ -460,11 +488,15 @@ impl StripLoad {
     #[inline]
     fn accumulate(
         &mut self,
-        m: Vector,
+        (face, m): (usize, Vector),
         (centre, u, v): (Vector, Vector, Vector),
         about: Vector,
         (load, first_s, first_t, square): (Real, Real, Real, Real),
     ) {
+        let face = face as u32;
+        if let Some(part) = self.parts.iter_mut().find(|p| p.0 == face || p.1 == 0.0) {
+            *part = (face, part.1 + load);
+        }
         self.load += load;
         self.force += m * load;
         self.moment += ((centre - about) * load + u * first_s + v * first_t).cross(m);
