@@ -24,6 +24,10 @@ use crate::geometry::{deepest_two, spacing, NodeId, NodeStrips, Polyhedron, Stri
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{plane_basis, Matrix, Real, Vector, Vector2};
 
+/// A pressed node keeps its shear plane while the face it was carries more than the load of the
+/// face that carries most over this.
+const SHEAR_PLANE_STAY: Real = 2.0;
+
 /// One block of a node contact as the step sees it: its state, rotation matrix and shape.
 pub(crate) type NodeBlock<'a> = (&'a BlockState, &'a Matrix, &'a Polyhedron);
 
@@ -161,9 +165,23 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
             .then(|| strip_load(id, a, b, strips.map_or(&[][..], |s| s.of(i)), frame.face))
             .filter(|load| load.load > 0.0 && sub.area > 0.0);
         // Its shear acts in the plane of the face that carries most of its load, pressed;
-        // else in that of the face its point lies deepest under.
+        // else in that of the face its point lies deepest under. A change of plane turns the
+        // stored shear by up to 90° in one step, work the books do not see: the plane stays
+        // while the face it was carries at least half the load of the one that carries most
+        // (a node on an edge of the other block, its two faces' loads crossing, would turn at
+        // every crossing). (WIP: a normal along the load's resultant, continuous, is the
+        // lasting answer.)
         let other = if id.on_b { a } else { b };
-        let (face, axes) = match pressed.and_then(|load| load.face()) {
+        let dominant = pressed.and_then(|load| {
+            let f = load.face()?;
+            let last = sub.plane.x as usize;
+            Some(if f != last && load.part(last) * SHEAR_PLANE_STAY > load.part(f) {
+                last
+            } else {
+                f
+            })
+        });
+        let (face, axes) = match dominant {
             Some(f) if f != frame.face => (f, node_axes(id.on_b, other.1, other.2.faces()[f].normal)),
             _ => (frame.face, frame.axes),
         };

@@ -330,6 +330,10 @@ impl StripLoad {
     /// equal ones), `None` with no load: the plane the node's shear acts in. Unlike the face
     /// its point lies deepest under, it is defined by the pieces that carry the load, also
     /// for a node on an edge of the other block, where that face is the round-off's choice.
+    /// The load under face `face` of the other block (zero if it carries none).
+    pub(crate) fn part(&self, face: usize) -> Real {
+        self.parts.iter().find(|p| p.0 as usize == face).map_or(0.0, |p| p.1)
+    }
     pub(crate) fn face(&self) -> Option<usize> {
         self.parts
             .iter()
