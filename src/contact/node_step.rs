@@ -11,9 +11,13 @@
 //! node lies under and whichever contact kind the pair had before.
 //!
 //! Shear forces are stored as components along tangents fixed in the other block's body frame
-//! for that face (`plane_basis` of its normal), so that they turn with the block; when a node
-//! passes under another face, its shear force is turned onto the new plane by the smallest
-//! rotation, which keeps its magnitude.
+//! for one of its faces (`plane_basis` of its normal, the face's index in `plane.x`), so that
+//! they turn with the block. A node at its point acts in the plane of the face it lies deepest
+//! under; when it passes under another face, its shear force is turned onto the new plane by the
+//! smallest rotation, which keeps its magnitude. A node integrated over its strips and pressed
+//! acts in the plane normal to its load's resultant, which turns continuously as the load moves
+//! from face to face: its shear is turned onto that plane from the stored face's at each step,
+//! and back onto the plane of the loaded face closest to it after the step.
 
 use super::kernel::{plane_turn, ContactStep, KernelContext};
 use super::law_update::{stays_separated, update_with_law};
@@ -23,10 +27,6 @@ use crate::block::BlockState;
 use crate::geometry::{deepest_two, spacing, NodeId, NodeStrips, Polyhedron, Strip, StripLoad};
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{plane_basis, Matrix, Real, Vector, Vector2};
-
-/// A pressed node keeps its shear plane while the face it was carries more than the load of the
-/// face that carries most over this.
-const SHEAR_PLANE_STAY: Real = 2.0;
 
 /// One block of a node contact as the step sees it: its state, rotation matrix and shape.
 pub(crate) type NodeBlock<'a> = (&'a BlockState, &'a Matrix, &'a Polyhedron);
@@ -83,12 +83,13 @@ pub(crate) fn stored_node_frame(id: NodeId, face: usize, a: NodeBlock<'_>, b: No
 }
 
 /// The shear components `shear` of a node on `b` (`on_b`) or `a`, stored along the tangents of
-/// face `from` of the other block (`shape`), turned onto face `to` by the smallest rotation
-/// (body frame of the other block: the turn does not depend on its pose).
-pub(crate) fn turned_shear(shear: Vector2, on_b: bool, shape: &Polyhedron, from: usize, to: usize) -> Vector2 {
+/// the plane of normal `from` (body frame of the other block: the turn does not depend on its
+/// pose), turned onto the plane of normal `to` by the smallest rotation, which keeps their
+/// magnitude.
+pub(crate) fn turned_shear(shear: Vector2, on_b: bool, from: Vector, to: Vector) -> Vector2 {
     let (old, new) = (
-        node_axes(on_b, &Matrix::IDENTITY, shape.faces()[from].normal),
-        node_axes(on_b, &Matrix::IDENTITY, shape.faces()[to].normal),
+        node_axes(on_b, &Matrix::IDENTITY, from),
+        node_axes(on_b, &Matrix::IDENTITY, to),
     );
     let s = old.shear(shear);
     let s = match plane_turn(old.normal, new.normal) {
@@ -164,32 +165,62 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         let pressed = integrate
             .then(|| strip_load(id, a, b, strips.map_or(&[][..], |s| s.of(i)), frame.face))
             .filter(|load| load.load > 0.0 && sub.area > 0.0);
-        // Its shear acts in the plane of the face that carries most of its load, pressed;
-        // else in that of the face its point lies deepest under. A change of plane turns the
-        // stored shear by up to 90° in one step, work the books do not see: the plane stays
-        // while the face it was carries at least half the load of the one that carries most
-        // (a node on an edge of the other block, its two faces' loads crossing, would turn at
-        // every crossing). (WIP: a normal along the load's resultant, continuous, is the
-        // lasting answer.)
+        // Pressed, its normal is that of its load's resultant: it turns continuously as the
+        // load moves from one face of the other block to another (a node on an edge of the
+        // other block), and its stored shear turns with it by the smallest rotation. The shear
+        // is kept between steps in the plane of a face of the other block (`sub.plane.x`, the
+        // one closest to the normal), turned from there onto the normal's plane at each step
+        // and back after it: the face is a matter of storage, the shear applied depends on the
+        // normal alone. Not pressed, the node's shear acts in the plane of the face its point
+        // lies deepest under, turned onto it from the last when that changes.
         let other = if id.on_b { a } else { b };
-        let dominant = pressed.and_then(|load| {
-            let f = load.face()?;
-            let last = sub.plane.x as usize;
-            Some(if f != last && load.part(last) * SHEAR_PLANE_STAY > load.part(f) {
-                last
-            } else {
-                f
-            })
-        });
-        let (face, axes) = match dominant {
-            Some(f) if f != frame.face => (f, node_axes(id.on_b, other.1, other.2.faces()[f].normal)),
-            _ => (frame.face, frame.axes),
-        };
         let last_face = sub.plane.x as usize;
-        if face != last_face && sub.force.shear != Vector2::ZERO {
-            sub.force.shear = turned_shear(sub.force.shear, id.on_b, other.2, last_face, face);
-        }
-        sub.plane.x = face as Real;
+        let faces = other.2.faces();
+        let resultant = pressed.and_then(|load| {
+            let length = load.force.length();
+            (length > 1e-9 * load.load).then(|| load.force / length)
+        });
+        let axes = match resultant {
+            Some(normal) => {
+                if sub.force.shear != Vector2::ZERO {
+                    sub.force.shear = turned_shear(sub.force.shear, id.on_b, faces[last_face].normal, normal);
+                }
+                node_axes(id.on_b, other.1, normal)
+            }
+            None => {
+                if frame.face != last_face && sub.force.shear != Vector2::ZERO {
+                    sub.force.shear = turned_shear(
+                        sub.force.shear,
+                        id.on_b,
+                        faces[last_face].normal,
+                        faces[frame.face].normal,
+                    );
+                }
+                sub.plane.x = frame.face as Real;
+                frame.axes
+            }
+        };
+        // Where a pressed node's shear is kept after its step: the loaded face whose normal
+        // lies closest to the resultant's (one has `m·n > 0`: `n` is a positive sum of them).
+        let keep_in = resultant.map(|normal| {
+            let loaded = pressed.iter().flat_map(|load| load.loaded_faces());
+            let face = loaded
+                .map(|f| (f, faces[f].normal.dot(normal)))
+                .fold(None, |best: Option<(usize, Real)>, (f, c)| match best {
+                    Some(b) if b.1 >= c => Some(b),
+                    _ => Some((f, c)),
+                })
+                .map_or(frame.face, |(f, _)| f);
+            (face, normal)
+        });
+        let keep = |sub: &mut SubContact<L::State>| {
+            if let Some((face, normal)) = keep_in {
+                if sub.force.shear != Vector2::ZERO {
+                    sub.force.shear = turned_shear(sub.force.shear, id.on_b, normal, faces[face].normal);
+                }
+                sub.plane.x = face as Real;
+            }
+        };
         let p = frame.point;
         let v_rel =
             (sb.velocity + sb.angular_velocity.cross(p - xb)) - (sa.velocity + sa.angular_velocity.cross(p - xa));
@@ -218,6 +249,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
                 && law.stays_open(sub.area, gap.abs(), &sub.state));
         if (!dashpots || dashpot_forces.get(i).is_none_or(|d| *d == Vector::ZERO)) && stays_separated(law, sub, gap) {
             sub.gap = gap;
+            keep(sub);
             continue;
         }
         let before = axes.force(&sub.force);
@@ -225,6 +257,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         step.dissipated += lost;
         step.fracture += fracture;
         let spring = axes.force(&sub.force);
+        keep(sub);
         spring_sum += (before + spring).dot(du);
         normal_force += sub.force.normal;
         let mut total = spring;

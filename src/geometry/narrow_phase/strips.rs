@@ -318,31 +318,19 @@ pub(crate) struct StripLoad {
     /// `½ Σ ρ ∫ min(g, 0)² dA` (m⁴): the stored energy over `k_n`.
     pub energy: Real,
     /// The load under each face of the other block so far (face, load), the first
-    /// [`TRACKED_FACES`] faces met; [`StripLoad::face`] reads the largest.
+    /// [`TRACKED_FACES`] faces met ([`StripLoad::loaded_faces`]).
     parts: [(u32, Real); TRACKED_FACES],
 }
 
-/// The most faces of the other block a node's load is told apart by ([`StripLoad::face`]).
+/// The most faces of the other block a node's load is told apart by ([`StripLoad::loaded_faces`]).
 const TRACKED_FACES: usize = 6;
 
 impl StripLoad {
-    /// The face of the other block that carries the largest part of the load (the first of
-    /// equal ones), `None` with no load: the plane the node's shear acts in. Unlike the face
-    /// its point lies deepest under, it is defined by the pieces that carry the load, also
-    /// for a node on an edge of the other block, where that face is the round-off's choice.
-    /// The load under face `face` of the other block (zero if it carries none).
-    pub(crate) fn part(&self, face: usize) -> Real {
-        self.parts.iter().find(|p| p.0 as usize == face).map_or(0.0, |p| p.1)
-    }
-    pub(crate) fn face(&self) -> Option<usize> {
-        self.parts
-            .iter()
-            .filter(|p| p.1 > 0.0)
-            .fold(None, |best: Option<(u32, Real)>, &p| match best {
-                Some(b) if b.1 >= p.1 => Some(b),
-                _ => Some(p),
-            })
-            .map(|p| p.0 as usize)
+    /// The faces of the other block that carry a part of the load (among the first
+    /// [`TRACKED_FACES`] met): the candidates for the plane a pressed node's stored shear is
+    /// kept in (`contact/node_step.rs`).
+    pub(crate) fn loaded_faces(&self) -> impl Iterator<Item = usize> + '_ {
+        self.parts.iter().filter(|p| p.1 > 0.0).map(|p| p.0 as usize)
     }
 }
 
