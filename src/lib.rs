@@ -116,7 +116,7 @@ pub mod prelude {
     pub use crate::error::{Error, Result};
     #[allow(deprecated)]
     pub use crate::geometry::SubcontactDensity;
-    pub use crate::geometry::{ContactParameters, SubContactDensity};
+    pub use crate::geometry::{ContactParameters, NodeRule, SubContactDensity};
     pub use crate::integrate::{CentralDifference, Damping, Integrator, TimeStep};
     pub use crate::law::{
         AnyLaw, ConstitutiveLaw, CoulombSlip, JointStatus, LawTable, LinearElastic, MaterialId, MortarJoint,

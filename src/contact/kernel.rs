@@ -60,6 +60,8 @@ pub(crate) struct KernelContext {
     /// The grid spacing of node contacts' nodes comes from this ([`crate::geometry::ContactParameters::density`]):
     /// a node's strips are as wide as at its detection.
     pub node_density: crate::geometry::SubContactDensity,
+    /// How node contacts' normal springs act ([`crate::geometry::NodeRule`]).
+    pub node_rule: crate::geometry::NodeRule,
     /// The model's step count: a joint open in part tries to enter joint-level stepping at
     /// one step in [`PARTIAL_ENTRY_PERIOD`] (its own, from its blocks).
     pub step: u64,

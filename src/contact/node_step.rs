@@ -24,7 +24,7 @@ use super::law_update::{stays_separated, update_with_law};
 use super::spread::tension_free;
 use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
 use crate::block::BlockState;
-use crate::geometry::{deepest_two, spacing, NodeId, NodeStrips, Polyhedron, Strip, StripLoad};
+use crate::geometry::{deepest_two, spacing, NodeId, NodeRule, NodeStrips, Polyhedron, Strip, StripLoad};
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{plane_basis, Matrix, Real, Vector, Vector2};
 
@@ -134,7 +134,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     // Nodes integrated over their strips (`geometry/narrow_phase/strips.rs`): in
     // large-displacement mode, for a law whose normal spring is linear (`k_n` per unit area)
     // and, in the node's state, carries no tension; elsewhere at their points.
-    let integrated = (ctx.mode == DisplacementMode::Large)
+    let integrated = (ctx.mode == DisplacementMode::Large && ctx.node_rule == NodeRule::Integrated)
         .then(|| law.elastic_regime().map(|r| r.normal_stiffness))
         .flatten()
         .filter(|k| *k > 0.0);

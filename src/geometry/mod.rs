@@ -13,8 +13,8 @@ pub(crate) use narrow_phase::nodes::{deepest_two, NodeId};
 pub(crate) use narrow_phase::spacing;
 pub(crate) use narrow_phase::strips::{NodeStrips, Strip, StripLoad};
 pub use narrow_phase::{
-    detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, PreviousContact,
-    SubContactDensity, SubContactSeed, SubKey, DEFAULT_SUBCONTACTS_PER_EDGE, MAX_SUBCONTACTS_PER_EDGE,
+    detect, BlockGeometry, ContactKind, ContactParameters, DetectedContact, NarrowPhaseScratch, NodeRule,
+    PreviousContact, SubContactDensity, SubContactSeed, SubKey, DEFAULT_SUBCONTACTS_PER_EDGE, MAX_SUBCONTACTS_PER_EDGE,
 };
 pub(crate) use narrow_phase::{face_frame, PARALLEL_ANGLE};
 #[allow(deprecated)]

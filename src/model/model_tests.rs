@@ -82,6 +82,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
         lanes: crate::contact::LaneBuild::Portable,
         joint_level: false,
         node_density: model.state.params.contact.density,
+        node_rule: model.state.params.contact.node_rule,
         step: 0,
     };
     let (mut grouped_subs, mut single_subs) = (model.state.contacts.subs.clone(), model.state.contacts.subs.clone());

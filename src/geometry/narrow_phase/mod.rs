@@ -148,6 +148,31 @@ pub struct ContactParameters {
     pub face_angle_tolerance: Real,
     /// Sub-contact density on joint faces. Default `PerEdge(15)` (the paper's value).
     pub density: SubContactDensity,
+    /// How a node contact's normal springs act: at each node's point (the default) or
+    /// integrated over the surface each node stands for ([`NodeRule`]).
+    pub node_rule: NodeRule,
+}
+
+/// How the normal spring of a node of a node contact (vertices, edges, tilted or partly
+/// overlapping faces; `docs/theory.md` §2.2, "Node contacts") acts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
+pub enum NodeRule {
+    /// At the node's point `p`: the energy `½ k_n A min(g(p), 0)²` of its tributary area `A`
+    /// at its own gap. Cheap, and exact where the gap is uniform (faces pressed flat), but a
+    /// corner or an edge pressed in carries its node's whole area from the first touch, and
+    /// a loaded hinge that turns past [`ContactParameters::face_angle_tolerance`] into a node
+    /// contact changes its stored energy (`docs/benchmarks/arch-impact.md`, item 6).
+    #[default]
+    Point,
+    /// Integrated over the surface each node stands for: `½ k_n Σ ρ ∫ min(g(x), 0)² dA` over
+    /// its pieces of its block's faces, exactly, for laws whose normal spring is linear
+    /// ([`crate::law::ElasticRegime`]) and in large-displacement mode (elsewhere the point
+    /// rule). A pressed node's shear acts in the plane normal to its load's resultant. The
+    /// change of kind of a loaded hinge then keeps its energy; a node step costs several
+    /// times the point rule's (`docs/theory.md` §2.2).
+    Integrated,
 }
 
 /// The default sub-contacts per face edge ([`ContactParameters::default`]).
@@ -160,6 +185,7 @@ impl Default for ContactParameters {
             redetect_fraction: 0.25,
             face_angle_tolerance: 15f64.to_radians(),
             density: SubContactDensity::PerEdge(DEFAULT_SUBCONTACTS_PER_EDGE),
+            node_rule: NodeRule::Point,
         }
     }
 }

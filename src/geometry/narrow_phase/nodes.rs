@@ -449,14 +449,18 @@ fn push_nodes(
     other: BlockGeometry<'_>,
     on_b: bool,
     h: Real,
-    tolerance: Real,
+    (tolerance, rule): (Real, NodeRule),
     seeds: &mut Vec<SubContactSeed>,
 ) {
     let to_other = other.pose.inverse() * *host.pose;
-    // A node stands for the strips of surface around it (`strips.rs`); it is listed when they
-    // come within the tolerance of the other block. Nodes farther than this from the other
-    // block's centroid cannot.
-    let reach = other.shape.radius() + tolerance + h;
+    // Integrated, a node stands for the strips of surface around it (`strips.rs`) and is
+    // listed when they come within the tolerance of the other block; at its point, when it
+    // does. Nodes farther than this from the other block's centroid cannot.
+    let strips = match rule {
+        NodeRule::Point => 0.0,
+        NodeRule::Integrated => h,
+    };
+    let reach = other.shape.radius() + tolerance + strips;
     let centre = to_other.inverse().transform_point(Vector::ZERO);
     let vertices = host.shape.vertices();
     let start = seeds.len();
@@ -470,20 +474,26 @@ fn push_nodes(
         }
         let (face, gap) = deepest_face(other.shape, q);
         // Its strips lie within `h` of it (`strips.rs`), and the gap is 1-Lipschitz.
-        if gap < tolerance + h {
+        if gap < tolerance + strips {
             let areas = areas.get_or_insert_with(|| NodeAreas::of(host.shape, h));
-            // Its strips, at least as far out as their faces' least values over them.
-            let mut least = Real::INFINITY;
-            for_each_strip(host.shape, &*areas, place, h, |s| {
-                let placed = (
-                    to_other.transform_point(s.centre),
-                    to_other.rotation * s.u,
-                    to_other.rotation * s.v,
-                );
-                least = least.min(least_gap(other.shape, placed, &s, face, tolerance));
-            });
-            if least >= tolerance {
-                return;
+            // Its strips, at least as far out as their faces' least values over them. The
+            // node lies on its strips: within the tolerance itself, it is listed without them.
+            if gap >= tolerance {
+                let mut least = Real::INFINITY;
+                for_each_strip(host.shape, &*areas, place, h, |s| {
+                    if least < tolerance {
+                        return;
+                    }
+                    let placed = (
+                        to_other.transform_point(s.centre),
+                        to_other.rotation * s.u,
+                        to_other.rotation * s.v,
+                    );
+                    least = least.min(least_gap(other.shape, placed, &s, face, tolerance));
+                });
+                if least >= tolerance {
+                    return;
+                }
             }
             seeds.push(SubContactSeed {
                 key: id.key(),
@@ -555,8 +565,9 @@ pub(super) fn node_contact(
 ) -> Option<DetectedContact> {
     let h = spacing(a.shape, b.shape, params.density);
     let start = seeds.len();
-    push_nodes(a, b, false, h, params.tolerance, seeds);
-    push_nodes(b, a, true, h, params.tolerance, seeds);
+    let listing = (params.tolerance, params.node_rule);
+    push_nodes(a, b, false, h, listing, seeds);
+    push_nodes(b, a, true, h, listing, seeds);
     (seeds.len() > start).then_some(DetectedContact {
         kind: ContactKind::Nodes,
         host_is_a: true,

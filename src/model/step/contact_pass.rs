@@ -209,6 +209,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             lanes: crate::contact::LaneBuild::Portable,
             joint_level: self.joint_stepping == crate::model::JointStepping::Whole,
             node_density: self.params.contact.density,
+            node_rule: self.params.contact.node_rule,
             step: self.clock.step,
         };
         // Rayleigh damping puts dashpot forces on the sub-contacts: the model keeps them from
