@@ -247,10 +247,14 @@ fn impact_summary(label: &str, kind: &str, runs: &[ImpactResult]) -> PyResult<Va
 /// median of the largest displacement over all the runs, the result to compare where the
 /// central run's moves with round-off. ``ks`` scales with ``kn``; ``damping`` is the
 /// stiffness-proportional Rayleigh ratio at 25 Hz; ``guide`` ``"frame"`` or ``"seat"``,
-/// ``base`` ``"sloped"`` or ``"flat"``, ``release`` ``"above"`` or ``"full"``.
+/// ``base`` ``"sloped"`` or ``"flat"``, ``release`` ``"above"`` or ``"full"``; ``node_rule``
+/// ``"point"`` or ``"integrated"`` (node contacts' springs integrated over the surface each
+/// node stands for: the books of a collapse close, several times slower;
+/// ``docs/benchmarks/arch-impact.md``).
 #[pyfunction]
 #[pyo3(signature = (setup="M60H20", *, kn=4e9, damping=0.01, width=0.15, duration=1.0, friction_deg=30.5,
-    per_edge=15, guide="frame", base="sloped", release="above", offsets_mm=vec![0.0], settled_states=1))]
+    per_edge=15, guide="frame", base="sloped", release="above", offsets_mm=vec![0.0], settled_states=1,
+    node_rule="point"))]
 #[allow(clippy::too_many_arguments)]
 pub fn arch_impact<'py>(
     py: Python<'py>,
@@ -266,6 +270,7 @@ pub fn arch_impact<'py>(
     release: &str,
     offsets_mm: Vec<f64>,
     settled_states: i64,
+    node_rule: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
     let per_edge = crate::convert::whole(per_edge, "per_edge", u64::from(u16::MAX))? as u16;
     let all = impact::setups();
@@ -294,6 +299,7 @@ pub fn arch_impact<'py>(
     c.guide = guide.parse::<ImpactorGuide>().map_err(bad)?;
     c.base = base.parse::<ImpactorBase>().map_err(bad)?;
     c.release = release_of(release)?;
+    c.node_rule = node_rule.parse().map_err(bad)?;
     let mut offsets: Vec<f64> = offsets_mm.iter().map(|mm| mm * 1e-3).collect();
     offsets.sort_by(|a, b| a.abs().total_cmp(&b.abs()));
     let cases: Vec<ImpactCase> = offsets

@@ -498,11 +498,13 @@ def test_ctrl_c_stops_a_push_over_waiting_for_its_servo(tmp_path):
     assert float(lines["late"]) < 1.0, done.stdout
 
 
-def test_sharp_block_keeps_its_energy():
+@pytest.mark.parametrize("node_rule", ["point", "integrated"])
+def test_sharp_block_keeps_its_energy(node_rule):
     """A tetrahedron dropped on its vertex, frictionless and undamped: its contacts are node
     contacts (vertices, edges and faces of both blocks pressed out of each other, a potential of
-    the poses), and the mechanical energy stays within 2 % of m g h as it lands and tumbles."""
-    m = vs.Model()
+    the poses), and the mechanical energy stays within 2 % of m g h as it lands and tumbles,
+    with the nodes' springs at their points or integrated over the surface they stand for."""
+    m = vs.Model(node_rule=node_rule)
     m.set_joint_law(0, 0, vs.CoulombSlip.dry(1e9, 1e9, 0.0))
     m.set_damping("none")
     m.add_cuboid("slab", (-1.0, -1.0, -0.2), (1.0, 1.0, 0.0), 2500.0, fixed=True)
@@ -525,6 +527,15 @@ def test_sharp_block_keeps_its_energy():
     assert np.all(np.isfinite(sub["point"]))
     assert worst < 0.02, worst
     assert b == 1
+
+
+def test_node_rule_is_a_model_parameter():
+    """``node_rule`` reaches the model (its scene holds it) and a bad one is refused by name."""
+    assert vs.Model.defaults()["node_rule"] == "point"
+    assert vs.Model(node_rule="integrated").to_scene_json() != vs.Model().to_scene_json()
+    assert '"node_rule":"integrated"' in vs.Model(node_rule="integrated").to_scene_json().replace(" ", "")
+    with pytest.raises(vs.VoussoirError, match="node rule"):
+        vs.Model(node_rule="points")
 
 
 def test_hinge_tilt_is_exact_at_any_density():

@@ -16,7 +16,7 @@ STATIC_KEYS = {
 }
 # Keys of a setup of arch_impact's summary.json (arch/src/cli/arch_impact.rs, GroupSummary).
 IMPACT_KEYS = {
-    "name", "label", "kind", "guide", "base", "release", "mass_kg", "height_m", "v0_m_per_s",
+    "name", "label", "kind", "guide", "base", "release", "node_rule", "mass_kg", "height_m", "v0_m_per_s",
     "contact_speed_m_per_s", "impact_energy_j", "kn_pa_per_m", "damping_ratio", "width_m",
     "first_peak_disp_m", "max_disp_m", "spread_max_disp_m", "median_max_disp_m", "spread_first_peak_disp_m",
     "max_rise_m", "max_rise_time_s", "max_velocity_m_per_s", "max_accel_m_per_s2",
@@ -74,6 +74,7 @@ def test_arch_impact_cheap():
     assert set(r) == IMPACT_KEYS | {"history"}
     assert r["name"] == r["label"] == "M60H20" and r["kind"] == "main"
     assert (r["guide"], r["base"], r["release"]) == ("Frame", "Sloped", "JustAbove")
+    assert r["node_rule"] == "point"
     assert r["runs_count"] == 2 and r["runs"][0]["height_offset_m"] == 0.0
     assert r["impact_energy_j"] == pytest.approx(60.93 * 9.81 * 0.205, rel=1e-3)
     assert r["experiment"] == {"collapsed": False, "max_disp_m": 0.034, "max_velocity_m_per_s": 1.99,
@@ -84,6 +85,17 @@ def test_arch_impact_cheap():
         "M80H45", "M75H45", "M75H20", "M60H20", "M60H25", "M60H30"]
     with pytest.raises(vs.VoussoirError, match="setup \"M1\""):
         vs.scenarios.arch_impact("M1")
+
+
+def test_arch_impact_node_rule():
+    # Node contacts integrated over the surface each node stands for: the blow lands on the
+    # sloped base's face joint, so the first impact is the point rule's to round-off.
+    r = vs.scenarios.arch_impact("M60H20", duration=0.02, per_edge=5, node_rule="integrated")
+    p = vs.scenarios.arch_impact("M60H20", duration=0.02, per_edge=5)
+    assert r["node_rule"] == "integrated" and p["node_rule"] == "point"
+    assert r["first_peak_disp_m"] == pytest.approx(p["first_peak_disp_m"], rel=1e-6)
+    with pytest.raises(vs.VoussoirError, match="node rule"):
+        vs.scenarios.arch_impact("M60H20", duration=0.02, node_rule="points")
 
 
 def test_arch_impact_settled_states_perturb_at_round_off():

@@ -185,6 +185,7 @@ class Model:
         mode: Literal["large", "small"] = "large",
         max_speed: float = 1000.0,
         impact_step: Optional[float] = 0.1,
+        node_rule: Literal["point", "integrated"] = "point",
     ) -> None: ...
     # The constructor's defaults above, as the library has them (the stub's are checked against it).
     @staticmethod
@@ -557,6 +558,7 @@ def arch_impact(
     release: Literal["above", "full"] = "above",
     offsets_mm: Sequence[float] = (0.0,),
     settled_states: int = 1,
+    node_rule: Literal["point", "integrated"] = "point",
 ) -> Dict[str, Any]: ...
 def impact_setups() -> List[Dict[str, Any]]: ...
 

@@ -184,6 +184,7 @@ pub fn build(case: &ImpactCase) -> Result<ImpactModel> {
     let (mut model, arch) = super::reference_arch_model(super::ArchJoints {
         width: case.width,
         per_edge: case.per_edge,
+        node_rule: case.node_rule,
         kn: case.kn,
         ks: case.ks,
         friction_deg: case.friction_deg,

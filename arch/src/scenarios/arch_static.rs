@@ -340,6 +340,7 @@ pub fn build(case: &StaticCase) -> Result<StaticModel> {
     let (mut model, arch) = super::reference_arch_model(super::ArchJoints {
         width: case.width,
         per_edge: case.per_edge,
+        node_rule: voussoir::geometry::NodeRule::Point,
         kn: case.kn,
         ks: case.ks,
         friction_deg: case.friction_deg,

@@ -156,6 +156,10 @@ pub struct ImpactCase {
     pub duration: Real,
     /// Sub-contacts per joint edge.
     pub per_edge: u16,
+    /// How node contacts' normal springs act (`point`, the default, or `integrated`: see
+    /// [`voussoir::geometry::NodeRule`] and `docs/benchmarks/arch-impact.md`, item 6).
+    #[serde(default)]
+    pub node_rule: voussoir::geometry::NodeRule,
     /// How the impactor is guided.
     pub guide: ImpactorGuide,
     /// Shape of the impactor's bottom face (frame guide only).
@@ -206,6 +210,7 @@ impl ImpactCase {
             width: 0.15,
             duration: 1.0,
             per_edge: 15,
+            node_rule: voussoir::geometry::NodeRule::Point,
             guide: ImpactorGuide::Frame,
             base: ImpactorBase::Sloped,
             release: Release::JustAbove,

@@ -81,6 +81,8 @@ pub struct ImpactSummary {
     pub base: ImpactorBase,
     /// Where the impactor starts.
     pub release: Release,
+    /// How node contacts' normal springs acted (`"point"` or `"integrated"`).
+    pub node_rule: voussoir::geometry::NodeRule,
     /// The impactor's mass (kg).
     pub mass_kg: f64,
     /// The drop height (m).
@@ -168,6 +170,7 @@ impl ImpactSummary {
             guide: c.guide,
             base: c.base,
             release: c.release,
+            node_rule: c.node_rule,
             mass_kg: s.mass,
             height_m: c.drop_height(),
             v0_m_per_s: r.v0,

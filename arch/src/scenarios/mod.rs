@@ -11,7 +11,7 @@ pub mod impact_summary;
 use voussoir::build::arch::{Arch, ArchSpec};
 use voussoir::contact::DisplacementMode;
 use voussoir::error::Result;
-use voussoir::geometry::{ContactParameters, SubContactDensity};
+use voussoir::geometry::{ContactParameters, NodeRule, SubContactDensity};
 use voussoir::integrate::TimeStep;
 use voussoir::law::{CoulombSlip, MaterialId};
 use voussoir::math::{Real, Vector};
@@ -29,6 +29,7 @@ pub const FRAME: MaterialId = MaterialId(2);
 pub(crate) struct ArchJoints {
     pub width: Real,
     pub per_edge: u16,
+    pub node_rule: NodeRule,
     pub kn: Real,
     pub ks: Real,
     pub friction_deg: Real,
@@ -44,6 +45,7 @@ pub(crate) fn reference_arch_model(j: ArchJoints) -> Result<(Model, Arch)> {
         gravity: Vector::new(0.0, -9.81, 0.0),
         contact: ContactParameters {
             density: SubContactDensity::PerEdge(j.per_edge),
+            node_rule: j.node_rule,
             ..ContactParameters::default()
         },
         mode: j.mode,

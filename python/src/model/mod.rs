@@ -33,9 +33,13 @@ use monitors::Samples;
 ///
 /// ``Model(*, gravity=(0, 0, -9.81), contact_tolerance=1e-3, subcontacts_per_edge=15,
 /// subcontact_spacing=None, time_step=None, safety=0.5, mode="large", max_speed=1000.0,
-/// impact_step=0.1)``: ``time_step`` None is automatic at ``safety`` times the critical step,
-/// a number is a fixed step (s); ``subcontact_spacing`` (m), when given, replaces
-/// ``subcontacts_per_edge``; ``impact_step`` None turns the impact refinement off.
+/// impact_step=0.1, node_rule="point")``: ``time_step`` None is automatic at ``safety`` times
+/// the critical step, a number is a fixed step (s); ``subcontact_spacing`` (m), when given,
+/// replaces ``subcontacts_per_edge``; ``impact_step`` None turns the impact refinement off;
+/// ``node_rule`` is how node contacts' normal springs act (vertices, edges, tilted faces):
+/// ``"point"`` at each node's point, ``"integrated"`` over the surface each node stands for,
+/// which keeps the energy of a loaded hinge that turns into a node contact at several times the
+/// cost of a node (``docs/theory.md`` §2.2).
 ///
 /// Joint laws are set per pair of materials (``set_joint_law``); block indices are ints, the
 /// rows of the arrays that ``positions()``, ``velocities()`` etc. return.
@@ -142,7 +146,8 @@ impl PyModel {
     #[pyo3(signature = (*, gravity=None, contact_tolerance=ModelParameters::default().contact.tolerance,
         subcontacts_per_edge=i64::from(voussoir::geometry::DEFAULT_SUBCONTACTS_PER_EDGE), subcontact_spacing=None,
         time_step=None, safety=voussoir::integrate::DEFAULT_SAFETY, mode="large",
-        max_speed=ModelParameters::default().max_speed, impact_step=ModelParameters::default().impact_step))]
+        max_speed=ModelParameters::default().max_speed, impact_step=ModelParameters::default().impact_step,
+        node_rule="point"))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         gravity: Option<&Bound<'_, PyAny>>,
@@ -154,6 +159,7 @@ impl PyModel {
         mode: &str,
         max_speed: f64,
         impact_step: Option<f64>,
+        node_rule: &str,
     ) -> PyResult<Self> {
         let subcontacts_per_edge =
             crate::convert::whole(subcontacts_per_edge, "subcontacts_per_edge", u64::from(u16::MAX))? as u16;
@@ -177,12 +183,14 @@ impl PyModel {
         };
         params.max_speed = max_speed;
         params.impact_step = impact_step;
+        params.contact.node_rule = node_rule.parse().map_err(bad)?;
         Ok(Self::wrap(Model::new(params).py()?))
     }
 
     /// The constructor's defaults, from the Rust library's ``ModelParameters::default()`` (the
     /// one place they are written): ``gravity``, ``contact_tolerance``,
-    /// ``subcontacts_per_edge``, ``safety``, ``mode``, ``max_speed``, ``impact_step``.
+    /// ``subcontacts_per_edge``, ``safety``, ``mode``, ``max_speed``, ``impact_step``,
+    /// ``node_rule``.
     ///
     /// >>> import voussoir as vs
     /// >>> vs.Model.defaults()["subcontacts_per_edge"]
@@ -210,6 +218,7 @@ impl PyModel {
         )?;
         d.set_item("max_speed", p.max_speed)?;
         d.set_item("impact_step", p.impact_step)?;
+        d.set_item("node_rule", p.contact.node_rule.name())?;
         Ok(d)
     }
 

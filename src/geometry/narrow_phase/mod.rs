@@ -175,6 +175,44 @@ pub enum NodeRule {
     Integrated,
 }
 
+impl NodeRule {
+    /// Every rule, the default first.
+    pub const ALL: [NodeRule; 2] = [NodeRule::Point, NodeRule::Integrated];
+
+    /// The rule's name (in scene files, on command lines and in Python): `point`,
+    /// `integrated`.
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeRule::Point => "point",
+            NodeRule::Integrated => "integrated",
+        }
+    }
+}
+
+impl std::fmt::Display for NodeRule {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for NodeRule {
+    type Err = String;
+
+    /// Parses a rule's [`NodeRule::name`].
+    ///
+    /// ```
+    /// use voussoir::geometry::NodeRule;
+    /// assert_eq!("integrated".parse::<NodeRule>(), Ok(NodeRule::Integrated));
+    /// assert!("points".parse::<NodeRule>().is_err());
+    /// ```
+    fn from_str(s: &str) -> std::result::Result<Self, Self::Err> {
+        NodeRule::ALL
+            .into_iter()
+            .find(|r| r.name() == s)
+            .ok_or_else(|| format!("node rule {s:?}: expected \"point\" or \"integrated\""))
+    }
+}
+
 /// The default sub-contacts per face edge ([`ContactParameters::default`]).
 pub const DEFAULT_SUBCONTACTS_PER_EDGE: u16 = 15;
 
