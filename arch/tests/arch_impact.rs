@@ -2,6 +2,7 @@
 
 use rayon::prelude::*;
 use voussoir::block::Block;
+use voussoir::geometry::NodeRule;
 use voussoir_arch::scenarios::arch_impact::{
     build, run, setups, ImpactCase, ImpactResult, ImpactorGuide, Release, GRAVITY,
 };
@@ -99,14 +100,58 @@ fn impact_energy_momentum_and_outcomes() {
     assert!(!r[1].collapsed, "the light drop (M60H5) must leave the arch standing");
 }
 
+/// **A collapse driven beyond the tests' drops keeps its books with integrated nodes** (issue 43,
+/// item 6): M75H20 dropped from 75 and 100 mm above the test's height (sloped base). As the
+/// ring collapses, loaded hinges open past the face angle tolerance and turn into node contacts;
+/// with point nodes that change of kind made 7.12 J of the 204 J blow at +75 mm (3.5 %), with
+/// the nodes' springs integrated over the surface they stand for the books close within
+/// 0.07–0.08 J (measured), against the 1 % every impact run is held to. (Integrated, the +75 mm
+/// drop stands at 35 mm; the +100 mm one collapses.)
+#[test]
+fn a_collapse_beyond_the_tests_drops_keeps_its_books_with_integrated_nodes() {
+    let case = |offset: f64| ImpactCase {
+        node_rule: NodeRule::Integrated,
+        height_offset: offset,
+        ..pick("M75H20")
+    };
+    let r = run_both([case(0.075), case(0.1)]);
+    for x in &r {
+        println!(
+            "M75H20 +{:.0} mm, integrated nodes: max disp {:.1} mm, collapsed {}, |energy error| ≤ {:.3} J of {:.1} J",
+            x.case.height_offset * 1e3,
+            x.max_disp * 1e3,
+            x.collapsed,
+            x.max_energy_error,
+            x.kinetic_energy
+        );
+        assert!(
+            x.max_energy_error < 0.01 * x.kinetic_energy,
+            "+{} m: energy error {} J for an impact of {} J",
+            x.case.height_offset,
+            x.max_energy_error,
+            x.kinetic_energy
+        );
+    }
+    assert!(r[1].collapsed, "the +100 mm drop collapses the ring");
+}
+
 /// The default impactor is a free block (no constrained degree of freedom) held in place only by
 /// the contacts with the fixed frame blocks: it stays within the clearance (plus the spring
 /// deflection of the guide joint), and the frictionless guide pushes along the normal of the
 /// impactor's face that a frame block's edge presses: horizontally, but for the impactor's tilt.
 #[test]
 fn frame_guided_impactor_is_free_and_guided_by_contacts() {
+    // Under both node rules: integrated, the shear plane of a node on the other block's edge
+    // was once round-off's choice, and the impactor drifted 7.3 µm across the width.
+    for rule in NodeRule::ALL {
+        frame_guided(rule);
+    }
+}
+
+fn frame_guided(node_rule: NodeRule) {
     let case = ImpactCase {
         duration: 0.3,
+        node_rule,
         ..pick("M60H30")
     };
     assert_eq!(case.guide, ImpactorGuide::Frame, "the frame guide is the default");
@@ -139,7 +184,7 @@ fn frame_guided_impactor_is_free_and_guided_by_contacts() {
     let (free, fx, fy, dx) = seen;
     let clearance = case.guide_clearance;
     println!(
-        "impactor free: {free}; guide force |Fx| ≤ {fx:.0} N, |Fy| ≤ {fy:.2} N; drift x ≤ {:.3} mm (sampled by run: {:.3} mm), \
+        "{node_rule}: impactor free: {free}; guide force |Fx| ≤ {fx:.0} N, |Fy| ≤ {fy:.2} N; drift x ≤ {:.3} mm (sampled by run: {:.3} mm), \
          z {:.2e} m; rotation ≤ {:.2e} rad; clearance {:.2} mm",
         dx * 1e3,
         r.max_impactor_drift[0] * 1e3,
