@@ -211,8 +211,9 @@ impl ContactReference {
         }
     }
 
-    /// The record of a joint open in part, if it holds one, to change.
+    /// The record of a joint open in part, if it holds one, to change (a checkpoint's reader).
     #[inline]
+    #[cfg(feature = "serde")]
     pub(crate) fn hinge_mut(&mut self) -> Option<&mut HingeRecord> {
         match self.side.as_deref_mut() {
             Some(SideRecord::Hinge(h)) => Some(h),

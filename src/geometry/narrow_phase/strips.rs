@@ -354,7 +354,7 @@ impl StripLoad {
         near: usize,
     ) {
         let piece = &strip.polygon;
-        if piece.len < 3 || !(strip.density > 0.0) {
+        if piece.len < 3 || strip.density.is_nan() || strip.density <= 0.0 {
             return;
         }
         let corners = &piece.points[..piece.len];
