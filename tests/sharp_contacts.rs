@@ -237,6 +237,24 @@ fn drops_with_friction(rule: NodeRule) {
     assert!(dissipated > 0.05, "the drops slide: {dissipated}");
 }
 
+/// An undamped, frictionless model (`kn` = `ks`, node contacts by `rule`) holding a fixed 0.2 m
+/// cube of density `density` under the plane z = 0, and a cube of its size and density to stand
+/// on it (not added).
+fn cube_on_cube(kn: Real, density: Real, rule: NodeRule) -> (Model, RigidBlock) {
+    let mut model = model_with_rule(CoulombSlip::dry(kn, kn, 0.0).expect("law"), rule);
+    model.set_damping(Damping::None).expect("damping");
+    let h = 0.1;
+    model
+        .add_block(
+            RigidBlock::cuboid("below", Vector::new(-h, -h, -2.0 * h), Vector::new(h, h, 0.0), density)
+                .expect("block")
+                .with_fixity(Fixity::FIXED),
+        )
+        .expect("below");
+    let cube = RigidBlock::cuboid("cube", Vector::new(-h, -h, 0.0), Vector::new(h, h, 2.0 * h), density).expect("cube");
+    (model, cube)
+}
+
 /// A 0.2 m cube on a fixed cube of the same size, its bottom face offset by `offset` (m) in x
 /// (and 0.3 of it in y), turned by `rotation` about its bottom centre, its lowest point on the
 /// fixed cube, spinning at `spin` (rad/s), undamped and frictionless, followed for 1 s.
@@ -244,19 +262,8 @@ fn drops_with_friction(rule: NodeRule) {
 /// initial kinetic energy and the work of gravity), and whether face and node contacts were
 /// seen.
 fn rocking(rotation: Rotation, offset: Real, spin: Vector, rule: NodeRule) -> (Real, bool, bool) {
-    let mut model = model_with_rule(CoulombSlip::dry(1e9, 1e9, 0.0).expect("law"), rule);
-    model.set_damping(Damping::None).expect("damping");
-    let h = 0.1;
-    model
-        .add_block(
-            RigidBlock::cuboid("below", Vector::new(-h, -h, -2.0 * h), Vector::new(h, h, 0.0), RHO)
-                .expect("block")
-                .with_fixity(Fixity::FIXED),
-        )
-        .expect("below");
-    let cube = RigidBlock::cuboid("cube", Vector::new(-h, -h, 0.0), Vector::new(h, h, 2.0 * h), RHO)
-        .expect("cube")
-        .transformed(Pose::from_rotation(rotation));
+    let (mut model, cube) = cube_on_cube(1e9, RHO, rule);
+    let cube = cube.transformed(Pose::from_rotation(rotation));
     let low = z_range(&cube).0;
     model
         .add_block(
@@ -315,20 +322,10 @@ fn blocks_rocking_through_face_edge_and_corner_keep_their_energy() {
 /// loaded joint turned into a node contact (the first node contact seen) and the energy scale
 /// (the initial kinetic energy), J.
 fn hinge_turning(density: Real, kn: Real, w: Real, rule: NodeRule) -> (Real, Real) {
-    let mut model = model_with_rule(CoulombSlip::dry(kn, kn, 0.0).expect("law"), rule);
-    model.set_damping(Damping::None).expect("damping");
-    let h = 0.1;
-    model
-        .add_block(
-            RigidBlock::cuboid("below", Vector::new(-h, -h, -2.0 * h), Vector::new(h, h, 0.0), density)
-                .expect("block")
-                .with_fixity(Fixity::FIXED),
-        )
-        .expect("below");
+    let (mut model, cube) = cube_on_cube(kn, density, rule);
     // Turning about the edge at y = h, z = 0: v = ω × (c − edge), ω = (−w, 0, 0), c − edge = (0, −h, h).
-    let cube = RigidBlock::cuboid("cube", Vector::new(-h, -h, 0.0), Vector::new(h, h, 2.0 * h), density)
-        .expect("cube")
-        .with_velocity(Vector::new(0.0, w * h, w * h), Vector::new(-w, 0.0, 0.0));
+    let h = 0.1;
+    let cube = cube.with_velocity(Vector::new(0.0, w * h, w * h), Vector::new(-w, 0.0, 0.0));
     let id = model.add_block(cube).expect("cube");
     let mechanical = |m: &Model| {
         let e = m.energies();
