@@ -138,7 +138,8 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         .then(|| law.elastic_regime().map(|r| r.normal_stiffness))
         .flatten()
         .filter(|k| *k > 0.0);
-    let h = spacing(a.2, b.2, ctx.node_density);
+    // The node spacing, which the strips' widths follow (integrated only).
+    let h = integrated.map_or(0.0, |_| spacing(a.2, b.2, ctx.node_density));
     // Their strips depend on the shapes alone: built at the contact's first integrated step
     // since its detection.
     let strips = integrated.and_then(|_| {
@@ -158,10 +159,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
         // Integrated (large-displacement mode, a linear normal spring, no tension in the
         // node's state), a node within `h` of the other block (its pieces lie within that of
         // it: `Strip::reach`) is pressed by its pieces' load, if they carry one.
-        let integrate = ctx.mode == DisplacementMode::Large
-            && integrated.is_some()
-            && tension_free(law, &sub.state)
-            && frame.gap <= h;
+        let integrate = integrated.is_some() && tension_free(law, &sub.state) && frame.gap <= h;
         let pressed = integrate
             .then(|| strip_load(id, a, b, strips.map_or(&[][..], |s| s.of(i)), frame.face))
             .filter(|load| load.load > 0.0 && sub.area > 0.0);
