@@ -395,6 +395,15 @@ impl ContactPair {
     pub(crate) fn range(&self) -> std::ops::Range<usize> {
         self.first as usize..self.first as usize + self.count as usize
     }
+
+    /// Whether this contact, re-detected as a contact of kind `next`, hands its forces to the
+    /// new contact's cells: a loaded node contact turning back into a face-face joint (which
+    /// only integrated nodes do, `geometry/narrow_phase/mod.rs`; `docs/theory.md` §6).
+    pub(crate) fn hands_forces_to_cells(&self, next: &ContactKind) -> bool {
+        matches!(self.kind, ContactKind::Nodes)
+            && matches!(next, ContactKind::FaceFace { .. })
+            && self.normal_force > 0.0
+    }
 }
 
 /// The plane of a contact's sub-contact anchors, in the host block's body frame: the anchor with

@@ -465,7 +465,14 @@ pub fn detect(
                     })
                     .flatten()
             }
-            ContactKind::Nodes => node_contact(a, b, n, params, seeds),
+            // Integrated nodes store what a joint's cells store for the same overlap, so a node
+            // contact whose faces have come back parallel turns back into a joint (its forces
+            // handed to the cells, `model/step/detection/staging.rs`); point nodes do not.
+            ContactKind::Nodes => match params.node_rule {
+                NodeRule::Integrated => closing_joint(a, b, n, axis.separation, params, scratch, seeds)
+                    .or_else(|| node_contact(a, b, n, params, seeds)),
+                NodeRule::Point => node_contact(a, b, n, params, seeds),
+            },
         };
         // A kept face-face joint must still be the contact: its faces the most aligned and no
         // part of either block outside them in the other (a stone toppling onto its next face).
@@ -513,6 +520,42 @@ pub fn detect(
         seeds.truncate(start);
     }
     node_contact(a, b, n, params, seeds)
+}
+
+/// The joint a loaded node contact turns back into when the blocks' most aligned faces have come
+/// back parallel (within [`PARALLEL_ANGLE`] and the face angle tolerance, as a new joint needs)
+/// and the joint they make is the whole contact (the checks a kept joint passes in [`detect`]):
+/// a voussoir joint that opened past [`PARALLEL_ANGLE`] unloaded, became a node contact and closed
+/// again. `None` (and no seeds pushed) otherwise.
+fn closing_joint(
+    a: BlockGeometry<'_>,
+    b: BlockGeometry<'_>,
+    n: Vector,
+    separation: Real,
+    params: &ContactParameters,
+    scratch: &mut NarrowPhaseScratch,
+    seeds: &mut Vec<SubContactSeed>,
+) -> Option<DetectedContact> {
+    let fa = a.shape.most_aligned_face(a.pose.rotation.inverse() * n);
+    let fb = b.shape.most_aligned_face(b.pose.rotation.inverse() * -n);
+    let na = a.pose.rotation * a.shape.faces()[fa].normal;
+    let nb = b.pose.rotation * b.shape.faces()[fb].normal;
+    let (cos, tolerance) = (-na.dot(nb), params.face_angle_tolerance.cos());
+    if cos < tolerance || cos < PARALLEL_ANGLE.cos() || near_coplanar_neighbour(a, fa, b, fb, params, scratch, seeds) {
+        return None;
+    }
+    let start = seeds.len();
+    let found = face_face(a, fa, b, fb, 0.0, None, params, scratch, seeds);
+    let whole = found.is_some()
+        && !next_face_takes_over(a, fa, b, fb, tolerance)
+        && sees_the_overlap(&seeds[start..], separation, a.shape.radius() + b.shape.radius())
+        && !vertex_outside_joint_inside(a, fa, &scratch.world_a, b)
+        && !vertex_outside_joint_inside(b, fb, &scratch.world_b, a);
+    if !whole {
+        seeds.truncate(start);
+        return None;
+    }
+    found
 }
 
 /// Whether a kept joint's sub-contacts see the blocks' overlap: the overlap along the separating

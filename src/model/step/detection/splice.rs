@@ -314,6 +314,9 @@ pub(super) fn add_dropped_work<S>(
     let carried = successor
         .filter(|(q, _)| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
         .map(|(q, records)| &records[q.range()]);
+    // A node contact turning into a joint hands its spring forces to the joint's cells, whose
+    // springs book their second half (`staging.rs`); its dashpot forces are dropped.
+    let handed = successor.is_some_and(|(q, _)| p.hands_forces_to_cells(&q.kind));
     let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
     let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
     let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
@@ -336,7 +339,7 @@ pub(super) fn add_dropped_work<S>(
         } else {
             (frame.transform_point(p.anchor(s)), p.axes())
         };
-        let spring = axes.force(&s.force);
+        let spring = if handed { Vector::ZERO } else { axes.force(&s.force) };
         if spring == Vector::ZERO && dashpot == Vector::ZERO {
             continue;
         }

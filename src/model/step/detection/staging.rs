@@ -6,8 +6,8 @@ use rayon::prelude::*;
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    node_frame, AnchorPlane, ContactLists, ContactPair, ContactReference, ContactStore, ContactWrench, ForceMoments,
-    OldContacts, SubContact, SubContactRecord,
+    node_frame, stored_node_frame, AnchorPlane, ContactLists, ContactPair, ContactReference, ContactStore,
+    ContactWrench, ForceMoments, OldContacts, SubContact, SubContactRecord,
 };
 use crate::error::Result;
 use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubContactSeed, SubKey, PARALLEL_ANGLE};
@@ -323,6 +323,17 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 *slot = dashpot;
             }
         }
+        if let Some(k) = k_old.filter(|&k| old.pairs[k].hands_forces_to_cells(&dc.kind)) {
+            let p = &old.pairs[k];
+            hand_node_forces_to_cells(
+                (&old.subs[p.range()], &old.records[p.range()]),
+                (bi, &rotations.0),
+                (bj, &rotations.1),
+                (host, &anchors, &axes),
+                joint_law,
+                subs,
+            );
+        }
         let mut pair = ContactPair {
             a: i,
             b: j,
@@ -356,6 +367,80 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
             bound_area,
             side: None,
         };
+    }
+}
+
+/// Hands the forces of a loaded node contact's nodes (`nodes`: its sub-contacts and records) to
+/// the cells of the face-face joint it turns into (`cells`, fresh; `docs/theory.md` §6,
+/// "Contact transitions"): each node's force (world, as it stands) goes to the cell whose
+/// rectangle on the joint's anchor plane lies nearest its point, composed in the joint's
+/// `axes`, so that the contact's resultant is kept and its moment moves by the distance from a
+/// node to its cell. The normal forces only start the trapezoidal work of the joint's first
+/// step (the cells' own follow from their gaps); the shear forces are the joint's history. A
+/// cell takes the largest accumulated slip and the most advanced status of its nodes, and
+/// every cell the law's unbonded state, as the nodes had: a bond lost stays lost.
+///
+/// The cells' shear springs must not store more than the nodes' did: the loaded cells cover the
+/// loaded part of the joint exactly, where the nodes' shares reach beyond it (an edge node's
+/// strip on the side face), so the same forces on less area store more (up to 1.5 times in a
+/// closing voussoir joint of `arch_impact`), and the law books what a cell's first step
+/// releases of it as friction. The cells' shear forces are then scaled down together until
+/// they store what the nodes stored; what they store less stays in the balance (never more).
+fn hand_node_forces_to_cells<L: ConstitutiveLaw>(
+    (nodes, records): (&[SubContact<L::State>], &[SubContactRecord]),
+    (bi, rotation_a): (&RigidBlock, &Matrix),
+    (bj, rotation_b): (&RigidBlock, &Matrix),
+    (host, anchors, axes): (&RigidBlock, &AnchorPlane, &JointAxes),
+    law: &L,
+    cells: &mut [SubContact<L::State>],
+) {
+    let unbonded = law.unbonded_state();
+    for cell in cells.iter_mut() {
+        cell.state = unbonded.clone();
+    }
+    for (node, record) in nodes.iter().zip(records) {
+        if node.force == JointForce::default() && node.slip == 0.0 {
+            continue;
+        }
+        let (point, node_axes) = stored_node_frame(
+            NodeId::from_key(record.key),
+            node.plane.x as usize,
+            (&bi.state, rotation_a, bi.shape()),
+            (&bj.state, rotation_b, bj.shape()),
+        );
+        let x = anchors.coordinates(host.state.pose.inverse_transform_point(point));
+        let outside = |c: &SubContact<L::State>| ((x - c.plane).abs() - c.half()).max(Vector2::ZERO).length();
+        let Some(cell) = cells
+            .iter_mut()
+            .reduce(|best, c| if outside(c) < outside(best) { c } else { best })
+        else {
+            return;
+        };
+        let f = node_axes.force(&node.force);
+        cell.force.normal += axes.normal.dot(f);
+        cell.force.shear += axes.components(f);
+        cell.slip = cell.slip.max(node.slip);
+        cell.status = match (cell.status, node.status) {
+            (JointStatus::Sliding, _) | (_, JointStatus::Sliding) => JointStatus::Sliding,
+            (JointStatus::Elastic, _) | (_, JointStatus::Elastic) => JointStatus::Elastic,
+            _ => JointStatus::Open,
+        };
+    }
+    let ks = law.stiffness().shear;
+    let shear_energy = |subs: &[SubContact<L::State>]| -> Real {
+        subs.iter()
+            .filter(|s| s.area > 0.0)
+            .map(|s| s.force.shear.length_squared() / (2.0 * ks * s.area))
+            .sum()
+    };
+    if ks > 0.0 {
+        let (stored, handed) = (shear_energy(nodes), shear_energy(cells));
+        if handed > stored {
+            let scale = (stored / handed).sqrt();
+            for cell in cells.iter_mut() {
+                cell.force.shear *= scale;
+            }
+        }
     }
 }
 
