@@ -249,7 +249,7 @@ fn impact_summary(label: &str, kind: &str, runs: &[ImpactResult]) -> PyResult<Va
 /// stiffness-proportional Rayleigh ratio at 25 Hz; ``guide`` ``"frame"`` or ``"seat"``,
 /// ``base`` ``"sloped"`` or ``"flat"``, ``release`` ``"above"`` or ``"full"``; ``node_rule``
 /// ``"point"`` or ``"integrated"`` (node contacts' springs integrated over the surface each
-/// node stands for: the books of a collapse close, several times slower;
+/// node stands for: the books of a collapse close, about 1.35 times slower;
 /// ``docs/benchmarks/arch-impact.md``).
 #[pyfunction]
 #[pyo3(signature = (setup="M60H20", *, kn=4e9, damping=0.01, width=0.15, duration=1.0, friction_deg=30.5,

@@ -38,8 +38,9 @@ use monitors::Samples;
 /// replaces ``subcontacts_per_edge``; ``impact_step`` None turns the impact refinement off;
 /// ``node_rule`` is how node contacts' normal springs act (vertices, edges, tilted faces):
 /// ``"point"`` at each node's point, ``"integrated"`` over the surface each node stands for,
-/// which keeps the energy of a loaded hinge that turns into a node contact at several times the
-/// cost of a node (``docs/theory.md`` §2.2).
+/// which keeps the energy of a loaded hinge that turns into a node contact (and back into a
+/// joint when its faces close flat) at several times the cost of a node (``docs/theory.md``
+/// §2.2, §6).
 ///
 /// Joint laws are set per pair of materials (``set_joint_law``); block indices are ints, the
 /// rows of the arrays that ``positions()``, ``velocities()`` etc. return.
