@@ -173,7 +173,9 @@ impl PyModel {
     /// ``polygon`` a list of (k, 3) arrays, the corners of each contact polygon (m, in order
     /// around it: the area a face-to-face joint's sub-contacts can carry; for a vertex or edge
     /// contact, the hull of its sub-contacts, possibly a segment or a point),
-    /// ``subcontact_count`` (m,) ints.
+    /// ``subcontact_count`` (m,) ints, ``kind`` a list of ``"face"`` (a face-to-face joint: a grid
+    /// of cells on the host face) or ``"nodes"`` (vertices, edges and tilted faces: nodes of both
+    /// blocks, ``docs/theory.md`` §2.2).
     fn contacts<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let this = self.lock(py);
         let cs: Vec<_> = this.model.contacts().collect();
@@ -229,6 +231,15 @@ impl PyModel {
                     .zip(&axes)
                     .map(|(c, a)| [c.resultant().dot(a.tangent), c.resultant().dot(a.tangent_2())]),
             ),
+        )?;
+        d.set_item(
+            "kind",
+            cs.iter()
+                .map(|c| match c.kind() {
+                    voussoir::geometry::ContactKind::FaceFace { .. } => "face",
+                    voussoir::geometry::ContactKind::Nodes => "nodes",
+                })
+                .collect::<Vec<_>>(),
         )?;
         d.set_item(
             "polygon",
