@@ -1129,3 +1129,48 @@ fn a_run_with_integrated_nodes_restarts_bit_for_bit() -> Result<()> {
     assert_eq!(fingerprint(&model), fingerprint(&restarted));
     Ok(())
 }
+
+/// **A node contact turning back into a joint restarts bit for bit** ([`NodeRule::Integrated`],
+/// `docs/theory.md` §6): a 0.2 m cube set rocking on the edge it shares with a fixed cube of its
+/// size tips past 15° (its loaded joint turns into a node contact), is checkpointed there, and
+/// falls back flat, where its loaded node contact turns back into a face joint and hands its
+/// forces to the cells; both runs to 0.6 s, with friction.
+#[test]
+fn a_node_contact_turning_back_into_a_joint_restarts_bit_for_bit() -> Result<()> {
+    let mut params = ModelParameters::default();
+    params.contact.node_rule = NodeRule::Integrated;
+    let mut model = common::model_with(params, CoulombSlip::dry(1e9, 1e9, 30.0)?);
+    model.set_damping(Damping::None)?;
+    let (h, w) = (0.1, 5.0);
+    let v = Vector::new;
+    model.add_block(
+        RigidBlock::cuboid("below", v(-h, -h, -2.0 * h), v(h, h, 0.0), 2600.0)?.with_fixity(Fixity::FIXED),
+    )?;
+    model.add_block(
+        RigidBlock::cuboid("cube", v(-h, -h, 0.0), v(h, h, 2.0 * h), 2600.0)?
+            .with_velocity(v(0.0, w * h, w * h), v(-w, 0.0, 0.0)),
+    )?;
+    let loaded_nodes = |m: &Model| {
+        m.contacts()
+            .any(|c| matches!(c.kind(), voussoir::geometry::ContactKind::Nodes) && c.normal_force() > 0.0)
+    };
+    while !loaded_nodes(&model) {
+        model.step()?;
+        assert!(model.time() < 0.3, "the joint turns into a node contact under load");
+    }
+    let mut restarted: Model = Model::from_checkpoint_str(&model.to_checkpoint_string()?)?;
+    let (mut was_loaded_nodes, mut turned_back) = (true, false);
+    while model.time() < 0.6 {
+        model.step()?;
+        restarted.step()?;
+        let face = model
+            .contacts()
+            .any(|c| matches!(c.kind(), voussoir::geometry::ContactKind::FaceFace { .. }));
+        turned_back |= was_loaded_nodes && face;
+        was_loaded_nodes = loaded_nodes(&model);
+    }
+    assert!(turned_back, "the loaded node contact turns back into a joint");
+    assert!(model.energies().friction > 0.0, "the test must include slip");
+    assert_eq!(fingerprint(&model), fingerprint(&restarted));
+    Ok(())
+}
