@@ -248,13 +248,13 @@ fn impact_summary(label: &str, kind: &str, runs: &[ImpactResult]) -> PyResult<Va
 /// central run's moves with round-off. ``ks`` scales with ``kn``; ``damping`` is the
 /// stiffness-proportional Rayleigh ratio at 25 Hz; ``guide`` ``"frame"`` or ``"seat"``,
 /// ``base`` ``"sloped"`` or ``"flat"``, ``release`` ``"above"`` or ``"full"``; ``node_rule``
-/// ``"point"`` or ``"integrated"`` (node contacts' springs integrated over the surface each
-/// node stands for: the books of a collapse close, about 1.35 times slower;
-/// ``docs/benchmarks/arch-impact.md``).
+/// ``"integrated"`` (node contacts' springs integrated over the surface each node stands for:
+/// the books of a collapse close) or ``"point"`` (the library's default, 1.4–1.6 times
+/// faster here; ``docs/benchmarks/arch-impact.md``).
 #[pyfunction]
 #[pyo3(signature = (setup="M60H20", *, kn=4e9, damping=0.01, width=0.15, duration=1.0, friction_deg=30.5,
     per_edge=15, guide="frame", base="sloped", release="above", offsets_mm=vec![0.0], settled_states=1,
-    node_rule="point"))]
+    node_rule="integrated"))]
 #[allow(clippy::too_many_arguments)]
 pub fn arch_impact<'py>(
     py: Python<'py>,

@@ -561,7 +561,7 @@ def arch_impact(
     release: Literal["above", "full"] = "above",
     offsets_mm: Sequence[float] = (0.0,),
     settled_states: int = 1,
-    node_rule: Literal["point", "integrated"] = "point",
+    node_rule: Literal["point", "integrated"] = "integrated",
 ) -> Dict[str, Any]: ...
 def impact_setups() -> List[Dict[str, Any]]: ...
 
