@@ -442,8 +442,9 @@ pub fn detect(
     // A loaded contact keeps its kind while it can: a face-face joint while its two faces stay
     // opposite within the tolerance, or within `COVERED_FACE_ANGLE` while the larger face covers
     // the smaller one whole (a block rocking on a larger one: the loaded edge row or corner node
-    // sits in cells the other face covers), a node contact always. The two store different energies
-    // for the same overlap, and a change under load would make or destroy the difference.
+    // sits in cells the other face covers), a node contact always but for integrated nodes whose
+    // faces have come back parallel (below). Point nodes and cells store different energies for
+    // the same overlap, and a change under load would make or destroy the difference.
     if let Some(p) = previous.filter(|p| p.loaded) {
         let start = seeds.len();
         let kept = match p.kind {
