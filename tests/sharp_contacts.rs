@@ -394,11 +394,17 @@ fn a_loaded_hinge_turning_past_the_tolerance_keeps_its_energy() {
 /// a joint (if one did), the largest |`accounted − input`| over the run, and the energy scale
 /// (the initial kinetic energy), J.
 fn closing_flat(density: Real, w: Real, phi: Real, rule: NodeRule) -> (Option<Real>, Real, Real) {
-    let (mut model, cube) = cube_on_cube_with(CoulombSlip::dry(1e9, 1e9, phi).expect("law"), density, rule);
+    let (back, worst, scale, _) = closing_flat_with(CoulombSlip::dry(1e9, 1e9, phi).expect("law"), density, w, rule);
+    (back, worst, scale)
+}
+
+/// [`closing_flat`] with the joint law `law`; also whether a loaded node contact was seen.
+fn closing_flat_with(law: CoulombSlip, density: Real, w: Real, rule: NodeRule) -> (Option<Real>, Real, Real, bool) {
+    let (mut model, cube) = cube_on_cube_with(law, density, rule);
     let h = 0.1;
     let cube = cube.with_velocity(Vector::new(0.0, w * h, w * h), Vector::new(-w, 0.0, 0.0));
     model.add_block(cube).expect("cube");
-    let (mut loaded_nodes, mut back, mut last, mut worst) = (false, None, 0.0, 0.0_f64);
+    let (mut loaded_nodes, mut back, mut last, mut worst, mut seen) = (false, None, 0.0, 0.0_f64, false);
     while model.time() < 0.6 {
         model.step().expect("step");
         let error = model.energies().balance_error();
@@ -410,10 +416,11 @@ fn closing_flat(density: Real, w: Real, phi: Real, rule: NodeRule) -> (Option<Re
             back = Some(error - last);
         }
         loaded_nodes = nodes == Some(true) && contact.is_some_and(|c| c.normal_force() > 0.0);
+        seen |= loaded_nodes;
         last = error;
         worst = worst.max(error.abs());
     }
-    (back, worst, model.energies().initial_kinetic)
+    (back, worst, model.energies().initial_kinetic, seen)
 }
 
 /// **A loaded node contact whose faces come back parallel turns back into a joint, and keeps its
@@ -428,7 +435,8 @@ fn closing_flat(density: Real, w: Real, phi: Real, rule: NodeRule) -> (Option<Re
 /// for the turn the other way, and the balance over the run within 1 % (measured 0.26 %, most
 /// of it from the first step). Point nodes keep a loaded node contact (their
 /// edge nodes store `½ k_n A g²` for a share the cells integrate), and it is checked that they
-/// do, so that the test sees the change it is about.
+/// do, so that the test sees the change it is about; so does a node contact whose nodes hold a
+/// state a new cell does not start from (a bond broken as the cube tipped).
 #[test]
 fn a_loaded_node_contact_closing_flat_turns_back_into_a_joint() {
     for phi in [0.0, 30.0] {
@@ -440,4 +448,12 @@ fn a_loaded_node_contact_closing_flat_turns_back_into_a_joint() {
         let (point, _, _) = closing_flat(2600.0, 5.0, phi, NodeRule::Point);
         assert!(point.is_none(), "φ {phi}°: point nodes keep a loaded node contact");
     }
+    // A bonded joint (cohesion and tensile strength, 10 Pa: it breaks as the cube tips) becomes
+    // a node contact in the failed state, which a new joint's cells do not start from: it stays
+    // a node contact rather than hand a lost bond back to the cells.
+    let bonded = CoulombSlip::new(1e9, 1e9, 30.0, 30.0, 10.0, 10.0).expect("law");
+    let (back, worst, scale, seen) = closing_flat_with(bonded, 2600.0, 5.0, NodeRule::Integrated);
+    assert!(seen, "the bonded joint turns into a loaded node contact");
+    assert!(back.is_none(), "a failed node contact turned back into a joint");
+    assert!(worst < 1e-2 * scale, "bonded: balance {worst} J of {scale} J");
 }

@@ -396,13 +396,31 @@ impl ContactPair {
         self.first as usize..self.first as usize + self.count as usize
     }
 
-    /// Whether this contact, re-detected as a contact of kind `next`, hands its forces to the
-    /// new contact's cells: a loaded node contact turning back into a face-face joint (which
-    /// only integrated nodes do, `geometry/narrow_phase/mod.rs`; `docs/theory.md` §6).
-    pub(crate) fn hands_forces_to_cells(&self, next: &ContactKind) -> bool {
-        matches!(self.kind, ContactKind::Nodes)
-            && matches!(next, ContactKind::FaceFace { .. })
+    /// Whether this contact, loaded, may turn back into a face-face joint, its forces handed to
+    /// the joint's cells (`docs/theory.md` §6): a node contact carrying load whose nodes are
+    /// integrated (`integrated`: large-displacement mode, `NodeRule::Integrated`, a law with a
+    /// linear normal spring) and all in the state a new cell starts from (`S::default()`: a
+    /// dry joint's; a node that slid or cracked in a law that remembers it keeps its history as
+    /// a node), so that the cells store what the nodes stored and lose no state. Point nodes
+    /// store `½ k_n A g²` for shares the cells integrate, and never turn back.
+    pub(crate) fn may_turn_back<S: PartialEq + Default>(&self, own: &[SubContact<S>], integrated: bool) -> bool {
+        let fresh = S::default();
+        integrated
+            && matches!(self.kind, ContactKind::Nodes)
             && self.normal_force > 0.0
+            && own.iter().all(|s| s.state == fresh)
+    }
+
+    /// Whether this contact, re-detected as a contact of kind `next`, hands its forces to the
+    /// new contact's cells: one that [may turn back](Self::may_turn_back) turning into a
+    /// face-face joint.
+    pub(crate) fn hands_forces_to_cells<S: PartialEq + Default>(
+        &self,
+        own: &[SubContact<S>],
+        integrated: bool,
+        next: &ContactKind,
+    ) -> bool {
+        matches!(next, ContactKind::FaceFace { .. }) && self.may_turn_back(own, integrated)
     }
 }
 

@@ -343,6 +343,12 @@ pub struct PreviousContact {
     pub host_is_a: bool,
     /// Whether it carried a normal force.
     pub loaded: bool,
+    /// Whether, a loaded node contact, it may turn back into a face-face joint when its blocks'
+    /// faces have come back parallel: its nodes integrated over the surface they stand for
+    /// ([`NodeRule::Integrated`], large-displacement mode, a law with a linear normal spring) and
+    /// in the state a new cell starts from, so that the joint's cells store what the nodes
+    /// stored (`docs/theory.md` §6). `false` for any other contact.
+    pub turns_back: bool,
     /// Whether it is a face-face joint whose sub-contacts carry nothing the step reads: no
     /// force, no dashpot force, each in a fresh cell's state (a joint open all over that never
     /// closed, or only without changing its law's state). Such a joint has no history to keep,
@@ -469,11 +475,9 @@ pub fn detect(
             // Integrated nodes store what a joint's cells store for the same overlap, so a node
             // contact whose faces have come back parallel turns back into a joint (its forces
             // handed to the cells, `model/step/detection/staging.rs`); point nodes do not.
-            ContactKind::Nodes => match params.node_rule {
-                NodeRule::Integrated => closing_joint(a, b, n, axis.separation, params, scratch, seeds)
-                    .or_else(|| node_contact(a, b, n, params, seeds)),
-                NodeRule::Point => node_contact(a, b, n, params, seeds),
-            },
+            ContactKind::Nodes if p.turns_back => closing_joint(a, b, n, axis.separation, params, scratch, seeds)
+                .or_else(|| node_contact(a, b, n, params, seeds)),
+            ContactKind::Nodes => node_contact(a, b, n, params, seeds),
         };
         // A kept face-face joint must still be the contact: its faces the most aligned and no
         // part of either block outside them in the other (a stone toppling onto its next face).

@@ -8,7 +8,7 @@ use super::changes::Changes;
 use crate::block::{Block, BlockId, BlockMotion, RigidBlock};
 use crate::contact::DisplacementMode;
 use crate::error::{Error, Result};
-use crate::geometry::BroadPhase;
+use crate::geometry::{BroadPhase, NodeRule};
 use crate::law::ConstitutiveLaw;
 use crate::math::{Pose, Real};
 use crate::model::Pipeline;
@@ -82,6 +82,11 @@ pub(crate) struct DetectionScratch<S> {
     boxes: Vec<Aabb>,
     /// Old contacts kept as they were.
     kept: Vec<bool>,
+    /// Per joint law: whether node contacts of that law are integrated (large-displacement
+    /// mode, [`NodeRule::Integrated`](crate::geometry::NodeRule), a linear normal spring), so
+    /// that a loaded one may turn back into a joint ([`ContactPair::may_turn_back`]). Taken at
+    /// each detection.
+    integrated_laws: Vec<bool>,
     /// The contacts after detection, in order, and where each one's sub-contacts start.
     layout: Vec<Slot>,
     firsts: Vec<u32>,
@@ -187,6 +192,7 @@ impl<S> Default for DetectionScratch<S> {
             moved: Vec::new(),
             boxes: Vec::new(),
             kept: Vec::new(),
+            integrated_laws: Vec::new(),
             layout: Vec::new(),
             firsts: Vec::new(),
             runs: Vec::new(),
@@ -283,6 +289,17 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             .reduce(|| false, |a, b| a || b)
     }
 
+    /// Whether node contacts of joint law `law` are integrated over the surface each node stands
+    /// for (`contact/node_step.rs`): in large-displacement mode, with [`NodeRule::Integrated`],
+    /// for a law whose normal spring is linear.
+    pub(super) fn nodes_integrated(&self, law: usize) -> bool {
+        self.params.mode == DisplacementMode::Large
+            && self.params.contact.node_rule == NodeRule::Integrated
+            && self.laws.laws()[law]
+                .elastic_regime()
+                .is_some_and(|r| r.normal_stiffness > 0.0)
+    }
+
     /// Re-detects contacts (`docs/theory.md` §2.3).
     ///
     /// Only pairs with a block that moved beyond the trigger since its reference pose are looked
@@ -300,6 +317,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let trigger = params.redetect_fraction * params.tolerance;
         let n = self.blocks.len();
         let sc = &mut pipeline.detection;
+        sc.integrated_laws.clear();
+        sc.integrated_laws
+            .extend((0..self.laws.laws().len()).map(|law| self.nodes_integrated(law)));
         if full || sc.moved.len() != n {
             sc.moved.clear();
             sc.moved.resize(n, true);
@@ -378,7 +398,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if sc.chunks.len() < chunks {
             sc.chunks.resize_with(chunks, ChunkScratch::default);
         }
+        // (Taken out while the tests borrow it, put back for the splice.)
+        let integrated_laws = std::mem::take(&mut sc.integrated_laws);
         let test = PairTest {
+            integrated_laws: &integrated_laws,
             blocks: &self.blocks,
             tested: &self.found.tested,
             params: &params,
@@ -431,6 +454,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 slices,
             )?;
         }
+        sc.integrated_laws = integrated_laws;
         if sc.staging_spread && sc.staging.store.pairs.len().is_multiple_of(SEGMENT) {
             // No dead room after the last segment.
             let end = sc

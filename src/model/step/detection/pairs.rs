@@ -101,6 +101,8 @@ pub(super) struct ChunkScratch {
 
 /// What the parallel narrow phase reads.
 pub(super) struct PairTest<'a, S> {
+    /// Per joint law, whether its node contacts are integrated (`DetectionScratch::integrated_laws`).
+    pub(super) integrated_laws: &'a [bool],
     pub(super) blocks: &'a [RigidBlock],
     pub(super) tested: &'a [TestedPair],
     pub(super) pairs: &'a [ContactPair],
@@ -157,6 +159,10 @@ impl<S: PartialEq + Default> PairTest<'_, S> {
                 kind: self.pairs[c].kind,
                 host_is_a: self.pairs[c].host_is_a,
                 loaded: self.pairs[c].normal_force > 0.0,
+                turns_back: self.pairs[c].may_turn_back(
+                    &self.subs[self.pairs[c].range()],
+                    self.integrated_laws[self.pairs[c].law as usize],
+                ),
                 // (Only an unloaded joint can be blank: a loaded one is not looked at.)
                 blank: self.pairs[c].normal_force <= 0.0 && self.blank(c),
             });

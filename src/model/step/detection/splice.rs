@@ -273,12 +273,12 @@ pub(super) struct Run {
 /// at every drop. Evaluated before the new lists replace the old ones (`dt` is still the step
 /// that produced the current poses); the stored energy that vanishes with the sub-contact is
 /// not dissipation and shows in [`crate::Energies::balance_error`].
-pub(super) fn dropped_work<S>(
+pub(super) fn dropped_work<S: PartialEq + Default>(
     old: &OldContacts<'_, S>,
     new: (&[ContactPair], &[SubContactRecord]),
     kept: &[bool],
     blocks: &[RigidBlock],
-    mode: DisplacementMode,
+    (mode, integrated_laws): (DisplacementMode, &[bool]),
     dt: Real,
 ) -> (Real, Real) {
     let mut owed = (0.0, 0.0);
@@ -292,7 +292,7 @@ pub(super) fn dropped_work<S>(
             .binary_search_by_key(&(p.a, p.b), |q| (q.a, q.b))
             .ok()
             .map(|s| (&new.0[s], new.1));
-        add_dropped_work(old, k, successor, blocks, mode, dt, &mut owed);
+        add_dropped_work(old, k, successor, blocks, (mode, integrated_laws), dt, &mut owed);
     }
     owed
 }
@@ -300,12 +300,12 @@ pub(super) fn dropped_work<S>(
 /// Adds to `owed` the work ([`dropped_work`]) of the sub-contacts of old contact `k` that its
 /// `successor` (the new contact of the same pair, with the new sub-contact records it indexes)
 /// does not carry on.
-pub(super) fn add_dropped_work<S>(
+pub(super) fn add_dropped_work<S: PartialEq + Default>(
     old: &OldContacts<'_, S>,
     k: usize,
     successor: Option<(&ContactPair, &[SubContactRecord])>,
     blocks: &[RigidBlock],
-    mode: DisplacementMode,
+    (mode, integrated_laws): (DisplacementMode, &[bool]),
     dt: Real,
     owed: &mut (Real, Real),
 ) {
@@ -316,7 +316,8 @@ pub(super) fn add_dropped_work<S>(
         .map(|(q, records)| &records[q.range()]);
     // A node contact turning into a joint hands its spring forces to the joint's cells, whose
     // springs book their second half (`staging.rs`); its dashpot forces are dropped.
-    let handed = successor.is_some_and(|(q, _)| p.hands_forces_to_cells(&q.kind));
+    let handed = successor
+        .is_some_and(|(q, _)| p.hands_forces_to_cells(&old.subs[p.range()], integrated_laws[p.law as usize], &q.kind));
     let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
     let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
     let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
@@ -473,7 +474,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 r.contact as usize,
                 Some(successor),
                 &self.blocks,
-                self.params.mode,
+                (self.params.mode, &sc.integrated_laws),
                 dt,
                 &mut owed,
             );
@@ -563,7 +564,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             (&sc.staging.store.pairs, &sc.staging.store.sub_records),
             &sc.kept,
             &self.blocks,
-            self.params.mode,
+            (self.params.mode, &sc.integrated_laws),
             if self.clock.drift > 0.0 {
                 self.clock.drift
             } else {

@@ -187,7 +187,7 @@ impl<'a, S> StagingSlices<'a, S> {
     }
 }
 
-impl<S: Clone + Default> StagingSlices<'_, S> {
+impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
     /// Writes the contact the narrow phase found between blocks `i < j` as contact `staged` of
     /// the detection, its sub-contacts (`seeds`) from `first` on (`law` the index of its joint
     /// law), carrying the history of old contact `k_old` by sub-contact key when it joins the
@@ -202,7 +202,7 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
         (j, bj): (u32, &RigidBlock),
         dc: &DetectedContact,
         (law, joint_law): (u32, &L),
-        large: bool,
+        (large, integrated): (bool, bool),
         seeds: &[SubContactSeed],
     ) where
         L: ConstitutiveLaw<State = S>,
@@ -323,7 +323,10 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
                 *slot = dashpot;
             }
         }
-        if let Some(k) = k_old.filter(|&k| old.pairs[k].hands_forces_to_cells(&dc.kind)) {
+        if let Some(k) = k_old.filter(|&k| {
+            let p = &old.pairs[k];
+            p.hands_forces_to_cells(&old.subs[p.range()], integrated, &dc.kind)
+        }) {
             let p = &old.pairs[k];
             hand_node_forces_to_cells(
                 (&old.subs[p.range()], &old.records[p.range()]),
@@ -375,10 +378,12 @@ impl<S: Clone + Default> StagingSlices<'_, S> {
 /// "Contact transitions"): each node's force (world, as it stands) goes to the cell whose
 /// rectangle on the joint's anchor plane lies nearest its point, composed in the joint's
 /// `axes`, so that the contact's resultant is kept and its moment moves by the distance from a
-/// node to its cell. The normal forces only start the trapezoidal work of the joint's first
-/// step (the cells' own follow from their gaps); the shear forces are the joint's history. A
-/// cell takes the largest accumulated slip and the most advanced status of its nodes, and
-/// every cell the law's unbonded state, as the nodes had: a bond lost stays lost.
+/// node to its cell (less than a cell), and a node's normal force along its load's resultant,
+/// within 1° of the joint's normal, leaves up to sin 1° of itself as shear history. The normal
+/// forces only start the trapezoidal work of the joint's first step (the cells' own follow from
+/// their gaps); the shear forces are the joint's history. A cell takes the largest accumulated
+/// slip and the most advanced status of its nodes; its law state stays the fresh one, which the
+/// nodes had ([`ContactPair::may_turn_back`]).
 ///
 /// The cells' shear springs must not store more than the nodes' did: the loaded cells cover the
 /// loaded part of the joint exactly, where the nodes' shares reach beyond it (an edge node's
@@ -394,10 +399,6 @@ fn hand_node_forces_to_cells<L: ConstitutiveLaw>(
     law: &L,
     cells: &mut [SubContact<L::State>],
 ) {
-    let unbonded = law.unbonded_state();
-    for cell in cells.iter_mut() {
-        cell.state = unbonded.clone();
-    }
     for (node, record) in nodes.iter().zip(records) {
         if node.force == JointForce::default() && node.slip == 0.0 {
             continue;
@@ -495,7 +496,10 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 (p.b, bj),
                 &dc,
                 (law, &self.laws.laws()[law as usize]),
-                self.params.mode == crate::contact::DisplacementMode::Large,
+                (
+                    self.params.mode == crate::contact::DisplacementMode::Large,
+                    self.nodes_integrated(law as usize),
+                ),
                 seeds,
             );
         }
