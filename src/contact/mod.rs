@@ -20,7 +20,7 @@ pub(crate) use closed_lanes::LaneBuild;
 pub(crate) use joint_level::{HingeRecord, JointLevel, SpanEnds};
 pub(crate) use kernel::{face_gap_coefficients, update_contact, KernelContext};
 pub(crate) use moments::ForceMoments;
-pub(crate) use node_step::{node_frame, stored_node_frame, update_nodes};
+pub(crate) use node_step::{integrated_stiffness, node_frame, stored_node_frame, update_nodes};
 pub(crate) use spread::tension_free;
 pub(crate) use store::{ContactLists, ContactSlices, ContactStore, OldContacts};
 pub(crate) use view::{CellGeometry, NodeGeometry, TensionFree};

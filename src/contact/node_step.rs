@@ -74,6 +74,22 @@ pub(crate) fn node_frame(id: NodeId, a: NodeBlock<'_>, b: NodeBlock<'_>) -> Node
     }
 }
 
+/// The normal stiffness `k_n` (per unit area) with which node contacts of `law` are integrated
+/// over the surface each node stands for, if they are: in large-displacement mode, with
+/// [`NodeRule::Integrated`], for a law whose normal spring is linear (its elastic regime). The
+/// step (`update_nodes`) and detection (which lets only such node contacts turn back into
+/// joints, `docs/theory.md` §6) ask the same question here.
+pub(crate) fn integrated_stiffness<L: ConstitutiveLaw>(
+    law: &L,
+    mode: DisplacementMode,
+    rule: NodeRule,
+) -> Option<Real> {
+    (mode == DisplacementMode::Large && rule == NodeRule::Integrated)
+        .then(|| law.elastic_regime().map(|r| r.normal_stiffness))
+        .flatten()
+        .filter(|k| *k > 0.0)
+}
+
 /// The world point of node `id` and the joint axes its stored forces are composed in: those of
 /// face `face` of the other block (the face it was pressed out of at its last step).
 pub(crate) fn stored_node_frame(id: NodeId, face: usize, a: NodeBlock<'_>, b: NodeBlock<'_>) -> (Vector, JointAxes) {
@@ -134,10 +150,7 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     // Nodes integrated over their strips (`geometry/narrow_phase/strips.rs`): in
     // large-displacement mode, for a law whose normal spring is linear (`k_n` per unit area)
     // and, in the node's state, carries no tension; elsewhere at their points.
-    let integrated = (ctx.mode == DisplacementMode::Large && ctx.node_rule == NodeRule::Integrated)
-        .then(|| law.elastic_regime().map(|r| r.normal_stiffness))
-        .flatten()
-        .filter(|k| *k > 0.0);
+    let integrated = integrated_stiffness(law, ctx.mode, ctx.node_rule);
     // The node spacing, which the strips' widths follow (integrated only).
     let h = integrated.map_or(0.0, |_| spacing(a.2, b.2, ctx.node_density));
     // Their strips depend on the shapes alone: built at the contact's first integrated step

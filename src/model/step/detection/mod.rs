@@ -6,9 +6,9 @@ use rayon::prelude::*;
 
 use super::changes::Changes;
 use crate::block::{Block, BlockId, BlockMotion, RigidBlock};
-use crate::contact::DisplacementMode;
+use crate::contact::{integrated_stiffness, DisplacementMode};
 use crate::error::{Error, Result};
-use crate::geometry::{BroadPhase, NodeRule};
+use crate::geometry::BroadPhase;
 use crate::law::ConstitutiveLaw;
 use crate::math::{Pose, Real};
 use crate::model::Pipeline;
@@ -83,7 +83,7 @@ pub(crate) struct DetectionScratch<S> {
     /// Old contacts kept as they were.
     kept: Vec<bool>,
     /// Per joint law: whether node contacts of that law are integrated (large-displacement
-    /// mode, [`NodeRule::Integrated`](crate::geometry::NodeRule), a linear normal spring), so
+    /// mode, `NodeRule::Integrated`, a linear normal spring), so
     /// that a loaded one may turn back into a joint ([`ContactPair::may_turn_back`]). Taken at
     /// each detection.
     integrated_laws: Vec<bool>,
@@ -290,14 +290,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
     }
 
     /// Whether node contacts of joint law `law` are integrated over the surface each node stands
-    /// for (`contact/node_step.rs`): in large-displacement mode, with [`NodeRule::Integrated`],
-    /// for a law whose normal spring is linear.
+    /// for ([`integrated_stiffness`], the step's own test).
     pub(super) fn nodes_integrated(&self, law: usize) -> bool {
-        self.params.mode == DisplacementMode::Large
-            && self.params.contact.node_rule == NodeRule::Integrated
-            && self.laws.laws()[law]
-                .elastic_regime()
-                .is_some_and(|r| r.normal_stiffness > 0.0)
+        integrated_stiffness(&self.laws.laws()[law], self.params.mode, self.params.contact.node_rule).is_some()
     }
 
     /// Re-detects contacts (`docs/theory.md` §2.3).
