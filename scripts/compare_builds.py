@@ -33,11 +33,17 @@ Scenes:
 A scene a build does not have (``shaking_wall`` came after e9fb418) is reported as n/a.
 
 With ``--instructions`` it counts instead of timing: each build runs once per scene and size
-under ``valgrind --tool=callgrind`` on one thread, to the end of the warm-up and to the end of
-the timed steps, and the difference of the two instruction counts per timed step is printed
-with the ratio. The count is the same for the same binary and input whatever else the machine
-does (one thread: no work-stealing), so it resolves changes of a few per cent that the wall
-clock here does not; it does not see memory stalls, which the timed runs do.
+under ``valgrind --tool=cachegrind`` with its cache simulation, on one thread, to the end of
+the warm-up and to the end of the timed steps, and the differences per timed step are printed
+with their ratios: the instructions, and the bytes read from memory (the last-level cache's
+read misses times 64; ``--ll-mb``, default 8 MB, 16-way, the development machine's L3) and
+the bytes of lines first written there (its write misses). The counts are the same for the
+same binary and input whatever else the machine does (one thread: no work-stealing), so they
+resolve changes of a few per cent that the wall clock here does not. They do not see memory
+stalls, prefetching or write-backs, which the timed runs do. Valgrind 3.19 does not decode
+every AVX2 instruction of the AVX2 kernels, so both builds run their portable kernels
+(``VOUSSOIR_PORTABLE=1``, the same bits); a base commit older than that switch gets it
+patched into its exported tree (``src/dispatch.rs``).
 
 Each run's first step is timed on its own (``Model::step`` once, after the wall is built): the
 full detection of every contact, the issue's "first step".
@@ -154,6 +160,28 @@ def export_base(commit, dest):
         tar.extractall(dest, filter="data") if hasattr(tarfile, "data_filter") else tar.extractall(dest)
 
 
+def add_portable_switch(tree):
+    """Makes `tree`'s AVX2 choice obey ``VOUSSOIR_PORTABLE`` as today's library does, for a
+    base commit older than the switch (its ``has_avx2`` gets the test first); returns whether
+    the tree has it now (a tree without ``src/dispatch.rs`` has no AVX2 kernels to avoid)."""
+    path = os.path.join(tree, "src", "dispatch.rs")
+    if not os.path.exists(path):
+        return True
+    source = open(path, encoding="utf-8").read()
+    if "VOUSSOIR_PORTABLE" in source:
+        return True
+    patched, n = re.subn(
+        r"(pub\(crate\) fn has_avx2\(\) -> bool \{)",
+        r'\1\n    if std::env::var_os("VOUSSOIR_PORTABLE").is_some_and(|v| !v.is_empty() && v != "0") {\n        return false;\n    }',
+        source,
+        count=1,
+    )
+    if n == 1:
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(patched)
+    return n == 1
+
+
 def driver_source(tree):
     """The driver, with the paths of this tree's wall builders (they moved between versions)."""
     def has(path, pattern):
@@ -212,24 +240,29 @@ def measure(binary, scene, blocks, threads):
     return json.loads(out.strip().splitlines()[-1])
 
 
-def instructions(binary, scene, blocks, work):
-    """Instructions per timed step of `scene` (callgrind, one thread): the count to the end of
-    the timed steps minus the count to the end of the warm-up, per timed step."""
+def counts(binary, scene, blocks, work, ll_mb):
+    """Per timed step of `scene` (cachegrind with its cache simulation, one thread, portable
+    kernels): the instructions, the last-level cache's read misses and its write misses. Each
+    is the count to the end of the timed steps minus the count to the end of the warm-up, per
+    timed step."""
     warmup, steps = SCENES[scene]
-    counts = []
+    totals = []
     for n in (0, steps):
-        out = os.path.join(work, f"callgrind.out.{os.getpid()}")
+        out = os.path.join(work, f"cachegrind.out.{os.getpid()}")
         run(
-            ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", "--dump-instr=no",
+            ["valgrind", "--tool=cachegrind", "--cache-sim=yes", f"--cachegrind-out-file={out}",
+             "--D1=32768,8,64", f"--LL={ll_mb * 1024 * 1024},16,64",
              binary, scene, str(blocks), str(warmup), str(n)],
             capture_output=True,
-            env={**os.environ, "RAYON_NUM_THREADS": "1"},
+            env={**os.environ, "RAYON_NUM_THREADS": "1", "VOUSSOIR_PORTABLE": "1"},
         )
         with open(out, encoding="utf-8") as f:
-            total = next(int(line.split()[1]) for line in f if line.startswith("summary:"))
+            lines = f.read().splitlines()
         os.remove(out)
-        counts.append(total)
-    return (counts[1] - counts[0]) / steps
+        events = next(line.split()[1:] for line in lines if line.startswith("events:"))
+        summary = next(line.split()[1:] for line in lines if line.startswith("summary:"))
+        totals.append(dict(zip(events, (int(v) for v in summary))))
+    return {k: (totals[1][k] - totals[0][k]) / steps for k in ("Ir", "DLmr", "DLmw")}
 
 
 def summary(values, scale, fmt):
@@ -250,7 +283,9 @@ def main():
     ap.add_argument("--rounds", type=int, default=5, help="runs of each build per scene and size")
     ap.add_argument("--threads", type=int, default=2, help="RAYON_NUM_THREADS of the runs")
     ap.add_argument("--json", help="also write the raw runs to this file")
-    ap.add_argument("--instructions", action="store_true", help="count instructions per step (callgrind) instead of timing")
+    ap.add_argument("--instructions", action="store_true",
+                    help="count instructions and bytes read from memory per step (cachegrind) instead of timing")
+    ap.add_argument("--ll-mb", type=int, default=8, help="last-level cache of --instructions, MB (16-way)")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")]
     scenes = a.scenes.split(",")
@@ -265,6 +300,9 @@ def main():
     os.makedirs(work, exist_ok=True)
     base_tree = os.path.join(work, f"tree-{base_commit}")
     export_base(a.base, base_tree)
+    if a.instructions and not add_portable_switch(base_tree):
+        print(f"warning: could not make {base_commit}'s kernels obey VOUSSOIR_PORTABLE; valgrind may stop on AVX2",
+              flush=True)
     binaries = {
         "base": build(f"base-{base_commit}", base_tree, work, "target-base"),
         "new": build("working-tree", ROOT, work, "target-new"),
@@ -272,17 +310,27 @@ def main():
 
     if a.instructions:
         print()
-        print(f"base {base_commit} against the working tree; instructions per step (callgrind, 1 thread)")
+        print(f"base {base_commit} against the working tree; per timed step (cachegrind, 1 thread, portable kernels, "
+              f"LL {a.ll_mb} MB 16-way): instructions, bytes read from memory (LL read misses x 64), "
+              "bytes of lines first written (LL write misses x 64)")
         print()
-        print("| scene | blocks | base instructions/step | new instructions/step | ratio |")
-        print("|---|---|---|---|---|")
+        print("| scene | blocks | base instructions | new instructions | ratio | base MB read | new MB read | ratio "
+              "| base MB first written | new MB first written | ratio |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|")
         for scene in scenes:
             for blocks in sizes:
                 if not all(shake for _, shake in binaries.values()) and scene.startswith("shake"):
                     continue
-                base = instructions(binaries["base"][0], scene, blocks, work)
-                new = instructions(binaries["new"][0], scene, blocks, work)
-                print(f"| {scene} | {blocks} | {base / 1e6:.2f} M | {new / 1e6:.2f} M | {new / base:.4f} |", flush=True)
+                base = counts(binaries["base"][0], scene, blocks, work, a.ll_mb)
+                new = counts(binaries["new"][0], scene, blocks, work, a.ll_mb)
+                mb = lambda c, k: c[k] * 64 / 1e6
+                share = lambda k: f"{new[k] / base[k]:.3f}" if base[k] else "n/a"
+                print(
+                    f"| {scene} | {blocks} | {base['Ir'] / 1e6:.2f} M | {new['Ir'] / 1e6:.2f} M | {share('Ir')} "
+                    f"| {mb(base, 'DLmr'):.1f} | {mb(new, 'DLmr'):.1f} | {share('DLmr')} "
+                    f"| {mb(base, 'DLmw'):.1f} | {mb(new, 'DLmw'):.1f} | {share('DLmw')} |",
+                    flush=True,
+                )
         return
 
     raw = []
