@@ -35,12 +35,13 @@ A scene a build does not have (``shaking_wall`` came after e9fb418) is reported 
 With ``--instructions`` it counts instead of timing: each build runs once per scene and size
 under ``valgrind --tool=cachegrind`` with its cache simulation, on one thread, to the end of
 the warm-up and to the end of the timed steps, and the differences per timed step are printed
-with their ratios: the instructions, and the bytes read from memory (the last-level cache's
-read misses times 64; ``--ll-mb``, default 8 MB, 16-way, the development machine's L3) and
-the bytes of lines first written there (its write misses). The counts are the same for the
-same binary and input whatever else the machine does (one thread: no work-stealing), so they
-resolve changes of a few per cent that the wall clock here does not. They do not see memory
-stalls, prefetching or write-backs, which the timed runs do. Valgrind 3.19 does not decode
+with their ratios: the instructions, and the bytes loaded from memory, the last-level cache's
+misses times 64 (``--ll-mb``, a power of two, default 8 MB, 16-way: the development machine's
+L3). Its reads and writes both count, since the simulated cache loads the line a write misses.
+The counts are the same for the same binary and input whatever else the machine does (one
+thread: no work-stealing), so they resolve changes of a few per cent that the wall clock here
+does not. They do not see stalls, prefetching, or the write-backs of dirty lines, which the
+timed runs do. Valgrind 3.19 does not decode
 every AVX2 instruction of the AVX2 kernels, so both builds run their portable kernels
 (``VOUSSOIR_PORTABLE=1``, the same bits); a base commit older than that switch gets it
 patched into its exported tree (``src/dispatch.rs``).
@@ -242,9 +243,9 @@ def measure(binary, scene, blocks, threads):
 
 def counts(binary, scene, blocks, work, ll_mb):
     """Per timed step of `scene` (cachegrind with its cache simulation, one thread, portable
-    kernels): the instructions, the last-level cache's read misses and its write misses. Each
-    is the count to the end of the timed steps minus the count to the end of the warm-up, per
-    timed step."""
+    kernels): the instructions (``Ir``), and the last-level cache's read misses (``DLmr``) and
+    write misses (``DLmw``), each a line loaded from memory. Each is the count to the end of the
+    timed steps minus the count to the end of the warm-up, per timed step."""
     warmup, steps = SCENES[scene]
     totals = []
     for n in (0, steps):
@@ -285,7 +286,8 @@ def main():
     ap.add_argument("--json", help="also write the raw runs to this file")
     ap.add_argument("--instructions", action="store_true",
                     help="count instructions and bytes read from memory per step (cachegrind) instead of timing")
-    ap.add_argument("--ll-mb", type=int, default=8, help="last-level cache of --instructions, MB (16-way)")
+    ap.add_argument("--ll-mb", type=int, default=8,
+                    help="last-level cache of --instructions, MB, a power of two (16-way, 64-byte lines)")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",")]
     scenes = a.scenes.split(",")
@@ -294,6 +296,8 @@ def main():
             sys.exit(f"unknown scene {s!r}: one of {', '.join(SCENES)}")
     if a.rounds < 1:
         sys.exit("--rounds must be at least 1")
+    if a.ll_mb < 1 or a.ll_mb & (a.ll_mb - 1):
+        sys.exit("--ll-mb must be a power of two (cachegrind takes only a power of two of sets)")
 
     base_commit = run(["git", "-C", ROOT, "rev-parse", "--short", a.base], capture_output=True, text=True).stdout.strip()
     work = os.path.join(ROOT, "target", "compare")
@@ -311,11 +315,11 @@ def main():
     if a.instructions:
         print()
         print(f"base {base_commit} against the working tree; per timed step (cachegrind, 1 thread, portable kernels, "
-              f"LL {a.ll_mb} MB 16-way): instructions, bytes read from memory (LL read misses x 64), "
-              "bytes of lines first written (LL write misses x 64)")
+              f"LL {a.ll_mb} MB 16-way): instructions; MB loaded from memory, (LL read + write misses) x 64, "
+              "and of them by writes")
         print()
-        print("| scene | blocks | base instructions | new instructions | ratio | base MB read | new MB read | ratio "
-              "| base MB first written | new MB first written | ratio |")
+        print("| scene | blocks | base instructions | new instructions | ratio | base MB loaded | new MB loaded | ratio "
+              "| base MB by writes | new MB by writes | ratio |")
         print("|---|---|---|---|---|---|---|---|---|---|---|")
         for scene in scenes:
             for blocks in sizes:
@@ -323,11 +327,13 @@ def main():
                     continue
                 base = counts(binaries["base"][0], scene, blocks, work, a.ll_mb)
                 new = counts(binaries["new"][0], scene, blocks, work, a.ll_mb)
+                for c in (base, new):
+                    c["loaded"] = c["DLmr"] + c["DLmw"]
                 mb = lambda c, k: c[k] * 64 / 1e6
                 share = lambda k: f"{new[k] / base[k]:.3f}" if base[k] else "n/a"
                 print(
                     f"| {scene} | {blocks} | {base['Ir'] / 1e6:.2f} M | {new['Ir'] / 1e6:.2f} M | {share('Ir')} "
-                    f"| {mb(base, 'DLmr'):.1f} | {mb(new, 'DLmr'):.1f} | {share('DLmr')} "
+                    f"| {mb(base, 'loaded'):.1f} | {mb(new, 'loaded'):.1f} | {share('loaded')} "
                     f"| {mb(base, 'DLmw'):.1f} | {mb(new, 'DLmw'):.1f} | {share('DLmw')} |",
                     flush=True,
                 )

@@ -33,7 +33,7 @@ fn asks_for_portable(value: Option<&std::ffi::OsStr>) -> bool {
 
 /// Whether the environment asked for the portable build, read once per process.
 #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-fn portable_requested() -> bool {
+pub(crate) fn portable_requested() -> bool {
     static REQUESTED: OnceLock<bool> = OnceLock::new();
     *REQUESTED.get_or_init(|| asks_for_portable(std::env::var_os(PORTABLE_VARIABLE).as_deref()))
 }

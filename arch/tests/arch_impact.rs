@@ -310,69 +310,79 @@ fn choices_parse_from_their_one_set_of_names() {
 
 /// **A loaded node contact turns back into a joint without moving the books** (issue 43, item 6;
 /// `docs/theory.md` §6): M60H20's central run with integrated nodes, the balance
-/// `accounted − input` read after every step. At a step where a node contact between two blocks
-/// has turned back into a face joint, the cells take the nodes' forces, with the shear scaled
-/// down where the cells' springs would store more than the nodes' did. Unscaled, the cells
-/// stored 0.494 J where the nodes stored 0.341 J, and the next step booked the difference as
-/// friction: the balance moved by up to 0.27 J in one step (measured: 0.275 J, 15 turn-back
-/// steps). Scaled, the worst turn-back step moves it by 0.023 J (14 steps), and the worst other
-/// step of the run by 0.012 J. The bound: a turn-back step is seen in the books no more than four
-/// of the run's worst ordinary steps, and by less than 0.05 % of the impact energy (0.061 J):
-/// twice the measured worst, a fifth of the unscaled handover's.
+/// `accounted − input` read after every step. When a loaded node contact between two blocks
+/// turns back into a face joint at a re-detection, the cells take the nodes' forces, with the
+/// shear scaled down where the cells' springs would store more than the nodes' did. Unscaled,
+/// the cells stored 0.494 J where the nodes stored 0.341 J, and the cells' first step booked the
+/// difference as friction (measured: the balance moved by up to 0.275 J in one such step). The
+/// step of the turn-back and the one after it are checked; every other step of the run sets the
+/// yardstick. Scaled (measured: 13 loaded node contacts turn back), the worst checked step moves
+/// the balance by 0.023 J, the worst other step by 0.012 J. The bound: a checked step moves it by at most four times the worst
+/// other step and by less than 0.05 % of the impact energy (0.061 J), 2.6 times the measured
+/// worst and a quarter of the unscaled handover's.
 #[test]
 fn integrated_node_contacts_turn_back_into_joints_within_the_books() {
     use std::collections::HashSet;
     use voussoir::geometry::ContactKind;
+    // Sampled at every step: a sample interval far below the step, and the frame callback
+    // (which the run calls at its samples) due at every one of them.
     let case = ImpactCase {
         node_rule: NodeRule::Integrated,
         sample_interval: 1e-9,
         ..pick("M60H20")
     };
-    let mut nodes_before: HashSet<(usize, usize)> = HashSet::new();
+    // The loaded node contacts after the last step: those the next re-detection may turn back
+    // (`ContactPair::may_turn_back` asks for a normal force).
+    let mut loaded_nodes: HashSet<(usize, usize)> = HashSet::new();
     let mut balance_before: Option<f64> = None;
-    let (mut turn_backs, mut worst_turn, mut worst_other) = (0usize, 0.0_f64, 0.0_f64);
+    // Steps left to check after a turn-back: its own and the cells' first after it.
+    let mut checking = 0_u32;
+    let (mut turn_backs, mut worst_checked, mut worst_other) = (0usize, 0.0_f64, 0.0_f64);
     let r = run(&case, Some(1e-12), |m| {
-        let e = m.energies();
-        let balance = e.accounted() - e.input();
-        let mut nodes = HashSet::new();
+        let balance = m.energies().balance_error();
+        let mut loaded = HashSet::new();
         let mut turned = false;
         for c in m.contacts() {
             let (a, b) = c.blocks();
             let pair = (a.index(), b.index());
             match c.kind() {
-                ContactKind::Nodes => {
-                    nodes.insert(pair);
+                ContactKind::Nodes if c.normal_force() > 0.0 => {
+                    loaded.insert(pair);
                 }
-                ContactKind::FaceFace { .. } if nodes_before.contains(&pair) => turned = true,
+                ContactKind::FaceFace { .. } if loaded_nodes.contains(&pair) => turned = true,
                 _ => {}
             }
         }
+        if turned {
+            turn_backs += 1;
+            checking = 2;
+        }
         if let Some(before) = balance_before {
             let moved = (balance - before).abs();
-            if turned {
-                turn_backs += 1;
-                worst_turn = worst_turn.max(moved);
+            if checking > 0 {
+                worst_checked = worst_checked.max(moved);
             } else {
                 worst_other = worst_other.max(moved);
             }
         }
+        checking = checking.saturating_sub(1);
         balance_before = Some(balance);
-        nodes_before = nodes;
+        loaded_nodes = loaded;
         Ok(())
     })
     .expect("run");
     println!(
-        "M60H20, integrated: {turn_backs} turn-back steps, worst balance move {worst_turn:.4} J; other steps {worst_other:.4} J; \
-         books within {:.3} J of {:.1} J",
+        "M60H20, integrated: {turn_backs} loaded node contacts turned back, worst checked step {worst_checked:.4} J; \
+         other steps {worst_other:.4} J; books within {:.3} J of {:.1} J",
         r.max_energy_error, r.kinetic_energy
     );
     assert!(
         turn_backs > 0,
-        "the run must turn node contacts back into joints to test them"
+        "the run must turn loaded node contacts back into joints to test them"
     );
     assert!(
-        worst_turn <= 4.0 * worst_other && worst_turn < 5e-4 * r.kinetic_energy,
-        "a turn-back step moved the books by {worst_turn} J (other steps at most {worst_other} J, impact {} J)",
+        worst_checked <= 4.0 * worst_other && worst_checked < 5e-4 * r.kinetic_energy,
+        "a turn-back moved the books by {worst_checked} J (other steps at most {worst_other} J, impact {} J)",
         r.kinetic_energy
     );
 }

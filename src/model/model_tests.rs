@@ -15,6 +15,11 @@ use crate::math::Vector;
 /// AVX2; elsewhere both runs take the portable path.
 #[test]
 fn avx2_and_portable_builds_are_bit_identical() {
+    // With `VOUSSOIR_PORTABLE` set, both runs would take the portable path and prove nothing.
+    assert!(
+        !crate::dispatch::portable_requested(),
+        "VOUSSOIR_PORTABLE is set: this test compares the AVX2 build with the portable one; unset it"
+    );
     let run = |portable: bool| {
         crate::dispatch::set_portable_only(portable);
         let mut model = crate::scenes::benchmark_wall(300).expect("wall");
