@@ -176,6 +176,14 @@ impl<S> DetectionScratch<S> {
     }
 }
 
+/// Whether the node contacts of joint law `law` are integrated, by the detection's table of the
+/// laws ([`DetectionScratch`]'s `integrated_laws`): a law index the laws no longer have (they
+/// changed since the contact was made) reads as not integrated. The turn-back test, the
+/// handover of forces and the dropped work all ask here, of the old contact's law.
+pub(super) fn law_integrated(integrated_laws: &[bool], law: u32) -> bool {
+    integrated_laws.get(law as usize) == Some(&true)
+}
+
 impl<S> Default for DetectionScratch<S> {
     fn default() -> Self {
         Self {
@@ -291,7 +299,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
 
     /// Whether node contacts of joint law `law` are integrated over the surface each node stands
     /// for ([`integrated_stiffness`], the step's own test).
-    pub(super) fn nodes_integrated(&self, law: usize) -> bool {
+    fn nodes_integrated(&self, law: usize) -> bool {
         integrated_stiffness(&self.laws.laws()[law], self.params.mode, self.params.contact.node_rule).is_some()
     }
 
@@ -445,7 +453,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 &mut sc.chunks[..tasks],
                 &sc.plan[batch.clone()],
                 &mut sc.outcomes[batch],
-                chunk,
+                (chunk, &integrated_laws),
                 slices,
             )?;
         }

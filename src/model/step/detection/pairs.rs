@@ -161,8 +161,7 @@ impl<S: PartialEq + Default> PairTest<'_, S> {
                 loaded: self.pairs[c].normal_force > 0.0,
                 turns_back: self.pairs[c].may_turn_back(
                     &self.subs[self.pairs[c].range()],
-                    // (A law index the laws no longer have: not integrated.)
-                    self.integrated_laws.get(self.pairs[c].law as usize) == Some(&true),
+                    super::law_integrated(self.integrated_laws, self.pairs[c].law),
                 ),
                 // (Only an unloaded joint can be blank: a loaded one is not looked at.)
                 blank: self.pairs[c].normal_force <= 0.0 && self.blank(c),

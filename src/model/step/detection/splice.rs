@@ -316,8 +316,7 @@ pub(super) fn add_dropped_work<S: PartialEq + Default>(
         .map(|(q, records)| &records[q.range()]);
     // A node contact turning into a joint hands its spring forces to the joint's cells, whose
     // springs book their second half (`staging.rs`); its dashpot forces are dropped.
-    // (A law index the laws no longer have: not integrated.)
-    let integrated = integrated_laws.get(p.law as usize) == Some(&true);
+    let integrated = super::law_integrated(integrated_laws, p.law);
     let handed = successor.is_some_and(|(q, _)| p.hands_forces_to_cells(&old.subs[p.range()], integrated, &q.kind));
     let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
     let frame = p.frame(reference, &sa.pose, &sb.pose, mode);

@@ -191,7 +191,9 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
     /// Writes the contact the narrow phase found between blocks `i < j` as contact `staged` of
     /// the detection, its sub-contacts (`seeds`) from `first` on (`law` the index of its joint
     /// law), carrying the history of old contact `k_old` by sub-contact key when it joins the
-    /// same features with the same host.
+    /// same features with the same host. `large`: large-displacement mode; `integrated`: whether
+    /// the old contact's nodes are integrated (its law's, [`super::law_integrated`]), so that a
+    /// loaded node contact turning into a joint hands its forces to the cells.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn write_detected<L>(
         &mut self,
@@ -455,7 +457,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         chunks: &mut [ChunkScratch],
         plan: &[Planned],
         outcomes: &mut [Outcome],
-        chunk: usize,
+        (chunk, integrated_laws): (usize, &[bool]),
         slices: StagingSlices<'_, L::State>,
     ) -> Result<()> {
         if chunks.len() > 1 {
@@ -466,8 +468,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             let (plan_a, plan_b) = plan.split_at(mid * chunk);
             let (outcomes_a, outcomes_b) = outcomes.split_at_mut(mid * chunk);
             let (a, b) = rayon::join(
-                || self.stage(chunks_a, plan_a, outcomes_a, chunk, slices_a),
-                || self.stage(chunks_b, plan_b, outcomes_b, chunk, slices_b),
+                || self.stage(chunks_a, plan_a, outcomes_a, (chunk, integrated_laws), slices_a),
+                || self.stage(chunks_b, plan_b, outcomes_b, (chunk, integrated_laws), slices_b),
             );
             return a.and(b);
         }
@@ -488,6 +490,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             let seeds = &scratch.seeds[o.first_seed as usize..(o.first_seed + o.seed_count) as usize];
             let (bi, bj) = (&self.blocks[p.a as usize], &self.blocks[p.b as usize]);
             let law = self.law_index(p.a, p.b)?;
+            // Whether the old contact's nodes are integrated, by its own law (as its turn-back
+            // test and its dropped work ask).
+            let integrated = p
+                .old_contact()
+                .is_some_and(|k| super::law_integrated(integrated_laws, self.contacts.pairs[k].law));
             slices.write_detected(
                 (o.staged, o.first_sub),
                 &old,
@@ -496,10 +503,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 (p.b, bj),
                 &dc,
                 (law, &self.laws.laws()[law as usize]),
-                (
-                    self.params.mode == crate::contact::DisplacementMode::Large,
-                    self.nodes_integrated(law as usize),
-                ),
+                (self.params.mode == crate::contact::DisplacementMode::Large, integrated),
                 seeds,
             );
         }
