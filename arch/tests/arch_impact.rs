@@ -317,9 +317,9 @@ fn choices_parse_from_their_one_set_of_names() {
 /// difference as friction (measured: the balance moved by up to 0.275 J in one such step). The
 /// step of the turn-back and the one after it are checked; every other step of the run sets the
 /// yardstick. Scaled (measured: 13 loaded node contacts turn back), the worst checked step moves
-/// the balance by 0.023 J, the worst other step by 0.012 J. The bound: a checked step moves it by at most four times the worst
-/// other step and by less than 0.05 % of the impact energy (0.061 J), 2.6 times the measured
-/// worst and a quarter of the unscaled handover's.
+/// the balance by 0.023 J, the worst other step by 0.012 J. The bound: a checked step moves it
+/// by at most four times the worst other step and by less than 0.05 % of the impact energy
+/// (0.061 J), 2.6 times the measured worst and under a quarter of the unscaled handover's.
 #[test]
 fn integrated_node_contacts_turn_back_into_joints_within_the_books() {
     use std::collections::HashSet;
