@@ -123,6 +123,10 @@ fn static_servo_and_friction_are_checked_when_parsed() {
         ("--friction", "0", "(0, 90)"),
         ("--friction", "30,90", "(0, 90)"),
         ("--friction", "-30", "(0, 90)"),
+        ("--joint-friction", "5=0", "(0, 90)"),
+        ("--joint-friction", "5=40,13=90", "(0, 90)"),
+        ("--joint-friction", "5", "J=DEG"),
+        ("--joint-friction", "x=40", "0 to 13"),
     ] {
         let message = refused(statics(&[flag, value]));
         assert!(
@@ -140,6 +144,8 @@ fn static_servo_and_friction_are_checked_when_parsed() {
     ])
     .expect("parses");
     assert_eq!((o.servo_increment, o.servo_ratio), (5e-4, 0.1));
+    let (_, o) = statics(&["--joint-friction", "5=40, 13=40.5"]).expect("parses");
+    assert_eq!(o.joint_friction, [(5, 40.0), (13, 40.5)]);
 }
 
 #[test]

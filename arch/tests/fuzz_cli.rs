@@ -69,6 +69,10 @@ fn check(text: &str) -> Result<bool, String> {
                 in_range("--friction", o.friction.iter().all(|&f| FRICTION_RANGE.contains(f)))?;
                 in_range("--servo-increment", SERVO_INCREMENT_RANGE.contains(o.servo_increment))?;
                 in_range("--servo-ratio", SERVO_RATIO_RANGE.contains(o.servo_ratio))?;
+                in_range(
+                    "--joint-friction",
+                    o.joint_friction.iter().all(|&(_, f)| FRICTION_RANGE.contains(f)),
+                )?;
                 Ok(true)
             }
             None => Ok(false),

@@ -67,6 +67,7 @@ fn static_summary(r: &StaticResult, convergence: Option<&Convergence>) -> Value 
             statics::PlateSupport::Rolling => "rolling",
             statics::PlateSupport::Held => "held",
         },
+        "joint_friction_deg": c.joint_friction,
         "peak_load_kn": r.peak_load / 1e3,
         "peak_load_kn_per_m": r.peak_load / 1e3 / c.width,
         "raw_peak_load_kn": r.raw_peak_load / 1e3,
@@ -111,11 +112,15 @@ fn static_summary(r: &StaticResult, convergence: Option<&Convergence>) -> Value 
 /// also runs the refined case (half the increment and threshold), in parallel, and fills
 /// ``rate_convergence``. ``plate`` is ``"rolling"`` (only its vertical velocity prescribed, the
 /// adopted baseline) or ``"held"`` (its whole velocity prescribed: straight down without
-/// turning, as the paper's "fix velocity").
+/// turning, as the paper's "fix velocity"). ``joint_friction`` gives chosen joints of the ring
+/// a friction angle of their own, ``{joint: degrees}`` with joints numbered 0 (left springing)
+/// to 13 (right springing), the others keeping ``friction_deg``: ``{5: 40, 13: 40}`` keeps
+/// joints 5 and 13 from sliding, and the arch forms the test's mechanism; the summary echoes
+/// it as ``joint_friction_deg``.
 #[pyfunction]
 #[pyo3(signature = (*, friction_deg=30.5, kn=4e9, ks=None, width=0.15, mode="large", per_edge=15,
     servo_increment=2e-5, servo_ratio=1e-3, rate=None, max_displacement=0.012, stop_fraction=0.5,
-    local_damping=0.8, convergence_check=false, label=None, plate="rolling"))]
+    local_damping=0.8, convergence_check=false, label=None, plate="rolling", joint_friction=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn arch_static<'py>(
     py: Python<'py>,
@@ -134,6 +139,7 @@ pub fn arch_static<'py>(
     convergence_check: bool,
     label: Option<String>,
     plate: &str,
+    joint_friction: Option<std::collections::BTreeMap<i64, f64>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let per_edge = crate::convert::whole(per_edge, "per_edge", u64::from(u16::MAX))? as u16;
     let plate_support = match plate.to_ascii_lowercase().as_str() {
@@ -179,6 +185,11 @@ pub fn arch_static<'py>(
     case.stop_fraction = stop_fraction;
     case.local_damping = local_damping;
     case.plate_support = plate_support;
+    for (joint, deg) in joint_friction.unwrap_or_default() {
+        // Negative indices are refused here, those past the ring by the scenario, which names the range.
+        let joint = crate::convert::whole(joint, "joint_friction: joint index", u64::from(u32::MAX))?;
+        case.joint_friction.insert(joint as usize, deg);
+    }
     if let Some(l) = label {
         case.label = l;
     }

@@ -9,7 +9,7 @@ import voussoir as vs
 # Keys of a case of arch_static's summary.json (arch/src/cli/arch_static.rs, CaseSummary).
 STATIC_KEYS = {
     "label", "loading", "servo", "friction_deg", "kn_pa_per_m", "ks_pa_per_m", "rate_m_per_s",
-    "mode", "width_m", "plate", "peak_load_kn", "peak_load_kn_per_m", "raw_peak_load_kn",
+    "mode", "width_m", "plate", "joint_friction_deg", "peak_load_kn", "peak_load_kn_per_m", "raw_peak_load_kn",
     "disp_at_peak_mm", "rate_convergence", "end_disp_mm", "end_load_kn",
     "settle_unbalanced_ratio", "mechanism", "joints_at_peak", "joints_at_end", "steps", "dt_s",
     "subcontacts", "wall_s",
@@ -67,6 +67,25 @@ def test_arch_static_plate_held_restrains_the_loaded_voussoir():
     held = vs.scenarios.arch_static(plate="held", **quick)
     assert (rolling["plate"], held["plate"]) == ("rolling", "held")
     assert held["peak_load_kn"] > 1.1 * rolling["peak_load_kn"]
+
+
+def test_arch_static_joint_friction_forms_the_tests_mechanism():
+    # Joints 5 and 13 at 40°, the rest at 30.5°: only joint 4 can slide, and the arch forms the
+    # test's mechanism, three hinges and one slide, which carries more than the uniform arch's
+    # sliding of joints 4, 5 and 13 and loses it with geometry (5.08 kN, then 2.17 kN at 12 mm
+    # at 15 per edge; docs/benchmarks/arch-static.md, "The test's mechanism, forced").
+    quick = dict(per_edge=5, max_displacement=0.008, stop_fraction=0.0)
+    forced = vs.scenarios.arch_static(joint_friction={5: 40.0, 13: 40.0}, **quick)
+    assert forced["joint_friction_deg"] == {"5": 40.0, "13": 40.0}
+    assert forced["mechanism"]["at_peak"]["sliding_joints"] == [4]
+    assert forced["end_load_kn"] < 0.8 * forced["peak_load_kn"]
+    assert vs.scenarios.arch_static(**quick)["joint_friction_deg"] == {}
+    with pytest.raises(vs.VoussoirError, match="joint index"):
+        vs.scenarios.arch_static(joint_friction={14: 40.0})
+    with pytest.raises(ValueError, match="joint index"):
+        vs.scenarios.arch_static(joint_friction={-1: 40.0})
+    with pytest.raises(vs.VoussoirError, match="friction angle of joint 5"):
+        vs.scenarios.arch_static(joint_friction={5: 90.0})
 
 
 def test_arch_impact_cheap():

@@ -1,7 +1,7 @@
 """Type stubs of the native module ``voussoir._voussoir`` (re-exported by ``voussoir``)."""
 
 from os import PathLike
-from typing import Any, Callable, Dict, Iterable, List, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, List, Literal, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -546,6 +546,7 @@ def arch_static(
     convergence_check: bool = False,
     label: Optional[str] = None,
     plate: Literal["rolling", "held"] = "rolling",
+    joint_friction: Optional[Mapping[int, float]] = None,
 ) -> Dict[str, Any]: ...
 def arch_impact(
     setup: str = "M60H20",

@@ -86,6 +86,30 @@ pub struct StaticOptions {
     /// adopted baseline) or held (its whole velocity prescribed, the paper's "fix velocity")
     #[arg(long, value_enum, default_value = "rolling")]
     pub plate: PlateArg,
+    /// Joints of the ring with a friction angle of their own, J=DEG: joint J from 0 (left
+    /// springing) to 13 (right springing), DEG in (0, 90); every other joint keeps the case's
+    /// angle. Applies to every case but the rate study, as `--plate` does. E.g. 5=40,13=40 keeps
+    /// joints 5 and 13 from sliding, and the arch forms the test's mechanism
+    #[arg(
+        long,
+        value_name = "J=DEG[,J=DEG]",
+        value_delimiter = ',',
+        action = ArgAction::Set,
+        value_parser = joint_friction
+    )]
+    pub joint_friction: Vec<(usize, f64)>,
+}
+
+/// One `--joint-friction` entry, `J=DEG`.
+fn joint_friction(s: &str) -> Result<(usize, f64), String> {
+    let (joint, deg) = s
+        .split_once('=')
+        .ok_or_else(|| format!("{s:?}: expected J=DEG, a joint's index and its friction angle in degrees"))?;
+    let joint: usize = joint
+        .trim()
+        .parse()
+        .map_err(|_| format!("{s:?}: the joint {joint:?} is not an index from 0 to 13"))?;
+    Ok((joint, FRICTION_RANGE.parser()(deg.trim())?))
 }
 
 /// `--plate`.
@@ -155,7 +179,7 @@ fn cases(o: &StaticOptions) -> Result<Vec<StaticCase>, BoxError> {
         servo.increment,
         servo.max_unbalanced_ratio,
     )?;
-    let base = StaticCase {
+    let mut base = StaticCase {
         servo: Some(servo),
         plate_support: match o.plate {
             PlateArg::Rolling => PlateSupport::Rolling,
@@ -163,6 +187,11 @@ fn cases(o: &StaticOptions) -> Result<Vec<StaticCase>, BoxError> {
         },
         ..StaticCase::baseline()
     };
+    for &(joint, deg) in &o.joint_friction {
+        if base.joint_friction.insert(joint, deg).is_some() {
+            return Err(format!("--joint-friction: joint {joint} is given twice").into());
+        }
+    }
     Ok(paper_cases(o, base))
 }
 
@@ -224,6 +253,8 @@ struct CaseSummary {
     width_m: f64,
     /// How the plate is held: "rolling" or "held" (`--plate`).
     plate: &'static str,
+    /// Joints with a friction angle of their own (`--joint-friction`): joint index → degrees.
+    joint_friction_deg: std::collections::BTreeMap<usize, f64>,
     peak_load_kn: f64,
     peak_load_kn_per_m: f64,
     raw_peak_load_kn: f64,
@@ -306,6 +337,7 @@ fn summarise(r: &StaticResult, convergence: Option<&Convergence>) -> CaseSummary
             PlateSupport::Rolling => "rolling",
             PlateSupport::Held => "held",
         },
+        joint_friction_deg: c.joint_friction.clone(),
         peak_load_kn: r.peak_load / 1e3,
         peak_load_kn_per_m: r.peak_load / 1e3 / c.width,
         raw_peak_load_kn: r.raw_peak_load / 1e3,

@@ -14,6 +14,7 @@
 //! [`limit_analysis`] gives the rigid-block collapse load of the settled arch beside the DEM's
 //! peak (`docs/benchmarks/arch-static.md`, "Limit analysis").
 
+use std::collections::BTreeMap;
 use std::ops::ControlFlow;
 use std::time::Instant;
 
@@ -91,6 +92,13 @@ pub struct StaticCase {
     /// default).
     #[serde(default)]
     pub plate_support: PlateSupport,
+    /// Joints of the ring with a friction angle of their own (joint index `0..=13` from the left
+    /// springing → degrees, in `(0°, 90°)`, initial = residual); every other joint has
+    /// `friction_deg`. Empty by default. E.g. `{5: 40, 13: 40}` keeps joints 5 and 13 from
+    /// sliding, and the arch forms the test's mechanism (`docs/benchmarks/arch-static.md`, "The
+    /// test's mechanism, forced"). The limit analysis takes the same angles.
+    #[serde(default)]
+    pub joint_friction: BTreeMap<usize, Real>,
 }
 
 /// How the loading plate is held while it is driven down.
@@ -155,6 +163,7 @@ impl StaticCase {
             servo: Some(ServoLoading::DEFAULT),
             time_step_safety: 0.9,
             plate_support: PlateSupport::Rolling,
+            joint_friction: BTreeMap::new(),
         }
     }
 
@@ -369,6 +378,25 @@ pub fn build(case: &StaticCase) -> Result<StaticModel> {
             .with_fixity(plate_fixity(case.plate_support, 0.0)),
     )?;
     let joints = arch.joint_refs();
+    for (&index, &friction_deg) in &case.joint_friction {
+        let joint = joints
+            .iter()
+            .find(|j| j.index == index)
+            .ok_or_else(|| voussoir::Error::InvalidParameter {
+                name: "joint_friction: joint index".into(),
+                value: index as Real,
+                expected: "a joint of the ring, 0 (left springing) to 13 (right springing)",
+            })?;
+        if !(friction_deg > 0.0 && friction_deg < 90.0) {
+            return Err(voussoir::Error::InvalidParameter {
+                name: format!("joint_friction: friction angle of joint {index} (degrees)"),
+                value: friction_deg,
+                expected: "in (0, 90): a joint without friction has no capacity, and tan φ is infinite at 90°",
+            });
+        }
+        let law = voussoir::law::CoulombSlip::dry(case.kn, case.ks, friction_deg)?;
+        model.set_interface_law(joint.blocks.0, joint.blocks.1, law)?;
+    }
     Ok(StaticModel {
         model,
         arch,
