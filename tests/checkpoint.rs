@@ -158,6 +158,19 @@ fn truncated_or_corrupt_checkpoints_are_errors() -> Result<()> {
         let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err(field);
         assert!(err.to_string().contains(path), "{err}");
     }
+    // A face-face cell's key that names other faces than its joint's (a cell keeps only its
+    // grid indices, its joint the faces): either face, the other block's or the host's.
+    for face_bit in [32, 48] {
+        let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
+        assert!(json["contacts"][0]["kind"].get("FaceFace").is_some(), "a joint first");
+        let key = &mut json["contacts"][0]["subcontacts"][1]["key"];
+        *key = serde_json::json!(key.as_u64().expect("a key") ^ (1u64 << face_bit));
+        let err = Model::<CoulombSlip>::from_checkpoint_str(&sealed(&json)?).expect_err("a cell of other faces");
+        assert!(
+            matches!(err, Error::Checkpoint { .. }) && err.to_string().contains("contacts[0].subcontacts[1].key"),
+            "{err}"
+        );
+    }
     // Another version is named as such, whatever else changed between the versions.
     let mut json: serde_json::Value = serde_json::from_str(&text).expect("json");
     json["version"] = serde_json::json!(6);

@@ -384,6 +384,7 @@ mod tests {
                     slip: 0.0,
                     half: [0.025, 0.0125],
                     status: JointStatus::Elastic,
+                    cell: [(k % 4) as u16, (k / 4) as u16],
                     state: AnyState {
                         coulomb: CoulombState {
                             failed: failed.contains(&k),

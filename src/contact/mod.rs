@@ -175,8 +175,9 @@ pub(crate) struct ContactReference {
     /// `area` when the critical step was last evaluated (0 for a new contact).
     pub(crate) bound_area: Real,
     /// What the contact keeps on the side ([`SideRecord`]). Boxed, so that a contact that
-    /// needs none (almost every contact of a wall) pays 8 bytes for it: allocated when the
-    /// contact first needs it after its detection, and reused after.
+    /// needs none (almost every contact of a wall) pays 8 bytes for it: a node contact's from
+    /// its detection on ([`ContactReference::nodes`]), a joint's allocated when it first needs
+    /// it after its detection, and reused after.
     pub(crate) side: Option<Box<SideRecord>>,
 }
 
@@ -186,9 +187,23 @@ pub(crate) enum SideRecord {
     /// Of a joint open in part ([`JointLevel::span`] not empty): what its cells stepped as a
     /// whole need; stale otherwise.
     Hinge(HingeRecord),
-    /// Of a node contact stepped integrated: its nodes' strips
-    /// (`geometry/narrow_phase/strips.rs`), built at its first such step after detection.
-    Nodes(crate::geometry::NodeStrips),
+    /// Of a node contact, always (from its detection or its checkpoint's load on): its nodes'
+    /// keys and strips ([`NodeRecord`]).
+    Nodes(NodeRecord),
+}
+
+/// What a node contact keeps beside its sub-contacts: the keys of its nodes, index for index
+/// with its sub-contacts (a node's key names its block, vertex, edge or face and its place
+/// there, [`crate::geometry::NodeId`]: up to 59 bits, which the padding of a [`SubContact`]
+/// cannot hold, where a face-face cell's key is its joint's faces and two grid indices,
+/// [`ContactPair::key`]), and, stepped integrated, their strips
+/// (`geometry/narrow_phase/strips.rs`), built at its first such step after detection.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct NodeRecord {
+    /// The nodes' keys, in sub-contact order (sorted).
+    pub(crate) keys: Vec<SubKey>,
+    /// Their strips, once built.
+    pub(crate) strips: Option<crate::geometry::NodeStrips>,
 }
 
 impl ContactReference {
@@ -221,30 +236,52 @@ impl ContactReference {
         }
     }
 
-    /// Keeps `record` as the contact's side record, in the box it has if any.
+    /// Keeps `record` as the contact's side record, in the box it has if any (a joint's: a node
+    /// contact's side record holds its keys).
     #[inline]
     pub(crate) fn keep(&mut self, record: SideRecord) {
+        debug_assert!(!matches!(self.side.as_deref(), Some(SideRecord::Nodes(_))));
         match self.side.as_deref_mut() {
             Some(side) => *side = record,
             None => self.side = Some(Box::new(record)),
         }
     }
 
-    /// A node contact's strips for its `nodes` nodes: those kept, or `build`'s, kept for the
-    /// steps until its next detection (which drops them).
+    /// The side record of a node contact whose nodes have keys `keys` (in sub-contact order),
+    /// without strips.
+    pub(crate) fn nodes(keys: Vec<SubKey>) -> Option<Box<SideRecord>> {
+        Some(Box::new(SideRecord::Nodes(NodeRecord { keys, strips: None })))
+    }
+
+    /// A node contact's keys, index for index with its sub-contacts (none for a face-face
+    /// joint, whose cells' keys follow from the contact, [`ContactPair::key`]).
     #[inline]
-    pub(crate) fn node_strips(
-        &mut self,
-        nodes: usize,
-        build: impl FnOnce() -> crate::geometry::NodeStrips,
-    ) -> Option<&crate::geometry::NodeStrips> {
-        if !matches!(self.side.as_deref(), Some(SideRecord::Nodes(s)) if s.holds(nodes)) {
-            self.keep(SideRecord::Nodes(build()));
-        }
+    pub(crate) fn node_keys(&self) -> &[SubKey] {
         match self.side.as_deref() {
-            Some(SideRecord::Nodes(s)) => Some(s),
-            _ => None,
+            Some(SideRecord::Nodes(r)) => &r.keys,
+            _ => &[],
         }
+    }
+
+    /// A node contact's keys and, when `build` is given, its nodes' strips: those kept, or
+    /// `build`'s (from the keys), kept for the steps until its next detection (which drops
+    /// them). No strips for a contact without a node record.
+    #[inline]
+    pub(crate) fn node_keys_and_strips(
+        &mut self,
+        build: Option<impl FnOnce(&[SubKey]) -> crate::geometry::NodeStrips>,
+    ) -> (&[SubKey], Option<&crate::geometry::NodeStrips>) {
+        let Some(SideRecord::Nodes(record)) = self.side.as_deref_mut() else {
+            debug_assert!(false, "a node contact without its node record");
+            return (&[], None);
+        };
+        let Some(build) = build else {
+            return (&record.keys, None);
+        };
+        if !record.strips.as_ref().is_some_and(|s| s.holds(record.keys.len())) {
+            record.strips = Some(build(&record.keys));
+        }
+        (&record.keys, record.strips.as_ref())
     }
 }
 
@@ -278,7 +315,8 @@ mod tests {
         assert_eq!(AnchorPlane::through(std::iter::empty()), AnchorPlane::default());
     }
 
-    /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state.
+    /// The size the documentation of [`super::SubContact`] states, with `CoulombSlip`'s state:
+    /// a cell's grid indices (its key) in the padding of the 74 bytes the step reads.
     #[test]
     fn subcontact_is_80_bytes_with_coulomb_state() {
         use crate::law::CoulombState;
@@ -287,11 +325,28 @@ mod tests {
 
     /// The contact record every step streams stays at the size `docs/performance.md` counts:
     /// a hinge's span in the joint record's padding, the rest of its record boxed in the
-    /// reference (8 bytes for a contact that is not a hinge).
+    /// reference (8 bytes for a contact that is neither a hinge nor a node contact).
     #[test]
     fn contact_records_keep_their_sizes() {
         assert_eq!(std::mem::size_of::<super::ContactPair>(), 536);
         assert_eq!(std::mem::size_of::<super::ContactReference>(), 104);
+    }
+
+    /// A cell's key is its joint's faces and its two grid indices, which its sub-contact holds
+    /// in the padding it had: whatever the faces (cut to 16 bits each, as the key does) and
+    /// the indices, the key comes back to the bit, and a key of other faces is told apart.
+    #[test]
+    fn cell_keys_come_back_from_their_indices_and_faces() {
+        use crate::geometry::SubKey;
+        for (fa, fb) in [(0, 0), (3, 5), (0xffff, 0x1_0007), (0x12_3456, 7)] {
+            for (i, j) in [(0, 0), (1, 65_534), (65_534, 2), (400, 999), (65_535, 65_535)] {
+                let key = SubKey::cell(fa, fb, i, j);
+                let [ki, kj] = key.cell_indices();
+                assert_eq!((u32::from(ki), u32::from(kj)), (i, j));
+                assert!(key.is_cell_of(fa, fb));
+                assert!(!key.is_cell_of(fa + 1, fb) && !key.is_cell_of(fa, fb + 1));
+            }
+        }
     }
 }
 
@@ -308,6 +363,38 @@ impl ContactPair {
     /// body frame (m).
     pub fn anchor<S>(&self, sub: &SubContact<S>) -> Vector {
         self.anchors.point(sub.plane)
+    }
+
+    /// The key of this contact's sub-contact `sub`, its `index`-th (`reference`: the
+    /// contact's): a face-face cell's from the joint's faces and the grid indices it holds, a
+    /// node's as its contact keeps it ([`ContactReference::node_keys`]).
+    #[inline]
+    pub(crate) fn key<S>(&self, reference: &ContactReference, index: usize, sub: &SubContact<S>) -> SubKey {
+        match self.kind {
+            ContactKind::FaceFace { face_a, face_b } => {
+                SubKey::cell(face_a, face_b, u32::from(sub.cell[0]), u32::from(sub.cell[1]))
+            }
+            ContactKind::Nodes => reference.node_keys()[index],
+        }
+    }
+
+    /// The index among `own` (this contact's sub-contacts, in key order) of the one with key
+    /// `key`, if any (`reference`: the contact's).
+    #[inline]
+    pub(crate) fn find_key<S>(
+        &self,
+        reference: &ContactReference,
+        own: &[SubContact<S>],
+        key: SubKey,
+    ) -> Option<usize> {
+        match self.kind {
+            // Every cell of the joint has its faces: its grid indices tell it.
+            ContactKind::FaceFace { face_a, face_b } => key
+                .is_cell_of(face_a, face_b)
+                .then(|| own.binary_search_by_key(&key.cell_indices(), |s| s.cell).ok())
+                .flatten(),
+            ContactKind::Nodes => reference.node_keys().binary_search(&key).ok(),
+        }
     }
     /// Fills the body-frame plane the step loop measures gaps to ([`ContactPair::plane_normal`]).
     pub(crate) fn cache_local_faces(&mut self, shape_a: &Polyhedron, shape_b: &Polyhedron) {
@@ -521,12 +608,17 @@ impl AnchorPlane {
 }
 
 /// A sub-contact: a point of a joint with a tributary area, its spring forces, its accumulated
-/// slip and the law's state — what the step reads and writes for every sub-contact, and nothing
-/// else (80 bytes with [`crate::law::CoulombSlip`]'s state). Its position is given by
+/// slip and the law's state — what the step reads and writes for every sub-contact — and a
+/// face-face cell's grid indices, in what would be padding (80 bytes with
+/// [`crate::law::CoulombSlip`]'s state, with or without them). Its position is given by
 /// two coordinates on the contact's [`AnchorPlane`], its shear force by two components along the
-/// joint's tangents ([`JointAxes`]). Its identity, dashpot force and gap offset sit in a parallel
-/// [`SubContactRecord`]; its world position and forces follow from the contact, see
-/// [`ContactView::point`], [`ContactView::shear_force`] and [`ContactView::total_force`].
+/// joint's tangents ([`JointAxes`]). Its identity ([`SubKey`]) follows from its contact and its
+/// grid indices, or for a node sits in its contact's [`NodeRecord`] ([`ContactPair::key`]); its
+/// dashpot force, when the model keeps any, in a parallel list
+/// ([`store::ContactStore::sub_dashpots`]), empty in a model without Rayleigh damping: 24 bytes
+/// per sub-contact that such a model neither stores nor moves. Its world position and forces
+/// follow from the contact, see [`ContactView::point`], [`ContactView::shear_force`] and
+/// [`ContactView::total_force`].
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct SubContact<S> {
     /// Coordinates of the material point on the host block, on the contact's anchor plane (m).
@@ -541,30 +633,22 @@ pub(crate) struct SubContact<S> {
     /// (m, along the anchor plane's axes; `contact/spread.rs`), zero for a node.
     pub(crate) half: [f32; 2],
     pub(crate) status: JointStatus,
+    /// A face-face cell's grid indices `(i, j)` ([`crate::geometry::SubKey::cell_indices`]),
+    /// which with its joint's faces make its key ([`ContactPair::key`]); zero for a node.
+    /// Written by detection (and a checkpoint's load) with the sub-contact, never by the step.
+    pub(crate) cell: [u16; 2],
     pub(crate) state: S,
 }
+
+// A sub-contact with `CoulombSlip`'s state takes the 80 bytes `docs/performance.md` counts:
+// its cell's grid indices sit in what was padding (checked at compile time).
+const _: () = assert!(std::mem::size_of::<SubContact<crate::law::CoulombState>>() == 80);
 
 impl<S> SubContact<S> {
     /// [`SubContact::half`] as a vector.
     #[inline(always)]
     pub(crate) fn half(&self) -> Vector2 {
         Vector2::new(self.half[0] as Real, self.half[1] as Real)
-    }
-}
-
-/// What a sub-contact keeps besides the fields of [`SubContact`]: its identity. Stored in a
-/// parallel array (same index as the sub-contact), so that the step streams only the
-/// [`SubContact`]s. Its dashpot force, when the model has any, sits in a third parallel array
-/// ([`store::ContactStore::sub_dashpots`]), empty in a model without Rayleigh damping: 24 bytes
-/// per sub-contact that such a model neither stores nor moves.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct SubContactRecord {
-    pub(crate) key: SubKey,
-}
-
-impl SubContactRecord {
-    pub(crate) fn new(key: SubKey) -> Self {
-        Self { key }
     }
 }
 

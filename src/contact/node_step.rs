@@ -22,9 +22,9 @@
 use super::kernel::{plane_turn, ContactStep, KernelContext};
 use super::law_update::{stays_separated, update_with_law};
 use super::spread::tension_free;
-use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact, SubContactRecord};
+use super::{ContactPair, ContactReference, ContactWrench, DisplacementMode, SubContact};
 use crate::block::BlockState;
-use crate::geometry::{deepest_two, spacing, NodeId, NodeRule, NodeStrips, Polyhedron, Strip, StripLoad};
+use crate::geometry::{deepest_two, spacing, NodeId, NodeRule, NodeStrips, Polyhedron, Strip, StripLoad, SubKey};
 use crate::law::{ConstitutiveLaw, JointAxes, JointStatus};
 use crate::math::{plane_basis, Matrix, Real, Vector, Vector2};
 
@@ -124,7 +124,6 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
     reference: &mut ContactReference,
     subs: &mut [SubContact<L::State>],
-    records: &[SubContactRecord],
     dashpot_forces: &mut [Vector],
     a: NodeBlock<'_>,
     b: NodeBlock<'_>,
@@ -154,20 +153,22 @@ pub(crate) fn update_nodes<L: ConstitutiveLaw>(
     // The node spacing, which the strips' widths follow (integrated only).
     let h = integrated.map_or(0.0, |_| spacing(a.2, b.2, ctx.node_density));
     // Their strips depend on the shapes alone: built at the contact's first integrated step
-    // since its detection.
-    let strips = integrated.and_then(|_| {
-        reference.node_strips(subs.len(), || {
-            let nodes = records
+    // since its detection. The nodes' keys are the contact's (`NodeRecord`).
+    let areas: &[SubContact<L::State>] = subs;
+    let (keys, strips) = reference.node_keys_and_strips(integrated.map(|_| {
+        |keys: &[SubKey]| {
+            let nodes = keys
                 .iter()
-                .zip(subs.iter())
-                .map(|(r, s)| (NodeId::from_key(r.key), s.area));
+                .zip(areas.iter())
+                .map(|(k, s)| (NodeId::from_key(*k), s.area));
             NodeStrips::build(nodes, (a.2, b.2), h)
-        })
-    });
+        }
+    }));
+    debug_assert_eq!(keys.len(), subs.len(), "a node contact's keys");
     let integrated = integrated.filter(|_| strips.is_some());
     let mut spread_energy = 0.0;
-    for (i, (sub, record)) in subs.iter_mut().zip(records).enumerate() {
-        let id = NodeId::from_key(record.key);
+    for (i, (sub, key)) in subs.iter_mut().zip(keys).enumerate() {
+        let id = NodeId::from_key(*key);
         let frame = node_frame(id, a, b);
         // Integrated (large-displacement mode, a linear normal spring, no tension in the
         // node's state), a node within `h` of the other block (its pieces lie within that of

@@ -1,16 +1,18 @@
 //! The contacts as the step stores them: the pairs, their references and wrenches, the
-//! sub-contacts and their records, struct of arrays (each contact owns a contiguous range of
-//! the sub-contacts, `ContactPair::range`), and the sub-contacts' dashpot forces when the model
-//! has any. One owner, [`ContactStore`], and the views the
+//! sub-contacts (each with its key, or for a node its contact's reference), struct of arrays
+//! (each contact owns a contiguous range of the sub-contacts, `ContactPair::range`), and the
+//! sub-contacts' dashpot forces when the model has any. One owner, [`ContactStore`], and the views the
 //! stages take of it: [`OldContacts`] (detection reading the contacts it replaces),
 //! [`ContactLists`] (detection rearranging them) and [`ContactSlices`] (the contact pass
 //! writing them, split at chunk boundaries).
 
-use super::{ContactPair, ContactReference, ContactWrench, SubContact, SubContactRecord};
+use super::{ContactPair, ContactReference, ContactWrench, SubContact};
 use crate::math::Vector;
 
 /// The contacts of a model (or detection's staging lists): struct of arrays, kept index for
-/// index (`pairs`, `references`, `wrenches`; `subs`, `sub_records`).
+/// index (`pairs`, `references`, `wrenches`; `subs` and, when kept, `sub_dashpots`). A
+/// sub-contact's key is no list of its own: a face-face cell holds its grid indices in what was
+/// its padding, a node contact's reference its nodes' keys ([`super::ContactPair::key`]).
 #[derive(Debug, Clone)]
 pub(crate) struct ContactStore<S> {
     /// The contacts, sorted by block pair.
@@ -24,8 +26,6 @@ pub(crate) struct ContactStore<S> {
     pub wrenches: Vec<ContactWrench>,
     /// The sub-contacts, each contact's in its range.
     pub subs: Vec<SubContact<S>>,
-    /// The sub-contacts' records (keys), index for index with `subs`.
-    pub sub_records: Vec<SubContactRecord>,
     /// The sub-contacts' stiffness-proportional (Rayleigh) dashpot forces on `b` (world) of the
     /// last step, index for index with `subs` while `dashpots_kept` — empty otherwise, while
     /// no sub-contact of the model can hold one (no Rayleigh damping since the model was built
@@ -43,7 +43,6 @@ impl<S> Default for ContactStore<S> {
             references: Vec::new(),
             wrenches: Vec::new(),
             subs: Vec::new(),
-            sub_records: Vec::new(),
             sub_dashpots: Vec::new(),
             dashpots_kept: false,
         }
@@ -57,7 +56,6 @@ impl<S> ContactStore<S> {
             pairs: &self.pairs,
             references: &self.references,
             subs: &self.subs,
-            records: &self.sub_records,
             dashpots: &self.sub_dashpots,
         }
     }
@@ -84,7 +82,6 @@ impl<S> ContactStore<S> {
             references: &mut self.references,
             wrenches: &mut self.wrenches,
             subs: &mut self.subs,
-            records: &mut self.sub_records,
             dashpots: &mut self.sub_dashpots,
             dashpots_kept: self.dashpots_kept,
         }
@@ -100,7 +97,6 @@ impl<S> ContactStore<S> {
             wrenches: &mut self.wrenches,
             sums,
             subs: &mut self.subs[first_sub..],
-            records: &mut self.sub_records[first_sub..],
             dashpots: if self.dashpots_kept {
                 &mut self.sub_dashpots[first_sub..]
             } else {
@@ -112,8 +108,7 @@ impl<S> ContactStore<S> {
     /// Whether the lists that run index for index do (kept so by detection and checkpoint
     /// load; the step asserts it).
     pub(crate) fn in_step(&self) -> bool {
-        self.sub_records.len() == self.subs.len()
-            && self.sub_dashpots.len() == if self.dashpots_kept { self.subs.len() } else { 0 }
+        self.sub_dashpots.len() == if self.dashpots_kept { self.subs.len() } else { 0 }
             && self.wrenches.len() == self.pairs.len()
             && self.references.len() == self.pairs.len()
     }
@@ -124,7 +119,6 @@ pub(crate) struct OldContacts<'a, S> {
     pub(crate) pairs: &'a [ContactPair],
     pub(crate) references: &'a [ContactReference],
     pub(crate) subs: &'a [SubContact<S>],
-    pub(crate) records: &'a [SubContactRecord],
     /// Empty when the model keeps no dashpot forces.
     pub(crate) dashpots: &'a [Vector],
 }
@@ -143,7 +137,6 @@ pub(crate) struct ContactLists<'a, S> {
     pub(crate) references: &'a mut Vec<ContactReference>,
     pub(crate) wrenches: &'a mut Vec<ContactWrench>,
     pub(crate) subs: &'a mut Vec<SubContact<S>>,
-    pub(crate) records: &'a mut Vec<SubContactRecord>,
     /// Index for index with `subs` when `dashpots_kept`, empty otherwise.
     pub(crate) dashpots: &'a mut Vec<Vector>,
     pub(crate) dashpots_kept: bool,
@@ -156,13 +149,12 @@ impl<S> ContactLists<'_, S> {
         self.references.clear();
         self.wrenches.clear();
         self.subs.clear();
-        self.records.clear();
         self.dashpots.clear();
     }
 }
 
 /// What the contact pass writes: the contacts, their wrenches and per-chunk sums `T`, and the
-/// sub-contacts with their records, all starting at the same contact.
+/// sub-contacts, all starting at the same contact.
 pub(crate) struct ContactSlices<'a, S, T> {
     pub pairs: &'a mut [ContactPair],
     /// The contacts' references, index for index with `pairs` (the step writes a hinge's).
@@ -172,7 +164,6 @@ pub(crate) struct ContactSlices<'a, S, T> {
     pub sums: &'a mut [T],
     /// The sub-contacts of `pairs`, from the first contact's first one.
     pub subs: &'a mut [SubContact<S>],
-    pub records: &'a mut [SubContactRecord],
     /// The sub-contacts' dashpot forces, or empty when the model keeps none.
     pub dashpots: &'a mut [Vector],
 }
@@ -188,7 +179,6 @@ impl<S, T> ContactSlices<'_, S, T> {
         let (wrenches, wrenches_right) = self.wrenches.split_at_mut(at);
         let (sums, sums_right) = self.sums.split_at_mut(chunks);
         let (subs, subs_right) = self.subs.split_at_mut(sub_at);
-        let (records, records_right) = self.records.split_at_mut(sub_at);
         let (dashpots, dashpots_right) = if self.dashpots.is_empty() {
             (self.dashpots, &mut [][..])
         } else {
@@ -201,7 +191,6 @@ impl<S, T> ContactSlices<'_, S, T> {
                 wrenches,
                 sums,
                 subs,
-                records,
                 dashpots,
             },
             Self {
@@ -210,7 +199,6 @@ impl<S, T> ContactSlices<'_, S, T> {
                 wrenches: wrenches_right,
                 sums: sums_right,
                 subs: subs_right,
-                records: records_right,
                 dashpots: dashpots_right,
             },
         )

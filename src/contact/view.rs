@@ -1,6 +1,6 @@
 //! The read API of contacts: borrowed views over the model's contact storage.
 //!
-//! The storage itself (the contact list, the sub-contacts and their records, laid out for the
+//! The storage itself (the contact list, the sub-contacts and their keys, laid out for the
 //! step loop) is private to the crate, so that its layout can change without changing the API
 //! or the checkpoint format. Users read a joint through [`ContactView`] and its sub-contacts
 //! through [`SubContactView`]; code that does not need the law's own state reads either through
@@ -8,7 +8,7 @@
 
 use super::lanes::face_gap;
 use super::spread::cell_response;
-use super::{stored_node_frame, AnchorPlane, ContactPair, ContactWrench, SubContact, SubContactRecord};
+use super::{stored_node_frame, AnchorPlane, ContactPair, ContactReference, ContactWrench, SubContact};
 use crate::block::BlockState;
 use crate::geometry::{ContactKind, NodeId, Polyhedron, SubKey};
 use crate::ids::BlockId;
@@ -26,9 +26,9 @@ pub(crate) struct NodeGeometry<'a> {
 
 impl NodeGeometry<'_> {
     /// The world point of a node sub-contact and the axes its forces are composed in.
-    fn frame<S>(&self, sub: &SubContact<S>, record: &SubContactRecord) -> (Vector, JointAxes) {
+    fn frame<S>(&self, sub: &SubContact<S>, key: SubKey) -> (Vector, JointAxes) {
         stored_node_frame(
-            NodeId::from_key(record.key),
+            NodeId::from_key(key),
             sub.plane.x as usize,
             (self.states[0], &self.rotations[0], self.shapes[0]),
             (self.states[1], &self.rotations[1], self.shapes[1]),
@@ -145,7 +145,8 @@ pub struct SubContactSample {
 pub struct ContactView<'a, S> {
     pair: &'a ContactPair,
     subs: &'a [SubContact<S>],
-    records: &'a [SubContactRecord],
+    /// The contact's reference: a node contact's keys.
+    reference: &'a ContactReference,
     /// The sub-contacts' dashpot forces, or empty when the model keeps none.
     dashpots: &'a [Vector],
     /// Maps anchors to world points: the host block's pose (its pose at detection in
@@ -160,17 +161,17 @@ impl<'a, S> ContactView<'a, S> {
     pub(crate) fn new(
         pair: &'a ContactPair,
         subs: &'a [SubContact<S>],
-        (records, dashpots): (&'a [SubContactRecord], &'a [Vector]),
+        (reference, dashpots): (&'a ContactReference, &'a [Vector]),
         frame: Pose,
         wrench: ContactWrench,
         (nodes, cells): (Option<NodeGeometry<'a>>, Option<CellGeometry<'a, S>>),
     ) -> Self {
-        debug_assert_eq!(subs.len(), records.len());
+        debug_assert!(nodes.is_none() || reference.node_keys().len() == subs.len());
         debug_assert!(dashpots.is_empty() || dashpots.len() == subs.len());
         Self {
             pair,
             subs,
-            records,
+            reference,
             dashpots,
             frame,
             wrench,
@@ -228,20 +229,17 @@ impl<'a, S> ContactView<'a, S> {
     /// The sub-contacts, in order.
     pub fn subcontacts(&self) -> impl ExactSizeIterator<Item = SubContactView<'a, S>> + 'a {
         let (pair, frame, nodes, cells, dashpots) = (self.pair, self.frame, self.nodes, self.cells, self.dashpots);
-        self.subs
-            .iter()
-            .zip(self.records)
-            .enumerate()
-            .map(move |(i, (sub, record))| SubContactView {
-                pair,
-                frame,
-                sub,
-                live: pair.joint.live(i, sub),
-                record,
-                dashpot: dashpots.get(i).copied().unwrap_or(Vector::ZERO),
-                nodes,
-                cells,
-            })
+        let reference = self.reference;
+        self.subs.iter().enumerate().map(move |(i, sub)| SubContactView {
+            pair,
+            frame,
+            sub,
+            live: pair.joint.live(i, sub),
+            key: pair.key(reference, i, sub),
+            dashpot: dashpots.get(i).copied().unwrap_or(Vector::ZERO),
+            nodes,
+            cells,
+        })
     }
     /// The sub-contact at `index`, if any.
     pub fn subcontact(&self, index: usize) -> Option<SubContactView<'a, S>> {
@@ -251,7 +249,7 @@ impl<'a, S> ContactView<'a, S> {
             frame: self.frame,
             sub,
             live: self.pair.joint.live(index, sub),
-            record: &self.records[index],
+            key: self.pair.key(self.reference, index, sub),
             dashpot: self.dashpots.get(index).copied().unwrap_or(Vector::ZERO),
             nodes: self.nodes,
             cells: self.cells,
@@ -318,7 +316,8 @@ pub struct SubContactView<'a, S> {
     /// The sub-contact's force, gap and status as they stand: its own, or those of its joint
     /// while the joint is stepped as a whole (`joint_level/`).
     live: (JointForce, Real, JointStatus),
-    record: &'a SubContactRecord,
+    /// Its key ([`ContactPair::key`]).
+    key: SubKey,
     /// Its dashpot force (zero when the model keeps none).
     dashpot: Vector,
     nodes: Option<NodeGeometry<'a>>,
@@ -328,7 +327,7 @@ pub struct SubContactView<'a, S> {
 impl<'a, S> SubContactView<'a, S> {
     /// Stable identity within the block pair (carries history across re-detection).
     pub fn key(&self) -> SubKey {
-        self.record.key
+        self.key
     }
     /// Coordinates of the anchor on the contact's [`AnchorPlane`] (m). For a node of a
     /// [`ContactKind::Nodes`] contact: the index of the other block's face it was last pressed
@@ -341,7 +340,7 @@ impl<'a, S> SubContactView<'a, S> {
     pub fn anchor(&self) -> Vector {
         match &self.nodes {
             Some(g) => {
-                let id = NodeId::from_key(self.record.key);
+                let id = NodeId::from_key(self.key);
                 id.point(g.shapes[id.on_b as usize])
             }
             None => self.pair.anchors.point(self.sub.plane),
@@ -350,20 +349,20 @@ impl<'a, S> SubContactView<'a, S> {
     /// For a node of a [`ContactKind::Nodes`] contact, whether it is a point of block `b`
     /// (else of `a`); `None` for a sub-contact of a face–face joint.
     pub fn node_on_b(&self) -> Option<bool> {
-        self.nodes.map(|_| NodeId::from_key(self.record.key).on_b)
+        self.nodes.map(|_| NodeId::from_key(self.key).on_b)
     }
     /// The joint axes this sub-contact's forces are composed in: the contact's, or for a node
     /// those of the face it is pressed out of.
     pub fn axes(&self) -> JointAxes {
         match &self.nodes {
-            Some(g) => g.frame(self.sub, self.record).1,
+            Some(g) => g.frame(self.sub, self.key).1,
             None => self.pair.axes(),
         }
     }
     /// World position (m).
     pub fn point(&self) -> Vector {
         match &self.nodes {
-            Some(g) => g.frame(self.sub, self.record).0,
+            Some(g) => g.frame(self.sub, self.key).0,
             None => self.frame.transform_point(self.anchor()),
         }
     }

@@ -125,7 +125,7 @@ impl<L: ConstitutiveLaw> Model<L> {
             p,
             &self.state.contacts.subs[p.range()],
             (
-                &self.state.contacts.sub_records[p.range()],
+                &self.state.contacts.references[k],
                 if self.state.contacts.dashpots_kept {
                     &self.state.contacts.sub_dashpots[p.range()]
                 } else {

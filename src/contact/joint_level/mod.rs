@@ -371,6 +371,7 @@ mod tests {
             slip: 0.0,
             half: [0.05, 0.05],
             status: JointStatus::Elastic,
+            cell: [0; 2],
             state: CoulombState::default(),
         }
     }

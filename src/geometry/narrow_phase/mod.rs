@@ -297,8 +297,25 @@ impl ContactParameters {
 pub struct SubKey(pub u64);
 
 impl SubKey {
-    fn cell(face_host: u32, face_other: u32, i: u32, j: u32) -> Self {
-        Self(((face_host as u64) << 48) | ((face_other as u64 & 0xffff) << 32) | ((i as u64) << 16) | j as u64)
+    /// The key of cell `(i, j)` of the grid on the host face of a face-face joint between face
+    /// `face_a` of block `a` and face `face_b` of block `b` (whichever is the host): the faces
+    /// in the upper 32 bits (each cut to 16), the grid indices (16 bits each, below
+    /// `MAX_NODES_PER_EDGE`) in the lower.
+    pub(crate) fn cell(face_a: u32, face_b: u32, i: u32, j: u32) -> Self {
+        Self(((face_a as u64) << 48) | ((face_b as u64 & 0xffff) << 32) | ((i as u64) << 16) | j as u64)
+    }
+
+    /// The grid indices `(i, j)` of a cell's key ([`SubKey::cell`]): with the joint's faces,
+    /// which its contact holds, they make the key again.
+    pub(crate) fn cell_indices(self) -> [u16; 2] {
+        [(self.0 >> 16) as u16, self.0 as u16]
+    }
+
+    /// Whether this is the key of a cell of a joint between faces `face_a` and `face_b`
+    /// ([`SubKey::cell`]).
+    pub(crate) fn is_cell_of(self, face_a: u32, face_b: u32) -> bool {
+        let [i, j] = self.cell_indices();
+        Self::cell(face_a, face_b, u32::from(i), u32::from(j)) == self
     }
 }
 

@@ -156,7 +156,7 @@ impl FaceShares for SharesOf<'_> {
 /// The strips of every node of a node contact, in the order of its sub-contacts, in the body
 /// frame of each node's block. They depend on the blocks' shapes and the node spacing alone, so
 /// a contact builds them at its first integrated step after its detection
-/// ([`crate::contact::ContactReference::node_strips`]) and steps with them until the next.
+/// ([`crate::contact::ContactReference::node_keys_and_strips`]) and steps with them until the next.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub(crate) struct NodeStrips {
     /// Node `k`'s strips are `strips[starts[k]..starts[k + 1]]`; empty until built.

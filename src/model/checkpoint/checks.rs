@@ -6,8 +6,9 @@
 use super::tested::tested_pairs;
 use super::{Snapshot, MAX_COUNT};
 use crate::block::Block;
-use crate::contact::{ContactStore, SubContact, SubContactRecord};
+use crate::contact::{ContactStore, SubContact};
 use crate::error::{Error, Result};
+use crate::geometry::SubKey;
 use crate::ids::BlockId;
 use crate::integrate::{CriticalStep, TimeStep};
 use crate::law::ConstitutiveLaw;
@@ -66,9 +67,9 @@ pub(super) fn check_contacts<L: ConstitutiveLaw>(
 ) -> Result<()> {
     let ContactStore {
         pairs,
+        references,
         wrenches,
         subs,
-        sub_records,
         ..
     } = storage;
     let n = snap.blocks.len();
@@ -99,11 +100,12 @@ pub(super) fn check_contacts<L: ConstitutiveLaw>(
             crate::geometry::ContactKind::Nodes => {
                 (p.a as usize) < n
                     && (p.b as usize) < n
-                    && (p.first as usize + p.count as usize) <= subs.len().min(sub_records.len())
+                    && (p.first as usize + p.count as usize) <= subs.len()
+                    && references[k].node_keys().len() == p.count as usize
                     && nodes_fit(
                         (snap.blocks[p.a as usize].shape(), snap.blocks[p.b as usize].shape()),
                         &subs[p.range()],
-                        &sub_records[p.range()],
+                        references[k].node_keys(),
                     )
             }
         };
@@ -268,15 +270,15 @@ pub(super) fn check_time_step(
 }
 
 /// Whether the sub-contacts of a node contact between blocks of shapes `shapes` name nodes of
-/// those shapes (their keys) and faces of the other block (the face each was last pressed out
+/// those shapes (their `keys`) and faces of the other block (the face each was last pressed out
 /// of, `plane.x`).
 pub(super) fn nodes_fit<S>(
     shapes: (&crate::geometry::Polyhedron, &crate::geometry::Polyhedron),
     subs: &[SubContact<S>],
-    records: &[SubContactRecord],
+    keys: &[SubKey],
 ) -> bool {
-    subs.iter().zip(records).all(|(s, r)| {
-        let id = crate::geometry::NodeId::from_key(r.key);
+    subs.iter().zip(keys).all(|(s, key)| {
+        let id = crate::geometry::NodeId::from_key(*key);
         let (host, other) = if id.on_b { (shapes.1, shapes.0) } else { shapes };
         let face = s.plane.x;
         id.fits(host) && face >= 0.0 && face.fract() == 0.0 && (face as usize) < other.faces().len() && s.plane.y == 0.0

@@ -14,10 +14,9 @@ use super::{
     VERSION,
 };
 use crate::block::Block;
-use crate::contact::{
-    ContactPair, ContactReference, ContactStore, ForceMoments, SideRecord, SpanEnds, SubContact, SubContactRecord,
-};
+use crate::contact::{ContactPair, ContactReference, ContactStore, ForceMoments, SideRecord, SpanEnds, SubContact};
 use crate::error::{Error, Result};
+use crate::geometry::ContactKind;
 use crate::ids::BlockId;
 use crate::integrate::CentralDifference;
 use crate::law::{ConstitutiveLaw, JointForce};
@@ -27,7 +26,9 @@ use crate::model::{Model, ModelParameters};
 
 /// The step's storage rebuilt from checkpointed joints. A joint stepped as a whole gets its
 /// cells' held shear forces back; its stored forces must be those its record gives them, to the
-/// bit (else the error names it).
+/// bit (else the error names it). A face-face cell keeps the grid indices of its key, whose
+/// faces must be its joint's (as detection writes them; else the error names it), a node
+/// contact its nodes' keys.
 /// A joint record holding what its file's `version` did not have (a span or a hinge record
 /// before version 15, open cells at one end before 16) is refused: no build of that version
 /// wrote it.
@@ -38,7 +39,7 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
         Vec::with_capacity(entries.len()),
         Vec::with_capacity(entries.len()),
     );
-    let (mut subs, mut records) = (Vec::with_capacity(total), Vec::with_capacity(total));
+    let mut subs = Vec::with_capacity(total);
     // Kept only when some sub-contact holds a dashpot force (a model without Rayleigh damping
     // keeps none; one with it fills them at its next step).
     let kept = entries
@@ -89,7 +90,21 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
                 ))
             }
         };
+        let mut node_keys = Vec::new();
         for (j, s) in e.subcontacts.into_iter().enumerate() {
+            let cell = match e.kind {
+                ContactKind::FaceFace { face_a, face_b } if s.key.is_cell_of(face_a, face_b) => s.key.cell_indices(),
+                ContactKind::FaceFace { .. } => {
+                    return Err(corrupt(
+                        &format!("contacts[{k}].subcontacts[{j}].key"),
+                        "is not the key of a cell of its joint's faces",
+                    ))
+                }
+                ContactKind::Nodes => {
+                    node_keys.push(s.key);
+                    [0; 2]
+                }
+            };
             let mut sub = SubContact {
                 plane: s.plane,
                 area: s.area,
@@ -98,6 +113,7 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
                 slip: s.slip,
                 half: s.half,
                 status: s.status,
+                cell,
                 state: s.state,
             };
             if let Some(entry) = &e.joint {
@@ -127,7 +143,6 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
                 }
             }
             subs.push(sub);
-            records.push(SubContactRecord { key: s.key });
             if kept {
                 dashpots.push(s.dashpot);
             }
@@ -162,7 +177,10 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
             ref_host_rotation: e.reference_host_rotation,
             area: e.area,
             bound_area: e.bound_area,
-            side: hinge,
+            side: match e.kind {
+                ContactKind::FaceFace { .. } => hinge,
+                ContactKind::Nodes => ContactReference::nodes(node_keys),
+            },
         });
         wrenches.push(e.wrench);
     }
@@ -171,7 +189,6 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
         references,
         wrenches,
         subs,
-        sub_records: records,
         sub_dashpots: dashpots,
         dashpots_kept: kept,
     })

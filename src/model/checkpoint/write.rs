@@ -38,12 +38,11 @@ impl<L: ConstitutiveLaw> Model<L> {
             wrench: self.state.contacts.wrenches[k],
             subcontacts: self.state.contacts.subs[range.clone()]
                 .iter()
-                .zip(&self.state.contacts.sub_records[range.clone()])
                 .zip(range.clone())
-                .map(|((s, rec), i)| {
+                .map(|(s, i)| {
                     let (force, gap, status) = p.joint.live(i - range.start, s);
                     SubContactEntry {
-                        key: rec.key,
+                        key: p.key(r, i - range.start, s),
                         plane: s.plane,
                         area: s.area,
                         gap,

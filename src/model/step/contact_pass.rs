@@ -108,7 +108,6 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             wrenches,
             sums,
             subs,
-            records,
             dashpots,
         } = chunk;
         let sums = &mut sums[0];
@@ -128,8 +127,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 update_nodes(
                     p,
                     reference,
-                    &mut subs[range.clone()],
-                    &records[range],
+                    &mut subs[range],
                     dashpots,
                     (&a.state, &ma.rotation, a.shape()),
                     (&b.state, &mb.rotation, b.shape()),
@@ -217,8 +215,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         if ctx.stiffness_damping > 0.0 {
             self.contacts.keep_dashpots();
         }
-        // The records run index for index with the sub-contacts (kept so by detection and
-        // checkpoint load).
+        // The lists run index for index with the contacts and the sub-contacts (kept so by
+        // detection and checkpoint load).
         assert!(self.contacts.in_step(), "contact lists out of step");
         assert_eq!(pipeline.motions.len(), self.blocks.len(), "block motions out of step");
         // One pass per contact: its plane, its sub-contacts (in order), its resultant; summed

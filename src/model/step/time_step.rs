@@ -239,10 +239,10 @@ impl<L: ConstitutiveLaw> BoundSources<'_, L> {
             // stiffer spring in every direction.
             let (ba, bb) = (&s.blocks[p.a as usize], &s.blocks[p.b as usize]);
             let (ra, rb) = (Matrix::from_quat(sa.pose.rotation), Matrix::from_quat(sb.pose.rotation));
-            let records = &s.contacts.sub_records[p.range()];
+            let keys = reference.node_keys();
             let point = |k: usize| {
                 stored_node_frame(
-                    NodeId::from_key(records[k].key),
+                    NodeId::from_key(keys[k]),
                     subs[k].plane.x as usize,
                     (sa, &ra, ba.shape()),
                     (sb, &rb, bb.shape()),

@@ -1,6 +1,7 @@
 use super::*;
 use crate::block::BlockState;
-use crate::contact::{ContactPair, SubContact, SubContactRecord};
+use crate::contact::{ContactPair, ContactStore, SubContact};
+use crate::geometry::SubKey;
 use crate::law::CoulombSlip;
 use crate::math::Vector;
 use crate::model::{Energies, Model};
@@ -15,7 +16,6 @@ fn check_layout<L: ConstitutiveLaw>(state: &ModelState<L>, room_limit: usize) {
         end = p.first + p.count;
     }
     assert!(end as usize <= state.contacts.subs.len(), "sub-contacts past the lists");
-    assert_eq!(state.contacts.subs.len(), state.contacts.sub_records.len());
     assert!(
         state.contacts.subs.len() <= room_limit,
         "{} sub-contacts' room past {room_limit}",
@@ -71,8 +71,15 @@ fn conveyor() -> Model<CoulombSlip> {
     model
 }
 
-/// Every contact with its sub-contacts and their records (its `first` left out).
-type Contacts<S> = Vec<(ContactPair, Vec<SubContact<S>>, Vec<SubContactRecord>)>;
+/// Every contact with its sub-contacts and their keys (its `first` left out).
+type Contacts<S> = Vec<(ContactPair, Vec<SubContact<S>>, Vec<SubKey>)>;
+
+/// The keys of contact `k`'s sub-contacts.
+fn keys<S>(contacts: &ContactStore<S>, k: usize) -> Vec<SubKey> {
+    let (p, reference) = (&contacts.pairs[k], &contacts.references[k]);
+    let subs = &contacts.subs[p.range()];
+    subs.iter().enumerate().map(|(i, s)| p.key(reference, i, s)).collect()
+}
 
 /// `model` run for `steps` steps with the splices `mode` allows: the blocks' states, the
 /// energies, the splice counts and the contacts at the end.
@@ -92,13 +99,10 @@ fn run<L: ConstitutiveLaw>(
         .contacts
         .pairs
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(k, p)| {
             let pair = ContactPair { first: 0, ..p.clone() };
-            (
-                pair,
-                s.contacts.subs[p.range()].to_vec(),
-                s.contacts.sub_records[p.range()].to_vec(),
-            )
+            (pair, s.contacts.subs[p.range()].to_vec(), keys(&s.contacts, k))
         })
         .collect();
     (states, model.energies(), model.pipeline.detection.splices, contacts)
@@ -150,8 +154,8 @@ fn in_place_full_and_fresh_splices_give_the_same_bits() {
     assert!(wall.in_place > 100, "the shaking wall's splices are in place: {wall:?}");
 }
 
-/// Spreading packed lists into segments moves every contact's sub-contacts and records with
-/// it, and leaves the slack between segments.
+/// Spreading packed lists into segments moves every contact's sub-contacts (and with them
+/// their keys) with it, and leaves the slack between segments.
 #[test]
 fn spreading_segments_keeps_every_contacts_subcontacts() {
     let mut model = shaking_wall(300, BENCHMARK_SPACING).expect("wall");
@@ -163,27 +167,22 @@ fn spreading_segments_keeps_every_contacts_subcontacts() {
         .contacts
         .pairs
         .iter()
-        .map(|p| {
-            (
-                state.contacts.subs[p.range()].to_vec(),
-                state.contacts.sub_records[p.range()].to_vec(),
-            )
-        })
+        .enumerate()
+        .map(|(k, p)| (state.contacts.subs[p.range()].to_vec(), keys(&state.contacts, k)))
         .collect();
     // Packed again, as a full detection stages them.
-    let (mut subs, mut records) = (Vec::new(), Vec::new());
-    for (p, (s, r)) in state.contacts.pairs.iter_mut().zip(&each) {
+    let mut subs = Vec::new();
+    for (p, (s, _)) in state.contacts.pairs.iter_mut().zip(&each) {
         p.first = subs.len() as u32;
         subs.extend_from_slice(s);
-        records.extend_from_slice(r);
     }
     let live = subs.len();
-    (state.contacts.subs, state.contacts.sub_records) = (subs, records);
+    state.contacts.subs = subs;
     state.spread_segments();
     check_layout(state, room_limit(live));
     for (k, (p, (s, r))) in state.contacts.pairs.iter().zip(&each).enumerate() {
         assert!(state.contacts.subs[p.range()] == s[..], "contact {k}'s sub-contacts");
-        assert!(state.contacts.sub_records[p.range()] == r[..], "contact {k}'s records");
+        assert!(keys(&state.contacts, k) == r[..], "contact {k}'s keys");
     }
     let gaps = contacts.div_ceil(SEGMENT) - 1;
     assert!(

@@ -467,7 +467,6 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 .last()
                 .map_or(0, |p| (p.first + p.count) as usize);
             sc.staging.store.subs.truncate(end);
-            sc.staging.store.sub_records.truncate(end);
             sc.staging.store.sub_dashpots.truncate(end);
         }
         let index = BlockIndex {

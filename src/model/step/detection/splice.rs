@@ -5,8 +5,8 @@
 use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
-    stored_node_frame, ContactLists, ContactPair, ContactStore, ContactWrench, DisplacementMode, OldContacts,
-    SubContactRecord,
+    stored_node_frame, ContactLists, ContactPair, ContactReference, ContactStore, ContactWrench, DisplacementMode,
+    OldContacts, SubContact,
 };
 use crate::error::Result;
 use crate::geometry::{ContactKind, NodeId};
@@ -143,33 +143,29 @@ pub(super) fn move_into_dead_room<T>(list: &mut [T], range: std::ops::Range<usiz
 }
 
 impl<S: Clone + Default> ContactStore<S> {
-    /// Makes the sub-contact lists (with their records and dashpot forces, when kept) `len`
+    /// Makes the sub-contact lists (the sub-contacts and their dashpot forces, when kept) `len`
     /// long: dead room added at the end (never read), or the end cut off.
     pub(super) fn resize_subcontacts(&mut self, len: usize) {
-        let (sub, record) = dead_subcontact();
-        self.subs.resize(len, sub);
-        self.sub_records.resize(len, record);
+        self.subs.resize(len, dead_subcontact());
         if self.dashpots_kept {
             self.sub_dashpots.resize(len, Vector::ZERO);
         }
     }
 
-    /// Moves sub-contacts `range` (with their records and dashpot forces) by `shift` places
-    /// into dead room ([`move_into_dead_room`]).
+    /// Moves sub-contacts `range` (with their dashpot forces) by `shift` places into dead room
+    /// ([`move_into_dead_room`]).
     pub(super) fn move_subcontacts(&mut self, range: std::ops::Range<usize>, shift: i64) {
         move_into_dead_room(&mut self.subs, range.clone(), shift);
-        move_into_dead_room(&mut self.sub_records, range.clone(), shift);
         if self.dashpots_kept {
             move_into_dead_room(&mut self.sub_dashpots, range, shift);
         }
     }
 
-    /// Writes `from`'s sub-contacts `range` (with their records and dashpot forces) from
-    /// sub-contact `to` on.
+    /// Writes `from`'s sub-contacts `range` (with their dashpot forces) from sub-contact `to`
+    /// on.
     pub(super) fn copy_subcontacts(&mut self, to: usize, from: &Self, range: std::ops::Range<usize>) {
         let end = to + range.len();
         self.subs[to..end].clone_from_slice(&from.subs[range.clone()]);
-        self.sub_records[to..end].clone_from_slice(&from.sub_records[range.clone()]);
         if self.dashpots_kept {
             self.sub_dashpots[to..end].copy_from_slice(&from.sub_dashpots[range]);
         }
@@ -203,7 +199,6 @@ impl<S> ContactLists<'_, S> {
     pub(super) fn move_subcontacts(&mut self, range: std::ops::Range<usize>, shift: i64, direction: Direction) {
         if (direction == Direction::Front && shift < 0) || (direction == Direction::Back && shift > 0) {
             move_into_dead_room(self.subs, range.clone(), shift);
-            move_into_dead_room(self.records, range.clone(), shift);
             if self.dashpots_kept {
                 move_into_dead_room(self.dashpots, range, shift);
             }
@@ -275,7 +270,7 @@ pub(super) struct Run {
 /// not dissipation and shows in [`crate::Energies::balance_error`].
 pub(super) fn dropped_work<S: PartialEq + Default>(
     old: &OldContacts<'_, S>,
-    new: (&[ContactPair], &[SubContactRecord]),
+    new: (&[ContactPair], &[ContactReference], &[SubContact<S>]),
     kept: &[bool],
     blocks: &[RigidBlock],
     (mode, integrated_laws): (DisplacementMode, &[bool]),
@@ -291,19 +286,19 @@ pub(super) fn dropped_work<S: PartialEq + Default>(
             .0
             .binary_search_by_key(&(p.a, p.b), |q| (q.a, q.b))
             .ok()
-            .map(|s| (&new.0[s], new.1));
+            .map(|s| (&new.0[s], &new.1[s], new.2));
         add_dropped_work(old, k, successor, blocks, (mode, integrated_laws), dt, &mut owed);
     }
     owed
 }
 
 /// Adds to `owed` the work ([`dropped_work`]) of the sub-contacts of old contact `k` that its
-/// `successor` (the new contact of the same pair, with the new sub-contact records it indexes)
-/// does not carry on.
+/// `successor` (the new contact of the same pair, its reference and the new sub-contacts it
+/// indexes) does not carry on.
 pub(super) fn add_dropped_work<S: PartialEq + Default>(
     old: &OldContacts<'_, S>,
     k: usize,
-    successor: Option<(&ContactPair, &[SubContactRecord])>,
+    successor: Option<(&ContactPair, &ContactReference, &[SubContact<S>])>,
     blocks: &[RigidBlock],
     (mode, integrated_laws): (DisplacementMode, &[bool]),
     dt: Real,
@@ -312,12 +307,12 @@ pub(super) fn add_dropped_work<S: PartialEq + Default>(
     let (p, reference) = (&old.pairs[k], &old.references[k]);
     debug_assert!(!p.joint.active, "a joint stepped as a whole dropped unwritten");
     let carried = successor
-        .filter(|(q, _)| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
-        .map(|(q, records)| &records[q.range()]);
+        .filter(|(q, ..)| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
+        .map(|(q, reference, subs)| (q, reference, &subs[q.range()]));
     // A node contact turning into a joint hands its spring forces to the joint's cells, whose
     // springs book their second half (`staging.rs`); its dashpot forces are dropped.
     let integrated = super::law_integrated(integrated_laws, p.law);
-    let handed = successor.is_some_and(|(q, _)| p.hands_forces_to_cells(&old.subs[p.range()], integrated, &q.kind));
+    let handed = successor.is_some_and(|(q, ..)| p.hands_forces_to_cells(&old.subs[p.range()], integrated, &q.kind));
     let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
     let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
     let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
@@ -328,11 +323,11 @@ pub(super) fn add_dropped_work<S: PartialEq + Default>(
     } else {
         (Matrix::IDENTITY, Matrix::IDENTITY)
     };
-    for ((s, r), i) in old.subs[p.range()].iter().zip(&old.records[p.range()]).zip(p.range()) {
+    for (n, (s, i)) in old.subs[p.range()].iter().zip(p.range()).enumerate() {
         let dashpot = old.dashpot(i);
         let (pt, axes) = if nodes {
             stored_node_frame(
-                NodeId::from_key(r.key),
+                NodeId::from_key(p.key(reference, n, s)),
                 s.plane.x as usize,
                 (sa, &rotations.0, ba.shape()),
                 (sb, &rotations.1, bb.shape()),
@@ -344,7 +339,7 @@ pub(super) fn add_dropped_work<S: PartialEq + Default>(
         if spring == Vector::ZERO && dashpot == Vector::ZERO {
             continue;
         }
-        if carried.is_some_and(|records| records.binary_search_by_key(&r.key, |t| t.key).is_ok()) {
+        if carried.is_some_and(|(q, kept, own)| q.find_key(kept, own, p.key(reference, n, s)).is_some()) {
             continue;
         }
         let v_rel =
@@ -467,7 +462,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         for r in &sc.replaced {
             let successor = (
                 &sc.staging.store.pairs[r.staged as usize],
-                sc.staging.store.sub_records.as_slice(),
+                &sc.staging.store.references[r.staged as usize],
+                sc.staging.store.subs.as_slice(),
             );
             add_dropped_work(
                 &old,
@@ -561,7 +557,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         }
         let owed = dropped_work(
             &old,
-            (&sc.staging.store.pairs, &sc.staging.store.sub_records),
+            (
+                &sc.staging.store.pairs,
+                &sc.staging.store.references,
+                &sc.staging.store.subs,
+            ),
             &sc.kept,
             &self.blocks,
             (self.params.mode, &sc.integrated_laws),
@@ -586,7 +586,6 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             std::mem::swap(&mut self.contacts.references, &mut sc.staging.store.references);
             std::mem::swap(&mut self.contacts.wrenches, &mut sc.staging.store.wrenches);
             std::mem::swap(&mut self.contacts.subs, &mut sc.staging.store.subs);
-            std::mem::swap(&mut self.contacts.sub_records, &mut sc.staging.store.sub_records);
             std::mem::swap(&mut self.contacts.sub_dashpots, &mut sc.staging.store.sub_dashpots);
             sc.release_staging();
             sc.room_limit = room_limit(self.contacts.pairs.iter().map(|p| p.count as usize).sum());
@@ -674,7 +673,6 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     let q = &sc.staging.store.pairs[s as usize];
                     let (from, to) = (q.range(), first as usize..(first + q.count) as usize);
                     lists.subs[to.clone()].clone_from_slice(&sc.staging.store.subs[from.clone()]);
-                    lists.records[to.clone()].clone_from_slice(&sc.staging.store.sub_records[from.clone()]);
                     if lists.dashpots_kept {
                         lists.dashpots[to].copy_from_slice(&sc.staging.store.sub_dashpots[from]);
                     }

@@ -7,7 +7,7 @@ use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
     node_frame, stored_node_frame, AnchorPlane, ContactLists, ContactPair, ContactReference, ContactStore,
-    ContactWrench, ForceMoments, OldContacts, SubContact, SubContactRecord,
+    ContactWrench, ForceMoments, OldContacts, SubContact,
 };
 use crate::error::Result;
 use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubContactSeed, SubKey, PARALLEL_ANGLE};
@@ -15,9 +15,9 @@ use crate::law::{ConstitutiveLaw, JointAxes, JointForce, JointStatus};
 use crate::math::{Matrix, Real, Vector, Vector2};
 use crate::model::ModelState;
 
-/// A sub-contact and a record to fill dead room with (never read).
-pub(super) fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord) {
-    let sub = SubContact {
+/// A sub-contact to fill dead room with (never read).
+pub(super) fn dead_subcontact<S: Default>() -> SubContact<S> {
+    SubContact {
         plane: Vector2::ZERO,
         area: 0.0,
         gap: 0.0,
@@ -25,9 +25,9 @@ pub(super) fn dead_subcontact<S: Default>() -> (SubContact<S>, SubContactRecord)
         slip: 0.0,
         half: [0.0; 2],
         status: JointStatus::Open,
+        cell: [0; 2],
         state: S::default(),
-    };
-    (sub, SubContactRecord::new(SubKey(0)))
+    }
 }
 
 /// A contact and its reference to fill room in the staging lists with until a contact is
@@ -97,7 +97,7 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
         let (pair_base, sub_base) = (self.store.pairs.len(), self.store.subs.len());
         let (contacts, subs) = self.placed;
         let (pair, reference) = dead_contact();
-        let (sub, record) = dead_subcontact();
+        let sub = dead_subcontact();
         self.store
             .pairs
             .par_extend(rayon::iter::repeat_n(pair, contacts - pair_base));
@@ -108,9 +108,6 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
             .wrenches
             .par_extend(rayon::iter::repeat_n(ContactWrench::default(), contacts - pair_base));
         self.store.subs.par_extend(rayon::iter::repeat_n(sub, subs - sub_base));
-        self.store
-            .sub_records
-            .par_extend(rayon::iter::repeat_n(record, subs - sub_base));
         if self.store.dashpots_kept {
             self.store
                 .sub_dashpots
@@ -123,7 +120,6 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
             references: &mut self.store.references[pair_base..],
             wrenches: &mut self.store.wrenches[pair_base..],
             subs: &mut self.store.subs[sub_base..],
-            records: &mut self.store.sub_records[sub_base..],
             dashpots: if self.store.dashpots_kept {
                 &mut self.store.sub_dashpots[sub_base..]
             } else {
@@ -142,7 +138,6 @@ pub(super) struct StagingSlices<'a, S> {
     pub(super) references: &'a mut [ContactReference],
     pub(super) wrenches: &'a mut [ContactWrench],
     pub(super) subs: &'a mut [SubContact<S>],
-    pub(super) records: &'a mut [SubContactRecord],
     /// The sub-contacts' dashpot forces, or empty when the model keeps none.
     pub(super) dashpots: &'a mut [Vector],
 }
@@ -156,7 +151,6 @@ impl<'a, S> StagingSlices<'a, S> {
         let (references_a, references_b) = self.references.split_at_mut(p);
         let (wrenches_a, wrenches_b) = self.wrenches.split_at_mut(p);
         let (subs_a, subs_b) = self.subs.split_at_mut(s);
-        let (records_a, records_b) = self.records.split_at_mut(s);
         let (dashpots_a, dashpots_b) = if self.dashpots.is_empty() {
             (self.dashpots, &mut [][..])
         } else {
@@ -170,7 +164,6 @@ impl<'a, S> StagingSlices<'a, S> {
                 references: references_a,
                 wrenches: wrenches_a,
                 subs: subs_a,
-                records: records_a,
                 dashpots: dashpots_a,
             },
             Self {
@@ -180,7 +173,6 @@ impl<'a, S> StagingSlices<'a, S> {
                 references: references_b,
                 wrenches: wrenches_b,
                 subs: subs_b,
-                records: records_b,
                 dashpots: dashpots_b,
             },
         )
@@ -215,7 +207,7 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
             let p = &old.pairs[k];
             debug_assert!(!p.joint.active, "a joint stepped as a whole re-detected unwritten");
             (p.kind.same_joint(&dc.kind) && p.host_is_a == dc.host_is_a)
-                .then(|| (&old.subs[p.range()], &old.records[p.range()], p.first as usize))
+                .then(|| (p, &old.references[k], &old.subs[p.range()], p.first as usize))
         });
         let old_subs = old_subs.flatten();
         // Carried spring forces were composed in the old contact's axes: their shear forces
@@ -225,7 +217,10 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
             (Some(k), Some(_)) => old.pairs[k].axes(),
             _ => JointAxes::from_normal(dc.normal),
         };
-        let (old_subs, old_records, old_first) = old_subs.unwrap_or((&[], &[], 0));
+        // The sub-contact of the old contact with a key, if any.
+        let old_index = |key| old_subs.and_then(|(p, reference, subs, _)| p.find_key(reference, subs, key));
+        let old_first = old_subs.map_or(0, |(.., first)| first);
+        let old_subs = old_subs.map_or(&[][..], |(_, _, subs, _)| subs);
         let old_anchors = k_old.map_or(AnchorPlane::default(), |k| old.pairs[k].anchors);
         // A face-face contact's anchors lie on the host face, in its frame: the frame its
         // cells' rectangles are aligned with (`contact/spread.rs`).
@@ -242,10 +237,7 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
             ContactKind::Nodes => AnchorPlane::through(seeds.iter().map(|s| s.anchor)),
         };
         let at = first as usize - self.sub_base;
-        let (subs, records) = (
-            &mut self.subs[at..at + seeds.len()],
-            &mut self.records[at..at + seeds.len()],
-        );
+        let subs = &mut self.subs[at..at + seeds.len()];
         // Empty when the model keeps no dashpot forces.
         let dashpots = self.dashpots.get_mut(at..at + seeds.len()).unwrap_or(&mut []);
         let nodes = matches!(dc.kind, ContactKind::Nodes);
@@ -270,9 +262,7 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
             Matrix::from_quat(bi.state.pose.rotation),
             Matrix::from_quat(bj.state.pose.rotation),
         );
-        for (n, ((seed, sub_slot), record_slot)) in
-            seeds.iter().zip(subs.iter_mut()).zip(records.iter_mut()).enumerate()
-        {
+        for (n, (seed, sub_slot)) in seeds.iter().zip(subs.iter_mut()).enumerate() {
             let plane = if nodes {
                 // A node's plane coordinates hold the face of the other block it lies deepest
                 // under (`contact/node_step.rs`).
@@ -293,11 +283,18 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
                 slip: 0.0,
                 half: [seed.half.x as f32, seed.half.y as f32],
                 status: JointStatus::Open,
+                cell: match dc.kind {
+                    ContactKind::FaceFace { .. } => seed.key.cell_indices(),
+                    ContactKind::Nodes => [0; 2],
+                },
                 state: fresh.clone(),
             };
-            let record = SubContactRecord::new(seed.key);
+            debug_assert!(match dc.kind {
+                ContactKind::FaceFace { face_a, face_b } => seed.key.is_cell_of(face_a, face_b),
+                ContactKind::Nodes => true,
+            });
             let mut dashpot = Vector::ZERO;
-            if let Ok(k) = old_records.binary_search_by_key(&seed.key, |r| r.key) {
+            if let Some(k) = old_index(seed.key) {
                 let o = &old_subs[k];
                 if nodes {
                     // Its shear force is stored along the tangents of that face.
@@ -320,7 +317,6 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
                 dashpot = old.dashpot(old_first + k);
             }
             *sub_slot = sub;
-            *record_slot = record;
             if let Some(slot) = dashpots.get_mut(n) {
                 *slot = dashpot;
             }
@@ -331,7 +327,7 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
         }) {
             let p = &old.pairs[k];
             hand_node_forces_to_cells(
-                (&old.subs[p.range()], &old.records[p.range()]),
+                (&old.subs[p.range()], old.references[k].node_keys()),
                 (bi, &rotations.0),
                 (bj, &rotations.1),
                 (host, &anchors, &axes),
@@ -370,12 +366,17 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
             ref_host_rotation: host.state.pose.rotation,
             area: seeds.iter().map(|s| s.area).sum(),
             bound_area,
-            side: None,
+            // A node contact's keys name its nodes (a cell's follows from its contact).
+            side: if nodes {
+                ContactReference::nodes(seeds.iter().map(|s| s.key).collect())
+            } else {
+                None
+            },
         };
     }
 }
 
-/// Hands the forces of a loaded node contact's nodes (`nodes`: its sub-contacts and records) to
+/// Hands the forces of a loaded node contact's nodes (`nodes`: its sub-contacts and keys) to
 /// the cells of the face-face joint it turns into (`cells`, fresh; `docs/theory.md` §6,
 /// "Contact transitions"): each node's force (world, as it stands) goes to the cell whose
 /// rectangle on the joint's anchor plane lies nearest its point, composed in the joint's
@@ -394,19 +395,20 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
 /// releases of it as friction. The cells' shear forces are then scaled down together until
 /// they store what the nodes stored; what they store less stays in the balance (never more).
 fn hand_node_forces_to_cells<L: ConstitutiveLaw>(
-    (nodes, records): (&[SubContact<L::State>], &[SubContactRecord]),
+    (nodes, keys): (&[SubContact<L::State>], &[SubKey]),
     (bi, rotation_a): (&RigidBlock, &Matrix),
     (bj, rotation_b): (&RigidBlock, &Matrix),
     (host, anchors, axes): (&RigidBlock, &AnchorPlane, &JointAxes),
     law: &L,
     cells: &mut [SubContact<L::State>],
 ) {
-    for (node, record) in nodes.iter().zip(records) {
+    debug_assert_eq!(nodes.len(), keys.len());
+    for (node, key) in nodes.iter().zip(keys) {
         if node.force == JointForce::default() && node.slip == 0.0 {
             continue;
         }
         let (point, node_axes) = stored_node_frame(
-            NodeId::from_key(record.key),
+            NodeId::from_key(*key),
             node.plane.x as usize,
             (&bi.state, rotation_a, bi.shape()),
             (&bj.state, rotation_b, bj.shape()),
@@ -478,7 +480,6 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             pairs: &self.contacts.pairs,
             references: &self.contacts.references,
             subs: &self.contacts.subs,
-            records: &self.contacts.sub_records,
             dashpots: &self.contacts.sub_dashpots,
         };
         let mut slices = slices;
