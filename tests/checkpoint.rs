@@ -1143,6 +1143,51 @@ fn a_run_with_integrated_nodes_restarts_bit_for_bit() -> Result<()> {
     Ok(())
 }
 
+/// **A block tossed off its last contact checkpoints and restarts bit for bit.** A tetrahedron
+/// resting on a vertex (a node contact, point rule) is thrown up off the slab: the step keeps
+/// the stability bound of its last contact (2.7e5 1/s² in the run that found this), while the
+/// whole evaluation the checkpoint reader checks against gives a block in flight the bound of
+/// a contact over its largest face (1.3e8 1/s²). The reader refused such a checkpoint as edited;
+/// it checks blocks in contact only. Saved in flight, reloaded, and both runs on through the
+/// landing, the same bits.
+#[test]
+fn a_block_tossed_off_its_last_contact_restarts_bit_for_bit() -> Result<()> {
+    let mut model = common::model_with(ModelParameters::default(), CoulombSlip::dry(1e9, 1e9, 30.0)?);
+    model.set_damping(Damping::local())?;
+    model.add_block(common::fixed_slab("slab"))?;
+    let s = 0.1;
+    let v = Vector::new;
+    let tetrahedron = RigidBlock::from_vertices(
+        "tetrahedron",
+        &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
+        2500.0,
+    )?
+    .transformed(Pose::from_rotation(Rotation::from_scaled_axis(v(0.3, -0.5, 0.2))));
+    let low = common::z_range(&tetrahedron).0;
+    let id = model.add_block(tetrahedron.transformed(Pose::from_translation(v(0.0, 0.0, 0.002 - low))))?;
+    let pressed = |m: &Model| m.contacts().any(|c| c.subcontacts().any(|x| x.normal_force() > 0.0));
+    while !pressed(&model) {
+        model.step()?;
+        assert!(model.time() < 0.5, "no pressed contact");
+    }
+    model.set_velocity(id, v(0.0, 0.0, 1.5), v(0.0, 0.0, 0.0))?;
+    while model.contacts().len() > 0 {
+        model.step()?;
+        assert!(model.time() < 1.0, "still in contact");
+    }
+    let mut restarted: Model = Model::from_checkpoint_str(&model.to_checkpoint_string()?)?;
+    // Up 0.11 m and down again (about 0.3 s), then on for 2,000 steps from the landing.
+    for m in [&mut model, &mut restarted] {
+        while m.contacts().len() == 0 {
+            m.step()?;
+            assert!(m.time() < 2.0, "the tetrahedron must land");
+        }
+        m.run_steps(2000)?;
+    }
+    assert_eq!(fingerprint(&model), fingerprint(&restarted));
+    Ok(())
+}
+
 /// **A node contact turning back into a joint restarts bit for bit** ([`NodeRule::Integrated`],
 /// `docs/theory.md` §6): a 0.2 m cube set rocking on the edge it shares with a fixed cube of its
 /// size tips past 15° (its loaded joint turns into a node contact), is checkpointed there, and
