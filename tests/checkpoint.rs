@@ -1188,6 +1188,91 @@ fn a_block_tossed_off_its_last_contact_restarts_bit_for_bit() -> Result<()> {
     Ok(())
 }
 
+/// **Every checkpoint of a tumbling scene loads, and restarts bit for bit.** A tetrahedron
+/// dropped on a vertex onto a slab, bouncing, rocking and settling, beside a cube that lands
+/// on the slab: contacts appear, vanish, change kind between nodes and faces, and blocks lose
+/// their last contact and land again. With point nodes and local damping, with integrated nodes
+/// and Rayleigh damping, and in small displacements (the tetrahedron set down within the
+/// contact tolerance, contacts being found once), a checkpoint every 25 steps over 3,000
+/// must load (the bug above was a refused one at step 2,871 of the first), and every 500 steps
+/// the reloaded model and the original step on 100 steps to the same bits.
+#[test]
+fn every_checkpoint_of_a_tumbling_scene_loads() -> Result<()> {
+    let v = Vector::new;
+    let scene = |params: ModelParameters, damping: Damping, lift: Real| -> Result<Model> {
+        let mut model = common::model_with(params, CoulombSlip::dry(1e9, 1e9, 30.0)?);
+        model.set_damping(damping)?;
+        model.add_block(common::fixed_slab("slab"))?;
+        let s = 0.1;
+        let tetrahedron = RigidBlock::from_vertices(
+            "tetrahedron",
+            &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
+            2500.0,
+        )?
+        .transformed(Pose::from_rotation(Rotation::from_scaled_axis(v(0.3, -0.5, 0.2))));
+        let low = common::z_range(&tetrahedron).0;
+        model.add_block(tetrahedron.transformed(Pose::from_translation(v(0.0, 0.0, lift - low))))?;
+        let gap = lift.min(1e-3);
+        model.add_block(RigidBlock::cuboid(
+            "cube",
+            v(0.4, 0.4, gap),
+            v(0.6, 0.6, gap + 0.2),
+            2500.0,
+        )?)?;
+        Ok(model)
+    };
+    let integrated = ModelParameters {
+        contact: ContactParameters {
+            node_rule: NodeRule::Integrated,
+            ..ContactParameters::default()
+        },
+        ..ModelParameters::default()
+    };
+    let small = ModelParameters {
+        mode: DisplacementMode::Small,
+        ..ModelParameters::default()
+    };
+    let rayleigh = Damping::Rayleigh {
+        mass: 0.5,
+        stiffness: 1e-5,
+    };
+    for (name, mut model) in [
+        (
+            "point nodes, local damping",
+            scene(ModelParameters::default(), Damping::local(), 0.03)?,
+        ),
+        ("integrated nodes, Rayleigh", scene(integrated, rayleigh, 0.03)?),
+        // Contacts found once: the tetrahedron starts within the contact tolerance.
+        ("small displacements, Rayleigh", scene(small, rayleigh, 2e-4)?),
+    ] {
+        let mut kinds = std::collections::BTreeSet::new();
+        for k in 1..=120 {
+            model.run_steps(25)?;
+            kinds.extend(
+                model
+                    .contacts()
+                    .map(|c| format!("{:?}", c.kind()).chars().take(4).collect::<String>()),
+            );
+            let text = model.to_checkpoint_string()?;
+            let mut again: Model = Model::from_checkpoint_str(&text).map_err(|e| Error::Unsupported {
+                what: format!("{name}, step {}: {e}", model.step_count()),
+            })?;
+            if k % 20 == 0 {
+                model.run_steps(100)?;
+                again.run_steps(100)?;
+                assert_eq!(
+                    fingerprint(&model),
+                    fingerprint(&again),
+                    "{name}, step {}",
+                    model.step_count()
+                );
+            }
+        }
+        assert!(kinds.len() == 2, "{name}: node and face contacts both met, {kinds:?}");
+    }
+    Ok(())
+}
+
 /// **A node contact turning back into a joint restarts bit for bit** ([`NodeRule::Integrated`],
 /// `docs/theory.md` §6): a 0.2 m cube set rocking on the edge it shares with a fixed cube of its
 /// size tips past 15° (its loaded joint turns into a node contact), is checkpointed there, and

@@ -191,6 +191,48 @@ fn parameters_re_detect_only_when_the_contacts_change() -> Result<()> {
     Ok(())
 }
 
+/// **A switch to small displacements detects every contact afresh** (`Model::set_parameters`):
+/// the geometry small displacements keep is then the switch's for every contact, where before
+/// each contact kept that of its own last detection in large displacements (the wall settles
+/// for 300 steps first, re-detecting as it sags). In small displacements, new gravity detects
+/// nothing, and new contact parameters detect afresh again.
+#[test]
+fn a_switch_to_small_displacements_detects_afresh() -> Result<()> {
+    let mut model = voussoir::scenes::benchmark_wall(300)?;
+    model.run_steps(300)?;
+    let detections = model.detection_count();
+    let p = *model.parameters();
+    let small = ModelParameters {
+        mode: DisplacementMode::Small,
+        ..p
+    };
+    model.set_parameters(small)?;
+    model.step()?;
+    assert_eq!(model.detection_count(), detections + 1, "detected at the switch");
+    model.run_steps(20)?;
+    assert_eq!(model.detection_count(), detections + 1, "and not again");
+    let tests = model.pair_tests();
+    model.set_parameters(ModelParameters {
+        gravity: p.gravity * 1.01,
+        ..small
+    })?;
+    model.step()?;
+    assert_eq!(model.pair_tests(), tests, "no pair tested afresh for new gravity");
+    model.set_parameters(ModelParameters {
+        contact: ContactParameters {
+            tolerance: p.contact.tolerance * 1.01,
+            ..p.contact
+        },
+        ..small
+    })?;
+    model.step()?;
+    assert!(
+        model.pair_tests() - tests >= model.contacts().len() as u64,
+        "a full detection for new contact parameters"
+    );
+    Ok(())
+}
+
 /// An interrupt check that fires stops the step before it changes anything: the model's state
 /// (blocks, contacts, energies, clock) is as before, and the run goes on afterwards.
 #[test]

@@ -22,6 +22,11 @@ impl Changes {
         self.0 |= other.0;
     }
 
+    /// Whether the set holds every change of `other`.
+    pub fn contains(self, other: Self) -> bool {
+        self.0 & other.0 == other.0
+    }
+
     /// Whether the next step must detect all contacts afresh and re-evaluate its time step,
     /// and whether what the last block pass prepared for it (rotation matrices, movement
     /// check) may be stale: any change does.

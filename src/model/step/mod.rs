@@ -50,8 +50,15 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             if changed || moved || refixed {
                 self.detect(pipeline)?;
             }
+        } else if changed && self.changes.contains(Changes::PARAMETERS) {
+            // New contact parameters, or a switch from large displacements: every contact found
+            // afresh, so that the geometry small displacements keep is that of this instant for
+            // every contact (after large displacements, each contact's reference was its own
+            // last detection's).
+            self.detect(pipeline)?;
         } else if changed {
-            // Small displacements keep the initial contact geometry: only the step is re-evaluated.
+            // Small displacements keep the contact geometry they found: only the step is
+            // re-evaluated.
             self.refresh_time_step(pipeline)?;
             self.changes.clear();
         }
