@@ -10,7 +10,7 @@ use super::moments::{ForceMoments, Lever};
 use super::spread::{CellResponse, CellRule, ExactCells};
 use super::{
     ContactPair, ContactReference, ContactWrench, DisplacementMode, HingeRecord, JointLevel, LaneBuild, SideRecord,
-    SpanEnds, SubContact,
+    SmallReference, SpanEnds, SubContact,
 };
 use crate::block::BlockMotion;
 use crate::law::{ConstitutiveLaw, ElasticRegime, JointAxes, JointStatus};
@@ -118,6 +118,7 @@ impl KernelContext {
 pub(crate) fn update_contact<L: ConstitutiveLaw>(
     pair: &mut ContactPair,
     reference: &mut ContactReference,
+    small: Option<&SmallReference>,
     subs: &mut [SubContact<L::State>],
     dashpot_forces: &mut [Vector],
     sa: &BlockMotion,
@@ -129,8 +130,9 @@ pub(crate) fn update_contact<L: ConstitutiveLaw>(
 ) -> ContactStep {
     // The axes of the previous step, in which the stored spring forces were composed.
     let previous_axes = pair.axes();
-    let host = pair.frame(&*reference, &sa.pose, &sb.pose, ctx.mode);
-    let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, ctx.mode);
+    debug_assert_eq!(small.is_some(), ctx.mode == DisplacementMode::Small);
+    let host = pair.frame(small, &sa.pose, &sb.pose);
+    let (xa, xb) = SmallReference::centroids(small, &sa.pose, &sb.pose);
     let xh = host.translation;
     // Large displacements: the gap of the anchor p is its signed distance from the other
     // block's plane m·x = d (m its outward normal, turning with it), gap = m·p − d; with

@@ -48,9 +48,9 @@ pub enum DisplacementMode {
 
 /// One contact between blocks `a < b`, with a contiguous range of sub-contacts.
 ///
-/// Layout: what a step reads and writes; the reference geometry of small-displacement mode,
-/// the detection bookkeeping and the record of a hinge sit in a parallel internal list, which a
-/// large-displacement step reads for hinges only.
+/// Layout: what a step reads and writes; the detection bookkeeping and the record of a hinge
+/// sit in a parallel internal list, which a large-displacement step reads for hinges only, and
+/// the reference geometry of small-displacement mode in another, kept in that mode only.
 #[derive(Debug, Clone, PartialEq)]
 #[repr(C)]
 pub(crate) struct ContactPair {
@@ -160,16 +160,12 @@ impl CellSummary {
 }
 
 /// What a contact keeps besides the fields of [`ContactPair`], in a parallel array (same index):
-/// its geometry at detection, which small-displacement mode steps with, the areas the
-/// critical-step bookkeeping compares, and what a contact of one kind keeps on the side (a
-/// hinge's record, a node contact's strips), which the step reads for those contacts only.
+/// the areas the critical-step bookkeeping compares, and what a contact of one kind keeps on
+/// the side (a hinge's record, a node contact's strips), which the step reads for those
+/// contacts only. Its geometry at detection, which small-displacement mode alone steps with,
+/// is a list of its own ([`SmallReference`]), kept in that mode only.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct ContactReference {
-    /// Centroids at detection (lever arms in small-displacement mode).
-    pub(crate) ref_a: Vector,
-    pub(crate) ref_b: Vector,
-    /// Rotation of the host block at detection (anchors to world in small-displacement mode).
-    pub(crate) ref_host_rotation: Rotation,
     /// Sum of the sub-contact areas (m²).
     pub(crate) area: Real,
     /// `area` when the critical step was last evaluated (0 for a new contact).
@@ -206,17 +202,51 @@ pub(crate) struct NodeRecord {
     pub(crate) strips: Option<crate::geometry::NodeStrips>,
 }
 
-impl ContactReference {
-    /// The centroids of `a` and `b` the step's lever arms start from: their current positions,
-    /// or those at detection in small-displacement mode.
+/// A contact's geometry at its detection, which small-displacement mode steps with: in a
+/// parallel list of the contacts ([`crate::contact::ContactStore::small_refs`], same index),
+/// kept in that mode only. Large-displacement mode steps with the current poses and keeps none
+/// (a switch to small displacements detects every contact afresh).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SmallReference {
+    /// Centroids at detection (lever arms in small-displacement mode).
+    pub(crate) ref_a: Vector,
+    pub(crate) ref_b: Vector,
+    /// Rotation of the host block at detection (anchors to world in small-displacement mode).
+    pub(crate) ref_host_rotation: Rotation,
+}
+
+impl SmallReference {
+    /// The reference the step's geometry of contact `k` follows in `mode`: its entry of `refs`
+    /// (a store's `small_refs`) in small-displacement mode, none (the current poses) in large
+    /// mode, or when the list is not kept (contacts found in large mode, read by the detection
+    /// that a switch to small displacements makes before any of them steps so).
     #[inline]
-    pub(crate) fn centroids(&self, pose_a: &Pose, pose_b: &Pose, mode: DisplacementMode) -> (Vector, Vector) {
+    pub(crate) fn of(refs: &[Self], k: usize, mode: DisplacementMode) -> Option<&Self> {
         match mode {
-            DisplacementMode::Large => (pose_a.translation, pose_b.translation),
-            DisplacementMode::Small => (self.ref_a, self.ref_b),
+            DisplacementMode::Large => None,
+            DisplacementMode::Small => refs.get(k),
         }
     }
 
+    /// The centroids of `a` and `b` the step's lever arms start from: their current positions,
+    /// or those at detection (`small`, [`SmallReference::of`]).
+    #[inline]
+    pub(crate) fn centroids(small: Option<&Self>, pose_a: &Pose, pose_b: &Pose) -> (Vector, Vector) {
+        match small {
+            None => (pose_a.translation, pose_b.translation),
+            Some(r) => (r.ref_a, r.ref_b),
+        }
+    }
+
+    /// A reference to fill room with until a contact's is written there (never read).
+    pub(crate) const DEAD: Self = Self {
+        ref_a: Vector::ZERO,
+        ref_b: Vector::ZERO,
+        ref_host_rotation: Rotation::IDENTITY,
+    };
+}
+
+impl ContactReference {
     /// The record of a joint open in part, if it holds one.
     #[inline]
     pub(crate) fn hinge(&self) -> Option<&HingeRecord> {
@@ -325,11 +355,14 @@ mod tests {
 
     /// The contact record every step streams stays at the size `docs/performance.md` counts:
     /// a hinge's span in the joint record's padding, the rest of its record boxed in the
-    /// reference (8 bytes for a contact that is neither a hinge nor a node contact).
+    /// reference (8 bytes for a contact that is neither a hinge nor a node contact), and the
+    /// reference geometry of small-displacement mode in a list of its own, which large
+    /// displacements do not keep.
     #[test]
     fn contact_records_keep_their_sizes() {
         assert_eq!(std::mem::size_of::<super::ContactPair>(), 536);
-        assert_eq!(std::mem::size_of::<super::ContactReference>(), 104);
+        assert_eq!(std::mem::size_of::<super::ContactReference>(), 24);
+        assert_eq!(std::mem::size_of::<super::SmallReference>(), 80);
     }
 
     /// A cell's key is its joint's faces and its two grid indices, which its sub-contact holds
@@ -417,32 +450,19 @@ impl ContactPair {
     }
 
     /// The pose mapping sub-contact anchors to world points, given the current poses of `a`
-    /// and `b`: the host's pose, or its pose at detection (`reference`) in small-displacement
-    /// mode.
+    /// and `b`: the host's pose, or its pose at detection (`small`, [`SmallReference::of`]:
+    /// in small-displacement mode).
     #[inline]
-    pub(crate) fn frame(
-        &self,
-        reference: &ContactReference,
-        pose_a: &Pose,
-        pose_b: &Pose,
-        mode: DisplacementMode,
-    ) -> Pose {
-        match mode {
-            DisplacementMode::Large => {
+    pub(crate) fn frame(&self, small: Option<&SmallReference>, pose_a: &Pose, pose_b: &Pose) -> Pose {
+        match small {
+            None => {
                 if self.host_is_a {
                     *pose_a
                 } else {
                     *pose_b
                 }
             }
-            DisplacementMode::Small => Pose::from_parts(
-                if self.host_is_a {
-                    reference.ref_a
-                } else {
-                    reference.ref_b
-                },
-                reference.ref_host_rotation,
-            ),
+            Some(r) => Pose::from_parts(if self.host_is_a { r.ref_a } else { r.ref_b }, r.ref_host_rotation),
         }
     }
 

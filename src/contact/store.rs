@@ -1,16 +1,18 @@
 //! The contacts as the step stores them: the pairs, their references and wrenches, the
 //! sub-contacts (each with its key, or for a node its contact's reference), struct of arrays
-//! (each contact owns a contiguous range of the sub-contacts, `ContactPair::range`), and the
-//! sub-contacts' dashpot forces when the model has any. One owner, [`ContactStore`], and the views the
+//! (each contact owns a contiguous range of the sub-contacts, `ContactPair::range`), the
+//! contacts' geometry at detection in small-displacement mode, and the sub-contacts' dashpot
+//! forces when the model has any. One owner, [`ContactStore`], and the views the
 //! stages take of it: [`OldContacts`] (detection reading the contacts it replaces),
 //! [`ContactLists`] (detection rearranging them) and [`ContactSlices`] (the contact pass
 //! writing them, split at chunk boundaries).
 
-use super::{ContactPair, ContactReference, ContactWrench, SubContact};
+use super::{ContactPair, ContactReference, ContactWrench, SmallReference, SubContact};
 use crate::math::Vector;
 
 /// The contacts of a model (or detection's staging lists): struct of arrays, kept index for
-/// index (`pairs`, `references`, `wrenches`; `subs` and, when kept, `sub_dashpots`). A
+/// index (`pairs`, `references`, `wrenches` and, when kept, `small_refs`; `subs` and, when
+/// kept, `sub_dashpots`). A
 /// sub-contact's key is no list of its own: a face-face cell holds its grid indices in what was
 /// its padding, a node contact's reference its nodes' keys ([`super::ContactPair::key`]).
 #[derive(Debug, Clone)]
@@ -24,6 +26,15 @@ pub(crate) struct ContactStore<S> {
     /// `ContactPair`, whose stream they would lengthen by 72 bytes per contact). Detection
     /// carries a kept contact's wrench and starts a new one at zero; checkpointed.
     pub wrenches: Vec<ContactWrench>,
+    /// The contacts' geometry at detection, which small-displacement mode steps with, index
+    /// for index with `pairs` while `small_kept` — empty otherwise (no allocation): large
+    /// displacements step with the current poses, and a switch to small displacements detects
+    /// every contact afresh, so that they never read it. Detection keeps it in
+    /// small-displacement mode and drops it in large mode; a checkpoint loaded in small mode
+    /// keeps the stored one.
+    pub small_refs: Vec<SmallReference>,
+    /// Whether `small_refs` is kept (index for index with `pairs`).
+    pub small_kept: bool,
     /// The sub-contacts, each contact's in its range.
     pub subs: Vec<SubContact<S>>,
     /// The sub-contacts' stiffness-proportional (Rayleigh) dashpot forces on `b` (world) of the
@@ -42,6 +53,8 @@ impl<S> Default for ContactStore<S> {
             pairs: Vec::new(),
             references: Vec::new(),
             wrenches: Vec::new(),
+            small_refs: Vec::new(),
+            small_kept: false,
             subs: Vec::new(),
             sub_dashpots: Vec::new(),
             dashpots_kept: false,
@@ -55,6 +68,7 @@ impl<S> ContactStore<S> {
         OldContacts {
             pairs: &self.pairs,
             references: &self.references,
+            small_refs: &self.small_refs,
             subs: &self.subs,
             dashpots: &self.sub_dashpots,
         }
@@ -69,6 +83,20 @@ impl<S> ContactStore<S> {
         }
     }
 
+    /// Keeps the contacts' small-displacement references (`keep`) or drops them, freeing
+    /// their memory. Kept afresh, every contact gets a dead one ([`SmallReference::DEAD`]),
+    /// to be written over: in small-displacement mode every detection detects every contact
+    /// afresh.
+    pub(crate) fn keep_small_refs(&mut self, keep: bool) {
+        if keep && !self.small_kept {
+            self.small_refs.clear();
+            self.small_refs.resize(self.pairs.len(), SmallReference::DEAD);
+        } else if !keep && self.small_kept {
+            self.small_refs = Vec::new();
+        }
+        self.small_kept = keep;
+    }
+
     /// The dashpot force of sub-contact `i` (zero when none are kept); read by checkpoints.
     #[cfg(feature = "serde")]
     pub(crate) fn dashpot(&self, i: usize) -> Vector {
@@ -81,6 +109,8 @@ impl<S> ContactStore<S> {
             pairs: &mut self.pairs,
             references: &mut self.references,
             wrenches: &mut self.wrenches,
+            small_refs: &mut self.small_refs,
+            small_kept: self.small_kept,
             subs: &mut self.subs,
             dashpots: &mut self.sub_dashpots,
             dashpots_kept: self.dashpots_kept,
@@ -95,6 +125,7 @@ impl<S> ContactStore<S> {
             pairs: &mut self.pairs,
             references: &mut self.references,
             wrenches: &mut self.wrenches,
+            small_refs: if self.small_kept { &mut self.small_refs } else { &mut [] },
             sums,
             subs: &mut self.subs[first_sub..],
             dashpots: if self.dashpots_kept {
@@ -111,6 +142,7 @@ impl<S> ContactStore<S> {
         self.sub_dashpots.len() == if self.dashpots_kept { self.subs.len() } else { 0 }
             && self.wrenches.len() == self.pairs.len()
             && self.references.len() == self.pairs.len()
+            && self.small_refs.len() == if self.small_kept { self.pairs.len() } else { 0 }
     }
 }
 
@@ -118,6 +150,8 @@ impl<S> ContactStore<S> {
 pub(crate) struct OldContacts<'a, S> {
     pub(crate) pairs: &'a [ContactPair],
     pub(crate) references: &'a [ContactReference],
+    /// Empty when the contacts keep no small-displacement references.
+    pub(crate) small_refs: &'a [SmallReference],
     pub(crate) subs: &'a [SubContact<S>],
     /// Empty when the model keeps no dashpot forces.
     pub(crate) dashpots: &'a [Vector],
@@ -136,6 +170,9 @@ pub(crate) struct ContactLists<'a, S> {
     pub(crate) pairs: &'a mut Vec<ContactPair>,
     pub(crate) references: &'a mut Vec<ContactReference>,
     pub(crate) wrenches: &'a mut Vec<ContactWrench>,
+    /// Index for index with `pairs` when `small_kept`, empty otherwise.
+    pub(crate) small_refs: &'a mut Vec<SmallReference>,
+    pub(crate) small_kept: bool,
     pub(crate) subs: &'a mut Vec<SubContact<S>>,
     /// Index for index with `subs` when `dashpots_kept`, empty otherwise.
     pub(crate) dashpots: &'a mut Vec<Vector>,
@@ -148,6 +185,7 @@ impl<S> ContactLists<'_, S> {
         self.pairs.clear();
         self.references.clear();
         self.wrenches.clear();
+        self.small_refs.clear();
         self.subs.clear();
         self.dashpots.clear();
     }
@@ -160,6 +198,8 @@ pub(crate) struct ContactSlices<'a, S, T> {
     /// The contacts' references, index for index with `pairs` (the step writes a hinge's).
     pub references: &'a mut [ContactReference],
     pub wrenches: &'a mut [ContactWrench],
+    /// The contacts' small-displacement references, or empty when the contacts keep none.
+    pub small_refs: &'a mut [SmallReference],
     /// One per chunk of contacts.
     pub sums: &'a mut [T],
     /// The sub-contacts of `pairs`, from the first contact's first one.
@@ -177,6 +217,11 @@ impl<S, T> ContactSlices<'_, S, T> {
         let (pairs, pairs_right) = self.pairs.split_at_mut(at);
         let (references, references_right) = self.references.split_at_mut(at);
         let (wrenches, wrenches_right) = self.wrenches.split_at_mut(at);
+        let (small_refs, small_refs_right) = if self.small_refs.is_empty() {
+            (self.small_refs, &mut [][..])
+        } else {
+            self.small_refs.split_at_mut(at)
+        };
         let (sums, sums_right) = self.sums.split_at_mut(chunks);
         let (subs, subs_right) = self.subs.split_at_mut(sub_at);
         let (dashpots, dashpots_right) = if self.dashpots.is_empty() {
@@ -189,6 +234,7 @@ impl<S, T> ContactSlices<'_, S, T> {
                 pairs,
                 references,
                 wrenches,
+                small_refs,
                 sums,
                 subs,
                 dashpots,
@@ -197,6 +243,7 @@ impl<S, T> ContactSlices<'_, S, T> {
                 pairs: pairs_right,
                 references: references_right,
                 wrenches: wrenches_right,
+                small_refs: small_refs_right,
                 sums: sums_right,
                 subs: subs_right,
                 dashpots: dashpots_right,

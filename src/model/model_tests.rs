@@ -135,6 +135,7 @@ fn compare_loops<L: ConstitutiveLaw<State = crate::law::CoulombState>>(model: &M
             *wrench = update_contact(
                 &mut pairs[k],
                 &mut model.state.contacts.references[k].clone(),
+                crate::contact::SmallReference::of(&model.state.contacts.small_refs, k, ctx.mode),
                 &mut subs[r.clone()],
                 &mut dashpot_forces[r.clone()],
                 sa,

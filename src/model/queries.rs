@@ -5,7 +5,7 @@ use rayon::prelude::*;
 
 use super::{block_pass, Energies, Model, ModelParameters, Timings};
 use crate::block::{Block, BlockId, RigidBlock, Wrench};
-use crate::contact::{ContactView, DisplacementMode};
+use crate::contact::{ContactView, DisplacementMode, SmallReference};
 use crate::error::{Error, Result};
 use crate::integrate::{CriticalStep, Damping};
 use crate::law::{ConstitutiveLaw, LawTable};
@@ -133,10 +133,9 @@ impl<L: ConstitutiveLaw> Model<L> {
                 },
             ),
             p.frame(
-                &self.state.contacts.references[k],
+                SmallReference::of(&self.state.contacts.small_refs, k, self.state.params.mode),
                 &sa.pose,
                 &sb.pose,
-                self.state.params.mode,
             ),
             self.state.contacts.wrenches[k],
             (nodes, cells),

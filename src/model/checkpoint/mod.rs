@@ -152,7 +152,10 @@ struct ContactEntry<S> {
     /// could sum in another order): `[F, F_x, F_y]`.
     springs: [Vector; 3],
     spread_energy: Real,
-    /// Centroids and host rotation at detection (small-displacement mode).
+    /// Centroids and host rotation at detection, which small-displacement mode steps with.
+    /// Large displacements keep none (they step with the current poses): their files hold
+    /// placeholders here, the blocks' centroids and the host block's rotation as they stand,
+    /// which a load checks as numbers and does not keep.
     reference_centroids: (Vector, Vector),
     reference_host_rotation: Rotation,
     area: Real,

@@ -14,7 +14,10 @@ use super::{
     VERSION,
 };
 use crate::block::Block;
-use crate::contact::{ContactPair, ContactReference, ContactStore, ForceMoments, SideRecord, SpanEnds, SubContact};
+use crate::contact::{
+    ContactPair, ContactReference, ContactStore, DisplacementMode, ForceMoments, SideRecord, SmallReference, SpanEnds,
+    SubContact,
+};
 use crate::error::{Error, Result};
 use crate::geometry::ContactKind;
 use crate::ids::BlockId;
@@ -32,13 +35,23 @@ use crate::model::{Model, ModelParameters};
 /// A joint record holding what its file's `version` did not have (a span or a hinge record
 /// before version 15, open cells at one end before 16) is refused: no build of that version
 /// wrote it.
-fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: u32) -> Result<ContactStore<S>> {
+///
+/// The contacts' geometry at detection (`reference_centroids`, `reference_host_rotation`) is
+/// kept when `small` (the file's model steps with small displacements); otherwise it is read
+/// (as numbers) but not kept: large displacements never read it, and the files of this version
+/// hold placeholders there (those of earlier ones, each contact's last detection).
+fn into_storage<S: PartialEq + Default>(
+    entries: Vec<ContactEntry<S>>,
+    version: u32,
+    small: bool,
+) -> Result<ContactStore<S>> {
     let total = entries.iter().map(|e| e.subcontacts.len()).sum();
     let (mut pairs, mut references, mut wrenches) = (
         Vec::with_capacity(entries.len()),
         Vec::with_capacity(entries.len()),
         Vec::with_capacity(entries.len()),
     );
+    let mut small_refs = Vec::with_capacity(if small { entries.len() } else { 0 });
     let mut subs = Vec::with_capacity(total);
     // Kept only when some sub-contact holds a dashpot force (a model without Rayleigh damping
     // keeps none; one with it fills them at its next step).
@@ -171,10 +184,14 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
             cells: Default::default(),
             joint,
         });
+        if small {
+            small_refs.push(SmallReference {
+                ref_a: e.reference_centroids.0,
+                ref_b: e.reference_centroids.1,
+                ref_host_rotation: e.reference_host_rotation,
+            });
+        }
         references.push(ContactReference {
-            ref_a: e.reference_centroids.0,
-            ref_b: e.reference_centroids.1,
-            ref_host_rotation: e.reference_host_rotation,
             area: e.area,
             bound_area: e.bound_area,
             side: match e.kind {
@@ -188,6 +205,8 @@ fn into_storage<S: PartialEq + Default>(entries: Vec<ContactEntry<S>>, version: 
         pairs,
         references,
         wrenches,
+        small_refs,
+        small_kept: small,
         subs,
         sub_dashpots: dashpots,
         dashpots_kept: kept,
@@ -266,7 +285,8 @@ where
     pub fn from_checkpoint_str(text: &str) -> Result<Self> {
         let mut snap = parse_snapshot::<L>(text)?;
         let tested = check_snapshot(&snap)?;
-        let storage = into_storage(std::mem::take(&mut snap.contacts), snap.version)?;
+        let small = snap.params.mode == DisplacementMode::Small;
+        let storage = into_storage(std::mem::take(&mut snap.contacts), snap.version, small)?;
         check_contacts(&snap, &storage, &tested)?;
         let pending_detection = snap.pending_detection;
         let mut model = restore_blocks(snap.params, std::mem::take(&mut snap.blocks), snap.dt.max(snap.drift))?;

@@ -10,15 +10,36 @@ use super::tested::TestedEntry;
 use super::{
     checksum_of, law_type_name, ContactEntry, JointEntry, Snapshot, SubContactEntry, CHECKSUM, FORMAT, VERSION,
 };
+use crate::contact::SmallReference;
 use crate::error::{Error, Result};
 use crate::law::ConstitutiveLaw;
 use crate::model::Model;
 
 impl<L: ConstitutiveLaw> Model<L> {
     /// Contact `k` as a checkpoint stores it.
+    ///
+    /// Its geometry at detection (`reference_centroids`, `reference_host_rotation`) as kept in
+    /// small-displacement mode; where the contacts keep none (large displacements, which never
+    /// read it: a switch to small displacements detects every contact afresh), placeholders in
+    /// the same fields, so that the format stays as it was: the blocks' current centroids and
+    /// the host block's current rotation.
     fn contact_entry(&self, k: usize) -> ContactEntry<L::State> {
         let (p, r) = (&self.state.contacts.pairs[k], &self.state.contacts.references[k]);
         let range = p.range();
+        let small = match self.state.contacts.small_refs.get(k) {
+            Some(s) => *s,
+            None => {
+                let (pa, pb) = (
+                    &self.state.blocks[p.a as usize].state.pose,
+                    &self.state.blocks[p.b as usize].state.pose,
+                );
+                SmallReference {
+                    ref_a: pa.translation,
+                    ref_b: pb.translation,
+                    ref_host_rotation: if p.host_is_a { pa.rotation } else { pb.rotation },
+                }
+            }
+        };
         ContactEntry {
             blocks: (p.a, p.b),
             kind: p.kind,
@@ -31,8 +52,8 @@ impl<L: ConstitutiveLaw> Model<L> {
             normal_force: p.normal_force,
             springs: [p.springs.force, p.springs.per_x, p.springs.per_y],
             spread_energy: p.spread_energy,
-            reference_centroids: (r.ref_a, r.ref_b),
-            reference_host_rotation: r.ref_host_rotation,
+            reference_centroids: (small.ref_a, small.ref_b),
+            reference_host_rotation: small.ref_host_rotation,
             area: r.area,
             bound_area: r.bound_area,
             wrench: self.state.contacts.wrenches[k],

@@ -10,7 +10,7 @@
 //! afterwards, so that they do not depend on the number of threads.
 
 use crate::block::{Block, BlockMotion, RigidBlock};
-use crate::contact::{update_contact, update_nodes, KernelContext, LaneBuild};
+use crate::contact::{update_contact, update_nodes, KernelContext, LaneBuild, SmallReference};
 use crate::geometry::ContactKind;
 use crate::integrate::{StiffnessBound, TimeStep};
 use crate::law::ConstitutiveLaw;
@@ -106,13 +106,14 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
             pairs,
             references,
             wrenches,
+            small_refs,
             sums,
             subs,
             dashpots,
         } = chunk;
         let sums = &mut sums[0];
         let base = pairs[0].first as usize;
-        for ((p, reference), w) in pairs.iter_mut().zip(references.iter_mut()).zip(wrenches) {
+        for (k, ((p, reference), w)) in pairs.iter_mut().zip(references.iter_mut()).zip(wrenches).enumerate() {
             let (ma, mb) = (&self.motions[p.a as usize], &self.motions[p.b as usize]);
             let range = p.first as usize - base..p.first as usize - base + p.count as usize;
             let watch = !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok();
@@ -139,6 +140,7 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
                 update_contact(
                     p,
                     reference,
+                    SmallReference::of(small_refs, k, ctx.mode),
                     &mut subs[range],
                     dashpots,
                     ma,

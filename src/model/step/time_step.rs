@@ -7,7 +7,7 @@ use crate::model::Pipeline;
 use rayon::prelude::*;
 
 use crate::block::Block;
-use crate::contact::stored_node_frame;
+use crate::contact::{stored_node_frame, SmallReference};
 use crate::geometry::{ContactKind, NodeId};
 use crate::integrate::{
     block_bound, block_side, bound_from_sides, contact_eigenvalues, AreaMoments, ContactStiffness, StiffnessBound,
@@ -258,7 +258,8 @@ impl<L: ConstitutiveLaw> BoundSources<'_, L> {
         } else {
             // The cells' area moments on the anchor plane, turned into the world about the
             // plane's origin: the same moments as cell by cell, without a pass over the cells.
-            let frame = p.frame(reference, &sa.pose, &sb.pose, s.params.mode);
+            let small = SmallReference::of(&s.contacts.small_refs, k, s.params.mode);
+            let frame = p.frame(small, &sa.pose, &sb.pose);
             let plane = &p.anchors;
             origin = frame.transform_point(plane.origin);
             moments = AreaMoments::of_plane(p.cells.area_moments, frame.rotation * plane.u, frame.rotation * plane.v);

@@ -420,6 +420,11 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         // room after every `SEGMENT` contacts.
         sc.staging.lists().clear();
         sc.staging.store.dashpots_kept = self.contacts.dashpots_kept;
+        // The contacts' geometry at detection, in small-displacement mode only (the splice
+        // makes the model's lists keep it or drop it alike).
+        sc.staging
+            .store
+            .keep_small_refs(self.params.mode == DisplacementMode::Small);
         sc.staging_spread = full;
         sc.segment_subs = 0;
         for start in (0..sc.plan.len()).step_by(BATCH) {

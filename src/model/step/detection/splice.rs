@@ -6,7 +6,7 @@ use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
     stored_node_frame, ContactLists, ContactPair, ContactReference, ContactStore, ContactWrench, DisplacementMode,
-    OldContacts, SubContact,
+    OldContacts, SmallReference, SubContact,
 };
 use crate::error::Result;
 use crate::geometry::{ContactKind, NodeId};
@@ -191,6 +191,9 @@ impl<S> ContactLists<'_, S> {
             move_into_dead_room(self.pairs, c..c + len, shift);
             move_into_dead_room(self.references, c..c + len, shift);
             move_into_dead_room(self.wrenches, c..c + len, shift);
+            if self.small_kept {
+                move_into_dead_room(self.small_refs, c..c + len, shift);
+            }
         }
     }
 
@@ -305,6 +308,9 @@ pub(super) fn add_dropped_work<S: PartialEq + Default>(
     owed: &mut (Real, Real),
 ) {
     let (p, reference) = (&old.pairs[k], &old.references[k]);
+    // The geometry the contact stepped with (the current poses when its references were not
+    // kept: it was found in large-displacement mode).
+    let small = SmallReference::of(old.small_refs, k, mode);
     debug_assert!(!p.joint.active, "a joint stepped as a whole dropped unwritten");
     let carried = successor
         .filter(|(q, ..)| q.kind.same_joint(&p.kind) && q.host_is_a == p.host_is_a)
@@ -314,8 +320,8 @@ pub(super) fn add_dropped_work<S: PartialEq + Default>(
     let integrated = super::law_integrated(integrated_laws, p.law);
     let handed = successor.is_some_and(|(q, ..)| p.hands_forces_to_cells(&old.subs[p.range()], integrated, &q.kind));
     let (sa, sb) = (&blocks[p.a as usize].state, &blocks[p.b as usize].state);
-    let frame = p.frame(reference, &sa.pose, &sb.pose, mode);
-    let (xa, xb) = reference.centroids(&sa.pose, &sb.pose, mode);
+    let frame = p.frame(small, &sa.pose, &sb.pose);
+    let (xa, xb) = SmallReference::centroids(small, &sa.pose, &sb.pose);
     let nodes = matches!(p.kind, ContactKind::Nodes);
     let (ba, bb) = (&blocks[p.a as usize], &blocks[p.b as usize]);
     let rotations = if nodes {
@@ -475,6 +481,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                 &mut owed,
             );
         }
+        // Every contact is re-tested in small-displacement mode (a full detection): each
+        // gets its reference below.
+        self.contacts.keep_small_refs(sc.staging.store.small_kept);
         if needed > room {
             // Dead room (sub-contacts not in any contact's range are never read).
             self.contacts.resize_subcontacts(needed as usize);
@@ -503,6 +512,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.contacts.pairs[k].first = r.first;
             self.contacts.references[k] = sc.staging.store.references[s].clone();
             self.contacts.wrenches[k] = sc.staging.store.wrenches[s];
+            if self.contacts.small_kept {
+                self.contacts.small_refs[k] = sc.staging.store.small_refs[s];
+            }
         }
         sc.reindex = false;
         sc.splices.in_place += 1;
@@ -585,6 +597,8 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             std::mem::swap(&mut self.contacts.pairs, &mut sc.staging.store.pairs);
             std::mem::swap(&mut self.contacts.references, &mut sc.staging.store.references);
             std::mem::swap(&mut self.contacts.wrenches, &mut sc.staging.store.wrenches);
+            std::mem::swap(&mut self.contacts.small_refs, &mut sc.staging.store.small_refs);
+            std::mem::swap(&mut self.contacts.small_kept, &mut sc.staging.store.small_kept);
             std::mem::swap(&mut self.contacts.subs, &mut sc.staging.store.subs);
             std::mem::swap(&mut self.contacts.sub_dashpots, &mut sc.staging.store.sub_dashpots);
             sc.release_staging();
@@ -610,6 +624,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         sc.splices.full += 1;
         sc.splices.fresh += u64::from(fresh);
         let (contacts, room) = (sc.layout.len(), end as usize);
+        // Every contact is re-tested in small-displacement mode (a full detection): each
+        // gets its reference below.
+        self.contacts.keep_small_refs(sc.staging.store.small_kept);
         if contacts > self.contacts.pairs.len() {
             // Room for the new contacts (the fillers are overwritten below).
             let filler = (
@@ -619,6 +636,9 @@ impl<L: ConstitutiveLaw> ModelState<L> {
             self.contacts.pairs.resize(contacts, filler.0);
             self.contacts.references.resize(contacts, filler.1);
             self.contacts.wrenches.resize(contacts, ContactWrench::default());
+            if self.contacts.small_kept {
+                self.contacts.small_refs.resize(contacts, SmallReference::DEAD);
+            }
         }
         if room > self.contacts.subs.len() {
             // Dead room (sub-contacts not in any contact's range are never read).
@@ -680,12 +700,16 @@ impl<L: ConstitutiveLaw> ModelState<L> {
                     lists.pairs[k].first = first;
                     lists.references[k] = sc.staging.store.references[s as usize].clone();
                     lists.wrenches[k] = sc.staging.store.wrenches[s as usize];
+                    if lists.small_kept {
+                        lists.small_refs[k] = sc.staging.store.small_refs[s as usize];
+                    }
                 }
             }
         }
         self.contacts.pairs.truncate(contacts);
         self.contacts.references.truncate(contacts);
         self.contacts.wrenches.truncate(contacts);
+        self.contacts.small_refs.truncate(contacts);
         self.contacts.resize_subcontacts(room);
         if STAGING_FRACTION * sc.staging.store.subs.capacity() > self.contacts.subs.len().max(1) {
             sc.release_staging();

@@ -7,7 +7,7 @@ use super::*;
 use crate::block::{Block, RigidBlock};
 use crate::contact::{
     node_frame, stored_node_frame, AnchorPlane, ContactLists, ContactPair, ContactReference, ContactStore,
-    ContactWrench, ForceMoments, OldContacts, SubContact,
+    ContactWrench, ForceMoments, OldContacts, SmallReference, SubContact,
 };
 use crate::error::Result;
 use crate::geometry::{face_frame, ContactKind, DetectedContact, NodeId, SubContactSeed, SubKey, PARALLEL_ANGLE};
@@ -54,9 +54,6 @@ pub(super) fn dead_contact() -> (ContactPair, ContactReference) {
         joint: Default::default(),
     };
     let reference = ContactReference {
-        ref_a: Vector::ZERO,
-        ref_b: Vector::ZERO,
-        ref_host_rotation: crate::math::Rotation::IDENTITY,
         area: 0.0,
         bound_area: 0.0,
         side: None,
@@ -107,6 +104,11 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
         self.store
             .wrenches
             .par_extend(rayon::iter::repeat_n(ContactWrench::default(), contacts - pair_base));
+        if self.store.small_kept {
+            self.store
+                .small_refs
+                .par_extend(rayon::iter::repeat_n(SmallReference::DEAD, contacts - pair_base));
+        }
         self.store.subs.par_extend(rayon::iter::repeat_n(sub, subs - sub_base));
         if self.store.dashpots_kept {
             self.store
@@ -119,6 +121,11 @@ impl<S: Clone + Default + Send + Sync> StagedLists<S> {
             pairs: &mut self.store.pairs[pair_base..],
             references: &mut self.store.references[pair_base..],
             wrenches: &mut self.store.wrenches[pair_base..],
+            small_refs: if self.store.small_kept {
+                &mut self.store.small_refs[pair_base..]
+            } else {
+                &mut []
+            },
             subs: &mut self.store.subs[sub_base..],
             dashpots: if self.store.dashpots_kept {
                 &mut self.store.sub_dashpots[sub_base..]
@@ -137,6 +144,8 @@ pub(super) struct StagingSlices<'a, S> {
     pub(super) pairs: &'a mut [ContactPair],
     pub(super) references: &'a mut [ContactReference],
     pub(super) wrenches: &'a mut [ContactWrench],
+    /// The contacts' small-displacement references, or empty when the lists keep none.
+    pub(super) small_refs: &'a mut [SmallReference],
     pub(super) subs: &'a mut [SubContact<S>],
     /// The sub-contacts' dashpot forces, or empty when the model keeps none.
     pub(super) dashpots: &'a mut [Vector],
@@ -150,6 +159,11 @@ impl<'a, S> StagingSlices<'a, S> {
         let (pairs_a, pairs_b) = self.pairs.split_at_mut(p);
         let (references_a, references_b) = self.references.split_at_mut(p);
         let (wrenches_a, wrenches_b) = self.wrenches.split_at_mut(p);
+        let (small_refs_a, small_refs_b) = if self.small_refs.is_empty() {
+            (self.small_refs, &mut [][..])
+        } else {
+            self.small_refs.split_at_mut(p)
+        };
         let (subs_a, subs_b) = self.subs.split_at_mut(s);
         let (dashpots_a, dashpots_b) = if self.dashpots.is_empty() {
             (self.dashpots, &mut [][..])
@@ -163,6 +177,7 @@ impl<'a, S> StagingSlices<'a, S> {
                 pairs: pairs_a,
                 references: references_a,
                 wrenches: wrenches_a,
+                small_refs: small_refs_a,
                 subs: subs_a,
                 dashpots: dashpots_a,
             },
@@ -172,6 +187,7 @@ impl<'a, S> StagingSlices<'a, S> {
                 pairs: pairs_b,
                 references: references_b,
                 wrenches: wrenches_b,
+                small_refs: small_refs_b,
                 subs: subs_b,
                 dashpots: dashpots_b,
             },
@@ -360,10 +376,15 @@ impl<S: Clone + Default + PartialEq> StagingSlices<'_, S> {
         let k = staged as usize - self.pair_base;
         self.pairs[k] = pair;
         self.wrenches[k] = ContactWrench::default();
+        // Kept in small-displacement mode only (empty otherwise).
+        if let Some(small) = self.small_refs.get_mut(k) {
+            *small = SmallReference {
+                ref_a: bi.state.pose.translation,
+                ref_b: bj.state.pose.translation,
+                ref_host_rotation: host.state.pose.rotation,
+            };
+        }
         self.references[k] = ContactReference {
-            ref_a: bi.state.pose.translation,
-            ref_b: bj.state.pose.translation,
-            ref_host_rotation: host.state.pose.rotation,
             area: seeds.iter().map(|s| s.area).sum(),
             bound_area,
             // A node contact's keys name its nodes (a cell's follows from its contact).
@@ -479,6 +500,7 @@ impl<L: ConstitutiveLaw> ModelState<L> {
         let old = OldContacts {
             pairs: &self.contacts.pairs,
             references: &self.contacts.references,
+            small_refs: &self.contacts.small_refs,
             subs: &self.contacts.subs,
             dashpots: &self.contacts.sub_dashpots,
         };
