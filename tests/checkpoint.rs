@@ -38,6 +38,22 @@ fn moving_wall() -> Result<Model> {
     Ok(model)
 }
 
+/// Adds a regular tetrahedron (the one inscribed in a 0.2 m cube, 2,500 kg/m³), turned so that
+/// it meets the slab of `common::fixed_slab` (top at z = 0) on a vertex, its lowest point `lift`
+/// above it.
+fn add_tilted_tetrahedron<L: ConstitutiveLaw>(model: &mut Model<L>, lift: Real) -> Result<BlockId> {
+    let s = 0.1;
+    let v = Vector::new;
+    let tetrahedron = RigidBlock::from_vertices(
+        "tetrahedron",
+        &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
+        2500.0,
+    )?
+    .transformed(Pose::from_rotation(Rotation::from_scaled_axis(v(0.3, -0.5, 0.2))));
+    let low = common::z_range(&tetrahedron).0;
+    model.add_block(tetrahedron.transformed(Pose::from_translation(v(0.0, 0.0, lift - low))))
+}
+
 /// A recorder of the wall's kinetic energy and top displacement every tenth step.
 fn wall_recorder(model: &Model) -> Result<Recorder<CoulombSlip>> {
     let mut recorder = Recorder::new(10);
@@ -1111,16 +1127,7 @@ fn a_run_with_integrated_nodes_restarts_bit_for_bit() -> Result<()> {
     params.contact.node_rule = NodeRule::Integrated;
     let mut model = common::model_with(params, CoulombSlip::dry(1e9, 1e9, 30.0)?);
     model.add_block(common::fixed_slab("slab"))?;
-    let s = 0.1;
-    let v = Vector::new;
-    let tetrahedron = RigidBlock::from_vertices(
-        "tetrahedron",
-        &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
-        2500.0,
-    )?
-    .transformed(Pose::from_rotation(Rotation::from_scaled_axis(v(0.3, -0.5, 0.2))));
-    let low = common::z_range(&tetrahedron).0;
-    model.add_block(tetrahedron.transformed(Pose::from_translation(v(0.0, 0.0, 0.03 - low))))?;
+    add_tilted_tetrahedron(&mut model, 0.03)?;
     // Until a node contact carries load.
     let pressed = |m: &Model| {
         m.contacts().any(|c| {
@@ -1155,22 +1162,13 @@ fn a_block_tossed_off_its_last_contact_restarts_bit_for_bit() -> Result<()> {
     let mut model = common::model_with(ModelParameters::default(), CoulombSlip::dry(1e9, 1e9, 30.0)?);
     model.set_damping(Damping::local())?;
     model.add_block(common::fixed_slab("slab"))?;
-    let s = 0.1;
-    let v = Vector::new;
-    let tetrahedron = RigidBlock::from_vertices(
-        "tetrahedron",
-        &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
-        2500.0,
-    )?
-    .transformed(Pose::from_rotation(Rotation::from_scaled_axis(v(0.3, -0.5, 0.2))));
-    let low = common::z_range(&tetrahedron).0;
-    let id = model.add_block(tetrahedron.transformed(Pose::from_translation(v(0.0, 0.0, 0.002 - low))))?;
+    let id = add_tilted_tetrahedron(&mut model, 0.002)?;
     let pressed = |m: &Model| m.contacts().any(|c| c.subcontacts().any(|x| x.normal_force() > 0.0));
     while !pressed(&model) {
         model.step()?;
         assert!(model.time() < 0.5, "no pressed contact");
     }
-    model.set_velocity(id, v(0.0, 0.0, 1.5), v(0.0, 0.0, 0.0))?;
+    model.set_velocity(id, Vector::new(0.0, 0.0, 1.5), Vector::ZERO)?;
     while model.contacts().len() > 0 {
         model.step()?;
         assert!(model.time() < 1.0, "still in contact");
@@ -1203,15 +1201,7 @@ fn every_checkpoint_of_a_tumbling_scene_loads() -> Result<()> {
         let mut model = common::model_with(params, CoulombSlip::dry(1e9, 1e9, 30.0)?);
         model.set_damping(damping)?;
         model.add_block(common::fixed_slab("slab"))?;
-        let s = 0.1;
-        let tetrahedron = RigidBlock::from_vertices(
-            "tetrahedron",
-            &[v(s, s, s), v(s, -s, -s), v(-s, s, -s), v(-s, -s, s)],
-            2500.0,
-        )?
-        .transformed(Pose::from_rotation(Rotation::from_scaled_axis(v(0.3, -0.5, 0.2))));
-        let low = common::z_range(&tetrahedron).0;
-        model.add_block(tetrahedron.transformed(Pose::from_translation(v(0.0, 0.0, lift - low))))?;
+        add_tilted_tetrahedron(&mut model, lift)?;
         let gap = lift.min(1e-3);
         model.add_block(RigidBlock::cuboid(
             "cube",

@@ -2,8 +2,8 @@
 //! sub-contacts (each with its key, or for a node its contact's reference), struct of arrays
 //! (each contact owns a contiguous range of the sub-contacts, `ContactPair::range`), the
 //! contacts' geometry at detection in small-displacement mode, and the sub-contacts' dashpot
-//! forces when the model has any. One owner, [`ContactStore`], and the views the
-//! stages take of it: [`OldContacts`] (detection reading the contacts it replaces),
+//! forces when the model has any. One owner, [`ContactStore`], and the views the stages take of
+//! it: [`OldContacts`] (detection reading the contacts it replaces),
 //! [`ContactLists`] (detection rearranging them) and [`ContactSlices`] (the contact pass
 //! writing them, split at chunk boundaries).
 
@@ -12,9 +12,9 @@ use crate::math::Vector;
 
 /// The contacts of a model (or detection's staging lists): struct of arrays, kept index for
 /// index (`pairs`, `references`, `wrenches` and, when kept, `small_refs`; `subs` and, when
-/// kept, `sub_dashpots`). A
-/// sub-contact's key is no list of its own: a face-face cell holds its grid indices in what was
-/// its padding, a node contact's reference its nodes' keys ([`super::ContactPair::key`]).
+/// kept, `sub_dashpots`). A sub-contact's key is no list of its own: a face-face cell holds its
+/// grid indices in what was its padding, a node contact's reference its nodes' keys
+/// ([`super::ContactPair::key`]).
 #[derive(Debug, Clone)]
 pub(crate) struct ContactStore<S> {
     /// The contacts, sorted by block pair.
