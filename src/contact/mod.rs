@@ -119,6 +119,22 @@ pub(crate) struct CellSummary {
     pub(crate) area_moments: [Real; 6],
 }
 
+impl ContactPair {
+    /// The range of the contact's own sub-contacts that its next step reads, as far as the
+    /// contact says beforehand: none for a joint stepped as a whole (unless it leaves), the
+    /// span of a hinge, all of them otherwise.
+    #[inline]
+    pub(crate) fn cells_read_by_step(&self) -> std::ops::Range<usize> {
+        if !self.joint.active {
+            0..self.count as usize
+        } else if self.joint.is_partial() {
+            self.joint.span_range()
+        } else {
+            0..0
+        }
+    }
+}
+
 impl CellSummary {
     /// The summary of the cells of `own`, a contact's sub-contacts.
     pub(crate) fn of<S>(own: &[SubContact<S>]) -> Self {

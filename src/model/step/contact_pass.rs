@@ -24,6 +24,45 @@ pub(in crate::model) const CONTACT_CHUNK: usize = 64;
 /// Chunks a task runs one after the other rather than splitting further.
 const CHUNKS_PER_TASK: usize = 4;
 
+/// How many contacts ahead of the one it steps the contact pass asks for the sub-contacts the
+/// step will read ([`prefetch_cells`]).
+const PREFETCH_AHEAD: usize = 8;
+
+/// The most cache lines of one contact's sub-contacts asked for ahead (2 kB: a bed joint of
+/// the benchmark wall); the hardware's stream prefetcher follows a longer run.
+const PREFETCH_LINES: usize = 32;
+
+/// Asks the processor to bring into cache the sub-contacts contact `q`'s step will read (its
+/// [`ContactPair::cells_read_by_step`]); `subs` starts at sub-contact `base`. A hint: nothing
+/// is read, and the results do not change.
+///
+/// With joints stepped as a whole, the sub-contacts a step reads are those of the contacts on
+/// the cell path, scattered among the cells it skips, in runs too short for the hardware
+/// prefetcher to follow: their first loads wait on memory (`docs/performance.md`, "Sub-contacts
+/// asked for ahead").
+#[inline(always)]
+fn prefetch_cells<S>(q: &crate::contact::ContactPair, subs: &[crate::contact::SubContact<S>], base: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let own = q.first as usize - base..q.first as usize - base + q.count as usize;
+        let read = q.cells_read_by_step();
+        let Some(cells) = subs.get(own.start + read.start..own.start + read.end) else {
+            return;
+        };
+        let start = cells.as_ptr().cast::<i8>();
+        let bytes = std::mem::size_of_val(cells).min(PREFETCH_LINES * 64);
+        for offset in (0..bytes).step_by(64) {
+            // SAFETY: SSE is part of x86_64's baseline; a prefetch reads nothing and never
+            // faults (the address stays within `cells` all the same).
+            unsafe {
+                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(start.wrapping_add(offset));
+            }
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (q, subs, base);
+}
+
 /// What the contact pass reads, shared by its tasks.
 pub(in crate::model) struct ContactPass<'a, L: ConstitutiveLaw> {
     pub blocks: &'a [RigidBlock],
@@ -113,7 +152,16 @@ impl<L: ConstitutiveLaw> ContactPass<'_, L> {
         } = chunk;
         let sums = &mut sums[0];
         let base = pairs[0].first as usize;
-        for (k, ((p, reference), w)) in pairs.iter_mut().zip(references.iter_mut()).zip(wrenches).enumerate() {
+        // The cells of the first contacts, then at each contact those of the one
+        // `PREFETCH_AHEAD` after it (`prefetch_cells`).
+        for q in pairs.iter().take(PREFETCH_AHEAD) {
+            prefetch_cells(q, subs, base);
+        }
+        for k in 0..pairs.len() {
+            if let Some(q) = pairs.get(k + PREFETCH_AHEAD) {
+                prefetch_cells(q, subs, base);
+            }
+            let (p, reference, w) = (&mut pairs[k], &mut references[k], &mut wrenches[k]);
             let (ma, mb) = (&self.motions[p.a as usize], &self.motions[p.b as usize]);
             let range = p.first as usize - base..p.first as usize - base + p.count as usize;
             let watch = !self.refining.is_empty() && self.refining.binary_search(&(p.a, p.b)).is_ok();
